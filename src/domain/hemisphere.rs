@@ -1,0 +1,84 @@
+//! The hemisphere of directions around a normal, measured in solid angle.
+
+use super::{Domain, Frame, Vec3};
+use std::f64::consts::PI;
+
+/// How `[0, 1]^2` is mapped onto the hemisphere.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HemisphereMap {
+    /// `cos theta = u_1`, `phi = 2 pi u_2`: uniform in solid angle, `|J| = 2 pi`.
+    Uniform,
+    /// Malley's map: `sin theta = sqrt(u_1)`, `phi = 2 pi u_2`; density
+    /// `cos theta / pi`, so `|J| = pi / cos theta`. A cosine-weighted integrand
+    /// `g(w) cos theta` becomes `pi g(w)` in `u`.
+    Cosine,
+}
+
+/// The hemisphere `{w : w . n >= 0}` of unit directions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hemisphere {
+    /// Frame whose `n` is the pole.
+    pub frame: Frame,
+    /// The parameterisation.
+    pub map: HemisphereMap,
+}
+
+impl Hemisphere {
+    /// The upper hemisphere about `+z`, uniform map.
+    pub fn uniform() -> Self {
+        Hemisphere {
+            frame: Frame::identity(),
+            map: HemisphereMap::Uniform,
+        }
+    }
+
+    /// The upper hemisphere about `+z`, cosine-weighted map.
+    pub fn cosine() -> Self {
+        Hemisphere {
+            frame: Frame::identity(),
+            map: HemisphereMap::Cosine,
+        }
+    }
+}
+
+impl Domain<2> for Hemisphere {
+    type Point = Vec3;
+
+    fn map(&self, u: [f64; 2]) -> (Vec3, f64) {
+        let phi = 2.0 * PI * u[1];
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let (sin_theta, cos_theta, jacobian) = match self.map {
+            HemisphereMap::Uniform => {
+                let z = u[0];
+                // sin = sqrt((1 - z)(1 + z)), no cancellation for z near 1.
+                ((1.0 - z).max(0.0).sqrt() * (1.0 + z).sqrt(), z, 2.0 * PI)
+            }
+            HemisphereMap::Cosine => {
+                let z = (1.0 - u[0]).max(0.0).sqrt();
+                (u[0].sqrt(), z, PI / z)
+            }
+        };
+        let local = Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
+        (self.frame.to_world(local), jacobian)
+    }
+
+    fn invert(&self, w: &Vec3) -> Option<[f64; 2]> {
+        let l = self.frame.to_local(*w);
+        if !(l.z >= 0.0) || ((l.norm() - 1.0).abs() > 1e-9) {
+            return None;
+        }
+        let mut phi = l.y.atan2(l.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        let u1 = match self.map {
+            HemisphereMap::Uniform => l.z,
+            HemisphereMap::Cosine => l.x * l.x + l.y * l.y,
+        };
+        Some([u1, (phi / (2.0 * PI)).min(1.0)])
+    }
+
+    fn measure(&self) -> f64 {
+        2.0 * PI
+    }
+}

@@ -1,0 +1,79 @@
+//! Errors of the quadrature core: every variant names the parameter, the value
+//! it was given and what is accepted, so a user can fix the input without
+//! reading the code.
+
+use thiserror::Error;
+
+/// An error raised by a rule, a domain or an integration.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum QuadError {
+    /// A parameter is outside its accepted range.
+    #[error("invalid {name} = {value}: expected {accepted}")]
+    InvalidParameter {
+        /// Name of the parameter, as the user wrote it (`n`, `a`, `radius`, ...).
+        name: String,
+        /// The value that was given, formatted.
+        value: String,
+        /// What is accepted, in words (`an integer in 1..=100000000`).
+        accepted: String,
+    },
+    /// A rule name that the registry does not know.
+    #[error("unknown rule `{name}`: expected one of {known}")]
+    UnknownRule {
+        /// The name that was given.
+        name: String,
+        /// The known names, comma separated.
+        known: String,
+    },
+    /// The rule cannot integrate over the requested dimension.
+    #[error("rule `{rule}` does not support dimension {dim}: it supports {supported}")]
+    UnsupportedDimension {
+        /// Rule name.
+        rule: &'static str,
+        /// Requested dimension.
+        dim: usize,
+        /// Dimensions the rule supports, in words.
+        supported: &'static str,
+    },
+    /// The integrand returned a non-finite value.
+    #[error("integrand returned {value} at unit-cube point {point:?}")]
+    NonFiniteIntegrand {
+        /// The point in the unit cube where it happened.
+        point: Vec<f64>,
+        /// The offending value, formatted.
+        value: String,
+    },
+}
+
+impl QuadError {
+    /// Shorthand for [`QuadError::InvalidParameter`].
+    pub fn invalid(
+        name: impl Into<String>,
+        value: impl std::fmt::Display,
+        accepted: impl Into<String>,
+    ) -> Self {
+        QuadError::InvalidParameter {
+            name: name.into(),
+            value: value.to_string(),
+            accepted: accepted.into(),
+        }
+    }
+}
+
+/// Checks that `x` is finite, naming the parameter otherwise.
+pub fn require_finite(name: &str, x: f64) -> Result<f64, QuadError> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(QuadError::invalid(name, x, "a finite number"))
+    }
+}
+
+/// Checks that `x` is finite and strictly positive.
+pub fn require_positive(name: &str, x: f64) -> Result<f64, QuadError> {
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        Err(QuadError::invalid(name, x, "a finite number > 0"))
+    }
+}

@@ -1,0 +1,44 @@
+//! # lightquad
+//!
+//! How accurate is each numerical approximation of a light-transport integral,
+//! and what does it cost? lightquad answers with pluggable quadrature rules,
+//! domains that map the unit cube onto the geometry of rendering, and (in later
+//! modules) the equations of volume rendering, the rendering equation and
+//! Whitted's model, each with closed forms where they exist.
+//!
+//! Three independent axes meet only where an integral is evaluated:
+//!
+//! - a **rule** ([`quadrature`]) places weighted nodes in `[0, 1]^D` for a budget
+//!   of `n` evaluations and returns an [`Estimate`] (value, error estimate,
+//!   evaluations);
+//! - a **domain** ([`domain`]) maps `[0, 1]^D` onto a ray segment, a surface
+//!   patch, the hemisphere or a pixel, with the Jacobian of the map;
+//! - an **equation** supplies the integrand.
+//!
+//! ```
+//! use lightquad::domain::{Domain, Hemisphere, integrate_over};
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! // int_{H^2} cos(theta) d omega = pi
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+//! let hemisphere = Hemisphere::uniform();
+//! let est = integrate_over(&GaussLegendre::default(), &hemisphere, 64, &mut rng, |w| w.z)?;
+//! assert!((est.value - std::f64::consts::PI).abs() < 1e-12);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
+
+#![forbid(unsafe_code)]
+#![deny(clippy::unwrap_used, clippy::expect_used)]
+#![warn(missing_docs)]
+
+pub mod domain;
+pub mod error;
+pub mod estimate;
+pub mod quadrature;
+pub mod sum;
+pub mod value;
+
+pub use error::QuadError;
+pub use estimate::Estimate;
+pub use value::{Rgb, Value};

@@ -1,0 +1,127 @@
+//! Iteration-free Gauss–Legendre nodes and weights for large `n`, after
+//! I. Bogaert, "Iteration-free computation of Gauss–Legendre quadrature nodes and
+//! weights", SIAM J. Sci. Comput. 36(3), A1008–A1026 (2014).
+//!
+//! With `v = 1/(n + 1/2)`, `alpha = v j_{0,k}` (the k-th zero of `J_0` scaled),
+//! `u = cot(alpha)`, the k-th node `x_k = cos(theta_k)` (counted from `x = +1`) is
+//!
+//! `theta_k = alpha + v^2 F1(alpha) + v^4 F2(alpha) + v^6 F3(alpha) + O(v^8)` with
+//!
+//! - `F1 = (u - 1/alpha) / 8`
+//! - `F2 = (6 (1 + u^2)/alpha + 25/alpha^3 - u (31 u^2 + 33)) / 384`
+//! - `F3 = u (2595 + 6350 u^2 + 3779 u^4)/15360 - 1073/(5120 alpha^5)
+//!        + (1 + u^2) (-(31 u^2 + 11)/(1024 alpha) + u/(512 alpha^2) - 25/(3072 alpha^3))`,
+//!
+//! and the weight is `w_k = 2 / (J_1(j_{0,k})^2 (alpha / sin alpha) (1/v^2 + W1 + W2 v^2 + W3 v^4))`
+//! with
+//!
+//! - `W1 = (u alpha + alpha^2 - 1) / (8 alpha^2)`
+//! - `W2 = (81 - 31 u alpha - 3 (1 - 2 u^2) alpha^2 + 6 u alpha^3 - (27 + 84 u^2 + 56 u^4) alpha^4) / (384 alpha^4)`
+//! - `W3 = (187/96 u^4 + 295/256 u^2 + 151/160 u^6 + 153/1024) + (-119/768 u^2 - 35/384 u^4 - 65/1024) u/alpha
+//!        + (5/512 + 7/384 u^4 + 15/512 u^2)/alpha^2 + (u^2/512 - 13/1536) u/alpha^3
+//!        + (-7/384 u^2 + 53/3072)/alpha^4 + 3749/15360 u/alpha^5 - 1125/1024/alpha^6`.
+//!
+//! The expansion is uniform in k, so one formula serves interior and boundary
+//! nodes. Terms are dropped where they fall below a tenth of an ulp for every k
+//! (the thresholds are stated at the constants). The truncation error
+//! `O(v^8)` is below double precision for n > 100; smaller n use Newton's method.
+//!
+//! Only one `sin_cos` is evaluated per node: `cos theta` and `1 - cos theta` follow
+//! from `sin alpha`, `cos alpha` and the small `delta = theta - alpha` by the
+//! angle-addition formula, without cancellation.
+
+use super::bessel::j0_zero_and_j1_squared;
+
+/// F2 is kept below this n: above it `v^4 |F2| < 1e-21` for every node.
+const F2_BELOW: usize = 100_000;
+/// F3 is kept below this n: above it `v^6 |F3| < 1e-21`.
+const F3_BELOW: usize = 3_000;
+/// W2 is kept below this n: above it `v^4 |W2| < 1e-20` relative.
+const W2_BELOW: usize = 20_000;
+/// W3 is kept below this n: above it `v^6 |W3| < 1e-20` relative.
+const W3_BELOW: usize = 3_000;
+
+/// One node of the upper half: `x = cos theta`, `y = 1 - x` (accurate even when
+/// `x` rounds to 1), and the weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HalfNode {
+    /// The node `x_k = cos(theta_k)`.
+    pub x: f64,
+    /// `1 - x_k`, computed without cancellation.
+    pub one_minus_x: f64,
+    /// The weight `w_k`.
+    pub weight: f64,
+}
+
+/// The k-th node counted from `x = +1` (k in 1..=ceil(n/2)) of the n-point rule.
+#[inline]
+pub fn node(n: usize, k: usize) -> HalfNode {
+    let v = 1.0 / (n as f64 + 0.5);
+    let v2 = v * v;
+    let (j, j1_squared) = j0_zero_and_j1_squared(k);
+    let alpha = j * v;
+    let (s, c) = alpha.sin_cos();
+    let u = c / s;
+    let ia = 1.0 / alpha;
+    let u2 = u * u;
+
+    // Node angle: theta = alpha + delta.
+    let f1 = (u - ia) * 0.125;
+    let mut delta_over_v2 = f1;
+    if n < F2_BELOW {
+        let ia3 = ia * ia * ia;
+        let f2 = (6.0 * (1.0 + u2) * ia + 25.0 * ia3 - u * (31.0 * u2 + 33.0)) / 384.0;
+        let mut tail = f2;
+        if n < F3_BELOW {
+            let ia2 = ia * ia;
+            let ia5 = ia3 * ia2;
+            let f3 = u * (2595.0 + u2 * (6350.0 + 3779.0 * u2)) / 15360.0 - 1073.0 / 5120.0 * ia5
+                + (1.0 + u2)
+                    * (-(31.0 * u2 + 11.0) / 1024.0 * ia + u / 512.0 * ia2 - 25.0 / 3072.0 * ia3);
+            tail += v2 * f3;
+        }
+        delta_over_v2 += v2 * tail;
+    }
+    let delta = v2 * delta_over_v2;
+
+    // cos(alpha + delta) and 1 - cos(alpha + delta) without cancellation:
+    // 1 - cos(alpha) = s^2/(1 + c); cos(alpha) - cos(theta) = c (1 - cos delta) + s sin delta.
+    let d2 = delta * delta;
+    let one_minus_cos_delta = 0.5 * d2 * (1.0 - d2 / 12.0);
+    let sin_delta = delta * (1.0 - d2 / 6.0);
+    let drop = c * one_minus_cos_delta + s * sin_delta;
+    let x = c - drop;
+    let one_minus_x = s * s / (1.0 + c) + drop;
+
+    // Weight.
+    let ua = u * alpha;
+    let a2 = alpha * alpha;
+    let w1 = (ua + a2 - 1.0) / (8.0 * a2);
+    let mut correction = w1;
+    if n < W2_BELOW {
+        let a4 = a2 * a2;
+        let w2 = (81.0 - 31.0 * ua - 3.0 * (1.0 - 2.0 * u2) * a2 + 6.0 * ua * a2
+            - (27.0 + u2 * (84.0 + 56.0 * u2)) * a4)
+            / (384.0 * a4);
+        let mut tail = w2;
+        if n < W3_BELOW {
+            let u4 = u2 * u2;
+            let w3 = (187.0 / 96.0 * u4 + 295.0 / 256.0 * u2 + 151.0 / 160.0 * u4 * u2 + 153.0 / 1024.0)
+                + (-119.0 / 768.0 * u2 - 35.0 / 384.0 * u4 - 65.0 / 1024.0) * u * ia
+                + (5.0 / 512.0 + 7.0 / 384.0 * u4 + 15.0 / 512.0 * u2) * ia * ia
+                + (u2 / 512.0 - 13.0 / 1536.0) * u * ia * ia * ia
+                + (-7.0 / 384.0 * u2 + 53.0 / 3072.0) * (ia * ia) * (ia * ia)
+                + 3749.0 / 15360.0 * u * (ia * ia) * (ia * ia) * ia
+                - 1125.0 / 1024.0 * (ia * ia * ia) * (ia * ia * ia);
+            tail += v2 * w3;
+        }
+        correction += v2 * tail;
+    }
+    // w = 2 v^2 sin(alpha) / (J1^2 alpha (1 + v^2 (W1 + ...)))
+    let weight = 2.0 * v2 * s / (j1_squared * alpha * (1.0 + v2 * correction));
+    HalfNode {
+        x,
+        one_minus_x,
+        weight,
+    }
+}

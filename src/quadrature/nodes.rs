@@ -1,0 +1,137 @@
+//! Weighted node sets on the unit interval and the one shared summation that
+//! turns (tensor products of) them into an integral.
+
+use crate::error::QuadError;
+use crate::sum::Compensated;
+use crate::value::Value;
+
+/// A 1-D rule on `[0, 1]`: nodes `u_i` and weights `w_i` with `sum w_i = 1`
+/// (so the rule estimates `int_0^1 f(u) du` by `sum w_i f(u_i)`), and optional
+/// companion weights on the same nodes for an embedded error estimate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnitNodes {
+    /// Nodes in `[0, 1]`, ascending.
+    pub u: Vec<f64>,
+    /// Weights, summing to 1.
+    pub w: Vec<f64>,
+    /// Weights of a lower-order companion rule on the same nodes (zero where
+    /// the companion has no node), when the rule has one.
+    pub companion: Option<Vec<f64>>,
+}
+
+impl UnitNodes {
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.u.len()
+    }
+
+    /// True when the rule has no nodes.
+    pub fn is_empty(&self) -> bool {
+        self.u.is_empty()
+    }
+}
+
+/// The result of one pass over a tensor-product node set.
+#[derive(Debug, Clone, Copy)]
+pub struct ProductSum<V: Value> {
+    /// `sum_i prod_d w_{i_d} f(u_i)`.
+    pub value: V,
+    /// The same sum with the companion weights, when every axis has them.
+    pub companion: Option<V>,
+    /// Integrand evaluations.
+    pub evaluations: u64,
+}
+
+/// Sums `f` over the tensor product of `axes` with compensated summation.
+///
+/// This is the only place where a deterministic rule meets the integrand.
+/// A non-finite integrand value stops the sum with an error naming the point.
+pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> V>(
+    axes: [&UnitNodes; D],
+    mut f: F,
+) -> Result<ProductSum<V>, QuadError> {
+    let with_companion = axes.iter().all(|a| a.companion.is_some());
+    let mut acc = Compensated::<V>::new();
+    let mut acc_c = Compensated::<V>::new();
+    let mut evaluations = 0u64;
+    if axes.iter().any(|a| a.is_empty()) {
+        return Ok(ProductSum {
+            value: V::zero(),
+            companion: with_companion.then(V::zero),
+            evaluations,
+        });
+    }
+
+    // One dimension: a straight loop the compiler can keep tight.
+    if D == 1 {
+        let a = axes[0];
+        let companion = a.companion.as_deref();
+        for i in 0..a.u.len() {
+            let mut p = [0.0; D];
+            p[0] = a.u[i];
+            let y = f(p);
+            if !y.all_finite() {
+                return Err(non_finite(&p, &y));
+            }
+            acc.add(y.map(|v| v * a.w[i]));
+            if let Some(c) = companion {
+                acc_c.add(y.map(|v| v * c[i]));
+            }
+        }
+        evaluations = a.u.len() as u64;
+    } else {
+        // D dimensions: walk the index odometer.
+        let mut idx = [0usize; D];
+        loop {
+            let mut p = [0.0; D];
+            let mut w = 1.0;
+            let mut wc = 1.0;
+            for d in 0..D {
+                p[d] = axes[d].u[idx[d]];
+                w *= axes[d].w[idx[d]];
+                if with_companion {
+                    wc *= axes[d].companion.as_ref().map_or(0.0, |c| c[idx[d]]);
+                }
+            }
+            let y = f(p);
+            evaluations += 1;
+            if !y.all_finite() {
+                return Err(non_finite(&p, &y));
+            }
+            acc.add(y.map(|v| v * w));
+            if with_companion {
+                acc_c.add(y.map(|v| v * wc));
+            }
+            // Advance the odometer, last axis fastest.
+            let mut d = D;
+            loop {
+                if d == 0 {
+                    return Ok(ProductSum {
+                        value: acc.total(),
+                        companion: with_companion.then(|| acc_c.total()),
+                        evaluations,
+                    });
+                }
+                d -= 1;
+                idx[d] += 1;
+                if idx[d] < axes[d].u.len() {
+                    break;
+                }
+                idx[d] = 0;
+            }
+        }
+    }
+    Ok(ProductSum {
+        value: acc.total(),
+        companion: with_companion.then(|| acc_c.total()),
+        evaluations,
+    })
+}
+
+/// The error for a non-finite integrand value at unit-cube point `p`.
+pub fn non_finite<V: Value>(p: &[f64], y: &V) -> QuadError {
+    QuadError::NonFiniteIntegrand {
+        point: p.to_vec(),
+        value: format!("{y:?}"),
+    }
+}

@@ -1,0 +1,61 @@
+//! Shared test helpers: reference-data loading and the tolerances every test
+//! file uses, each with a sentence on when it applies.
+#![allow(dead_code)]
+
+use serde_json::Value as Json;
+
+/// Unit roundoff of f64.
+pub const EPS: f64 = f64::EPSILON;
+
+/// Loads a JSON file from tests/data.
+pub fn data(name: &str) -> Json {
+    let path = format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// Parses a decimal string (40 digits) to the nearest f64.
+pub fn num(v: &Json) -> f64 {
+    v.as_str()
+        .unwrap_or_else(|| panic!("expected a decimal string, got {v}"))
+        .parse()
+        .unwrap_or_else(|e| panic!("{v}: {e}"))
+}
+
+/// Parses an array of decimal strings.
+pub fn nums(v: &Json) -> Vec<f64> {
+    v.as_array()
+        .unwrap_or_else(|| panic!("expected an array, got {v}"))
+        .iter()
+        .map(num)
+        .collect()
+}
+
+/// Relative difference `|a - b| / |b|` (absolute when b = 0).
+pub fn rel(a: f64, b: f64) -> f64 {
+    if b == 0.0 {
+        (a - b).abs()
+    } else {
+        ((a - b) / b).abs()
+    }
+}
+
+/// A deterministic rng for the rule calls.
+pub fn rng(seed: u64) -> rand_pcg::Pcg64 {
+    use rand::SeedableRng;
+    rand_pcg::Pcg64::seed_from_u64(seed)
+}
+
+/// Least-squares slope of `log(err)` against `log(n)`: the observed order.
+pub fn fitted_order(points: &[(f64, f64)]) -> f64 {
+    let m = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (n, e)| (a + n.ln(), b + e.ln()));
+    let (mx, my) = (sx / m, sy / m);
+    let (num, den) = points.iter().fold((0.0, 0.0), |(a, b), (n, e)| {
+        let dx = n.ln() - mx;
+        (a + dx * (e.ln() - my), b + dx * dx)
+    });
+    num / den
+}
