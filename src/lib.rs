@@ -35,6 +35,7 @@
 pub mod domain;
 pub mod error;
 pub mod estimate;
+pub mod experiment;
 pub mod quadrature;
 pub mod sum;
 pub mod value;

@@ -27,15 +27,18 @@ impl Frame {
     /// A frame around `normal` (normalised), tangents by the branch-free method
     /// of Duff et al., "Building an orthonormal basis, revisited" (JCGT 2017).
     pub fn from_normal(normal: Vec3) -> Result<Self, QuadError> {
-        let len = normal.norm();
-        if !(len.is_finite() && len > 0.0) {
+        // Scale by the largest component first, so that neither huge nor tiny
+        // (finite, non-zero) normals overflow or underflow in the norm.
+        let largest = normal.amax();
+        if !(normal.iter().all(|x| x.is_finite()) && largest > 0.0) {
             return Err(QuadError::invalid(
                 "normal",
                 format!("{:?}", normal.as_slice()),
                 "a finite, non-zero vector",
             ));
         }
-        let n = normal / len;
+        let scaled = normal / largest;
+        let n = scaled / scaled.norm();
         let sign = 1.0_f64.copysign(n.z);
         let a = -1.0 / (sign + n.z);
         let b = n.x * n.y * a;

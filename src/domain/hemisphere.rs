@@ -44,6 +44,8 @@ impl Hemisphere {
 impl Domain<2> for Hemisphere {
     type Point = Vec3;
 
+    /// `w = sin theta cos phi s + sin theta sin phi t + cos theta n`,
+    /// `phi = 2 pi u_2`, `theta` and `|J|` as [`HemisphereMap`] says.
     fn map(&self, u: [f64; 2]) -> (Vec3, f64) {
         let phi = 2.0 * PI * u[1];
         let (sin_phi, cos_phi) = phi.sin_cos();
@@ -62,20 +64,21 @@ impl Domain<2> for Hemisphere {
         (self.frame.to_world(local), jacobian)
     }
 
+    /// `u_1 = cos theta` (uniform) or `sin^2 theta` (cosine), `u_2 = atan2(w_t,
+    /// w_s) / (2 pi)` in `[0, 1)`; `None` below the horizon or off the unit
+    /// sphere by more than [`INVERT_TOL`](super::INVERT_TOL).
     fn invert(&self, w: &Vec3) -> Option<[f64; 2]> {
         let l = self.frame.to_local(*w);
-        if !(l.z >= 0.0) || ((l.norm() - 1.0).abs() > 1e-9) {
+        if !(l.z >= 0.0 && super::within(l.norm() - 1.0, super::INVERT_TOL)) {
             return None;
         }
-        let mut phi = l.y.atan2(l.x);
-        if phi < 0.0 {
-            phi += 2.0 * PI;
-        }
+        // Rounding can put `cos theta` or `sin^2 theta` a few ulps above 1.
         let u1 = match self.map {
             HemisphereMap::Uniform => l.z,
             HemisphereMap::Cosine => l.x * l.x + l.y * l.y,
-        };
-        Some([u1, (phi / (2.0 * PI)).min(1.0)])
+        }
+        .min(1.0);
+        Some([u1, super::azimuth_fraction(l.y, l.x)])
     }
 
     fn measure(&self) -> f64 {

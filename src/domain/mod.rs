@@ -2,7 +2,7 @@
 //! lives on, with the Jacobian of the map and its inverse.
 //!
 //! `int_Omega g(p) d mu(p) = int_{[0,1]^D} g(map(u)) |J(u)| du`, so any
-//! [`Rule`](crate::quadrature::Rule) integrates over any domain
+//! [`Rule`] integrates over any domain
 //! ([`integrate_over`]): R rules and D domains cost R + D code.
 //!
 //! | domain | D | point | measure |
@@ -15,13 +15,23 @@
 //! | [`Hemisphere`] (uniform or cosine-weighted map) | 2 | unit direction | solid angle |
 //! | [`Pixel`] (image-plane square) | 2 | `[x, y]` | area |
 
+pub mod disk;
 pub mod frame;
 pub mod hemisphere;
+pub mod pixel;
+pub mod rectangle;
 pub mod segment;
+pub mod sphere;
+pub mod triangle;
 
+pub use disk::Disk;
 pub use frame::Frame;
 pub use hemisphere::{Hemisphere, HemisphereMap};
+pub use pixel::Pixel;
+pub use rectangle::Rectangle;
 pub use segment::Segment;
+pub use sphere::SphericalCap;
+pub use triangle::Triangle;
 
 use crate::error::QuadError;
 use crate::estimate::Estimate;
@@ -30,6 +40,66 @@ use crate::value::Value;
 
 /// A 3-vector (points and directions).
 pub type Vec3 = nalgebra::Vector3<f64>;
+
+/// Relative tolerance of [`Domain::invert`]: a point within `INVERT_TOL` times
+/// the domain's size of the domain (and of its surface) is on it; its `u` is
+/// clamped into `[0, 1]^D`.
+pub const INVERT_TOL: f64 = 1e-9;
+
+/// The dimensionless slack `invert` grants a point: [`INVERT_TOL`] plus the
+/// rounding of coordinates of magnitude `magnitude` on a domain of size `size`.
+pub(crate) fn invert_slack(size: f64, magnitude: f64) -> f64 {
+    INVERT_TOL + 64.0 * f64::EPSILON * magnitude / size
+}
+
+/// `x` clamped into `[0, 1]` when it lies within `slack` of it, else `None`
+/// (`NaN` included).
+pub(crate) fn snap_unit(x: f64, slack: f64) -> Option<f64> {
+    if -slack <= x && x <= 1.0 + slack {
+        Some(x.clamp(0.0, 1.0))
+    } else {
+        None
+    }
+}
+
+/// `|x| <= bound`, false for `NaN`.
+pub(crate) fn within(x: f64, bound: f64) -> bool {
+    x.abs() <= bound
+}
+
+/// The azimuth `atan2(y, x) / (2 pi)` in `[0, 1]`: the inverse of `phi = 2 pi u`.
+pub(crate) fn azimuth_fraction(y: f64, x: f64) -> f64 {
+    let mut phi = y.atan2(x);
+    if phi < 0.0 {
+        phi += 2.0 * std::f64::consts::PI;
+    }
+    (phi / (2.0 * std::f64::consts::PI)).clamp(0.0, 1.0)
+}
+
+/// Checks that every component of `v` is finite, naming the parameter otherwise.
+pub(crate) fn require_finite_vec3(name: &str, v: Vec3) -> Result<Vec3, QuadError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(QuadError::invalid(
+            name,
+            format!("{:?}", v.as_slice()),
+            "a vector with finite components",
+        ))
+    }
+}
+
+/// The [`Frame`] around `normal`, an error naming `name` when `normal` is
+/// non-finite or zero.
+pub(crate) fn frame_around(name: &str, normal: Vec3) -> Result<Frame, QuadError> {
+    Frame::from_normal(normal).map_err(|_| {
+        QuadError::invalid(
+            name,
+            format!("{:?}", normal.as_slice()),
+            "a finite, non-zero vector",
+        )
+    })
+}
 
 /// A map from `[0, 1]^D` onto a domain, with its Jacobian and inverse.
 pub trait Domain<const D: usize> {

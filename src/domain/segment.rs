@@ -114,10 +114,14 @@ impl Domain<1> for Segment {
 
     fn invert(&self, t: &f64) -> Option<[f64; 1]> {
         let len = self.b - self.a;
-        if !(self.a <= *t && *t <= self.b) || len <= 0.0 {
+        if !(self.a <= *t && *t <= self.b) {
             return None;
         }
-        Some([(t - self.a) / len])
+        if len <= 0.0 {
+            // The empty segment [a, a]: every u maps to a.
+            return Some([0.0]);
+        }
+        Some([((t - self.a) / len).min(1.0)])
     }
 
     fn measure(&self) -> f64 {

@@ -31,6 +31,7 @@ pub struct GaussKronrod {
 /// Kronrod abscissae on [-1, 1], from the outside in; odd indices are the
 /// Gauss nodes; the last is 0 (QUADPACK's `xgk`, verified against a 40-digit
 /// table in tests/data/gauss_kronrod_15.json).
+#[allow(clippy::excessive_precision)] // QUADPACK's digits, correctly rounded by the compiler
 pub const XGK: [f64; 8] = [
     0.991_455_371_120_812_639_206_854_697_526_329,
     0.949_107_912_342_758_524_526_189_684_047_851,
@@ -42,6 +43,7 @@ pub const XGK: [f64; 8] = [
     0.0,
 ];
 /// Kronrod weights for [`XGK`].
+#[allow(clippy::excessive_precision)] // QUADPACK's digits, correctly rounded by the compiler
 pub const WGK: [f64; 8] = [
     0.022_935_322_010_529_224_963_732_008_058_970,
     0.063_092_092_629_978_553_290_700_663_189_204,
@@ -53,6 +55,7 @@ pub const WGK: [f64; 8] = [
     0.209_482_141_084_727_828_012_999_174_891_714,
 ];
 /// Gauss weights for the nodes `XGK[1], XGK[3], XGK[5], XGK[7]`.
+#[allow(clippy::excessive_precision)] // QUADPACK's digits, correctly rounded by the compiler
 pub const WG: [f64; 4] = [
     0.129_484_966_168_869_693_270_611_432_679_082,
     0.279_705_391_489_276_667_901_467_771_423_780,

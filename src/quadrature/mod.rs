@@ -87,10 +87,7 @@ pub const RULES: &[(&str, &str)] = &[
         "gauss-kronrod",
         "adaptive Gauss–Kronrod G7-K15 on [0,1] (1-D); embedded error estimate",
     ),
-    (
-        "monte-carlo",
-        "plain Monte Carlo, seeded; standard error",
-    ),
+    ("monte-carlo", "plain Monte Carlo, seeded; standard error"),
     (
         "stratified",
         "stratified (jittered) Monte Carlo, one sample per cell; paired-cell standard error",
@@ -131,11 +128,7 @@ impl AnyRule {
             _ => {
                 return Err(QuadError::UnknownRule {
                     name: name.to_string(),
-                    known: RULES
-                        .iter()
-                        .map(|(n, _)| *n)
-                        .collect::<Vec<_>>()
-                        .join(", "),
+                    known: RULES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
                 });
             }
         })

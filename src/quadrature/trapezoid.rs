@@ -59,7 +59,9 @@ impl Rule for Trapezoid {
         let coarse = sum.companion.unwrap_or(sum.value);
         Ok(Estimate {
             value: sum.value,
-            error: sum.value.zip(coarse, |fine, coarse| (fine - coarse).abs() / 3.0),
+            error: sum
+                .value
+                .zip(coarse, |fine, coarse| (fine - coarse).abs() / 3.0),
             evaluations: sum.evaluations,
         })
     }

@@ -30,7 +30,7 @@ use crate::estimate::Estimate;
 use crate::value::Value;
 use bogaert::HalfNode;
 
-/// Largest order accepted (the tables take 24 bytes a node).
+/// Largest order accepted (a table takes 16 bytes a node).
 pub const MAX_ORDER: usize = 100_000_000;
 /// Orders up to this use Newton's method; above it, Bogaert's expansion.
 pub const NEWTON_MAX_ORDER: usize = 100;
@@ -44,8 +44,6 @@ pub struct Table {
     pub x: Vec<f64>,
     /// Weights `w_i`, summing to 2.
     pub w: Vec<f64>,
-    /// `1 - |x_i|`, to full relative precision.
-    pub one_minus_abs_x: Vec<f64>,
 }
 
 /// Checks an order n.
@@ -62,7 +60,7 @@ pub fn check_order(n: usize) -> Result<usize, QuadError> {
 }
 
 /// The k-th node from `x = +1` (k in 1..=ceil(n/2)).
-fn half_node(n: usize, k: usize) -> HalfNode {
+pub fn half_node(n: usize, k: usize) -> HalfNode {
     let mut node = bogaert::node(n, k);
     if n <= NEWTON_MAX_ORDER {
         node = newton::node(n, k, node);
@@ -74,75 +72,69 @@ fn half_node(n: usize, k: usize) -> HalfNode {
     node
 }
 
+/// Fills `nodes` and `weights` (length n) by symmetry from the half nodes:
+/// `place(node)` gives the (lower, upper) node values of a mirrored pair, the
+/// lower one at index k - 1 and the upper one at n - k. Chunks run in
+/// parallel for large n.
+fn fill_symmetric(
+    n: usize,
+    nodes: &mut [f64],
+    weights: &mut [f64],
+    scale: f64,
+    place: impl Fn(&HalfNode) -> (f64, f64) + Sync,
+) {
+    const CHUNK: usize = 4096;
+    let lower = n / 2;
+    let (x_lo, x_rest) = nodes.split_at_mut(lower);
+    let (w_lo, w_rest) = weights.split_at_mut(lower);
+    let (x_mid, x_hi) = x_rest.split_at_mut(n - 2 * lower);
+    let (w_mid, w_hi) = w_rest.split_at_mut(n - 2 * lower);
+    // Lower chunk c covers k = c*CHUNK + 1 ..; its mirror is the c-th chunk
+    // of the upper half counted from the end, filled back to front.
+    let fill = |first_k: usize, xl: &mut [f64], wl: &mut [f64], xh: &mut [f64], wh: &mut [f64]| {
+        let len = xl.len();
+        for i in 0..len {
+            let node = half_node(n, first_k + i);
+            let (lo, hi) = place(&node);
+            xl[i] = lo;
+            xh[len - 1 - i] = hi;
+            wl[i] = scale * node.weight;
+            wh[len - 1 - i] = scale * node.weight;
+        }
+    };
+    if n >= PARALLEL_FROM {
+        x_lo.par_chunks_mut(CHUNK)
+            .zip(w_lo.par_chunks_mut(CHUNK))
+            .zip(x_hi.par_rchunks_mut(CHUNK).zip(w_hi.par_rchunks_mut(CHUNK)))
+            .enumerate()
+            .for_each(|(c, ((xl, wl), (xh, wh)))| fill(c * CHUNK + 1, xl, wl, xh, wh));
+    } else {
+        fill(1, x_lo, w_lo, x_hi, w_hi);
+    }
+    // The middle node of an odd rule.
+    if let (Some(xm), Some(wm)) = (x_mid.first_mut(), w_mid.first_mut()) {
+        let node = half_node(n, lower + 1);
+        *xm = place(&node).1;
+        *wm = scale * node.weight;
+    }
+}
+
 /// Computes the n-point rule on `[-1, 1]` (not cached: see [`unit_nodes`]).
 pub fn table(n: usize) -> Result<Table, QuadError> {
     check_order(n)?;
-    let lower = n / 2; // nodes with x < 0; the same number with x > 0
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
-    let mut y = vec![0.0; n];
-
-    // Fill the negative half (ascending: k = 1 is the most negative) and its
-    // mirror image in the positive half in one pass, chunk by chunk.
-    {
-        let (x_lo, x_hi) = x.split_at_mut(n - lower);
-        let (w_lo, w_hi) = w.split_at_mut(n - lower);
-        let (y_lo, y_hi) = y.split_at_mut(n - lower);
-        let fill = |chunk: usize,
-                    (xl, wl, yl): (&mut [f64], &mut [f64], &mut [f64]),
-                    (xh, wh, yh): (&mut [f64], &mut [f64], &mut [f64])| {
-            let len = xl.len();
-            for i in 0..len {
-                let node = half_node(n, chunk + i + 1);
-                xl[i] = -node.x;
-                wl[i] = node.weight;
-                yl[i] = node.one_minus_x;
-                xh[len - 1 - i] = node.x;
-                wh[len - 1 - i] = node.weight;
-                yh[len - 1 - i] = node.one_minus_x;
-            }
-        };
-        let (x_lo, x_mid) = x_lo.split_at_mut(lower);
-        let (w_lo, w_mid) = w_lo.split_at_mut(lower);
-        let (y_lo, y_mid) = y_lo.split_at_mut(lower);
-        const CHUNK: usize = 4096;
-        if n >= PARALLEL_FROM {
-            x_lo.par_chunks_mut(CHUNK)
-                .zip(w_lo.par_chunks_mut(CHUNK))
-                .zip(y_lo.par_chunks_mut(CHUNK))
-                .zip(
-                    x_hi.par_rchunks_mut(CHUNK)
-                        .zip(w_hi.par_rchunks_mut(CHUNK))
-                        .zip(y_hi.par_rchunks_mut(CHUNK)),
-                )
-                .enumerate()
-                .for_each(|(c, (((xl, wl), yl), ((xh, wh), yh)))| {
-                    fill(c * CHUNK, (xl, wl, yl), (xh, wh, yh))
-                });
-        } else {
-            fill(0, (x_lo, w_lo, y_lo), (x_hi, w_hi, y_hi));
-        }
-        // The middle node of an odd rule.
-        if let (Some(xm), Some(wm), Some(ym)) =
-            (x_mid.first_mut(), w_mid.first_mut(), y_mid.first_mut())
-        {
-            let node = half_node(n, lower + 1);
-            *xm = 0.0;
-            *wm = node.weight;
-            *ym = 1.0;
-        }
-    }
-    Ok(Table {
-        x,
-        w,
-        one_minus_abs_x: y,
-    })
+    fill_symmetric(n, &mut x, &mut w, 1.0, |node| (-node.x, node.x));
+    Ok(Table { x, w })
 }
 
-/// The n-point rule mapped to `[0, 1]` (`u = (1 + x)/2`, `w/2`), cached per n.
+/// The n-point rule mapped to `[0, 1]` (`u = (1 + x)/2`, weights `w/2`),
+/// cached per n.
 ///
-/// Nodes in the lower half are `(1 - |x|)/2`, exact to full relative precision
-/// however close they come to 0.
+/// Nodes in the lower half are `(1 - |x|)/2` from the accurately computed
+/// `1 - |x|`, so they keep full relative precision however close to 0 they
+/// come (at n = 1e6 the first is 1.4e-12, where `(1 + x)/2` would keep only
+/// four digits); near-singular integrands at a segment's start need that.
 pub fn unit_nodes(n: usize) -> Result<Arc<UnitNodes>, QuadError> {
     check_order(n)?;
     static CACHE: OnceLock<Mutex<HashMap<usize, Arc<UnitNodes>>>> = OnceLock::new();
@@ -152,18 +144,11 @@ pub fn unit_nodes(n: usize) -> Result<Arc<UnitNodes>, QuadError> {
     if let Some(hit) = cache.lock().ok().and_then(|c| c.get(&n).cloned()) {
         return Ok(hit);
     }
-    let t = table(n)?;
-    let lower = n / 2;
-    let u = (0..n)
-        .map(|i| {
-            if i < lower {
-                0.5 * t.one_minus_abs_x[i]
-            } else {
-                0.5 * (1.0 + t.x[i])
-            }
-        })
-        .collect();
-    let w = t.w.iter().map(|w| 0.5 * w).collect();
+    let mut u = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    fill_symmetric(n, &mut u, &mut w, 0.5, |node| {
+        (0.5 * node.one_minus_x, 0.5 * (1.0 + node.x))
+    });
     let nodes = Arc::new(UnitNodes {
         u,
         w,

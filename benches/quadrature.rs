@@ -1,0 +1,93 @@
+//! Quadrature benchmarks.
+//!
+//! - `gl_nodes/*`: Gauss–Legendre node and weight generation for n = 10, 1e3,
+//!   1e5, 1e6: lightquad against the crates `gauss-quad` and `bilby` (both
+//!   implement Bogaert's method), serial and parallel, in the same run.
+//! - `gl_integrate/*`: integrating `cos(50 x)` over [-1, 1] at n = 1e6 with
+//!   cached nodes, against the same peers.
+//! - `sum_overhead/*`: the shared compensated summation against a bare loop
+//!   that only evaluates the integrand at the same nodes, n = 1e3 .. 1e6.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use lightquad::quadrature::gauss_legendre::{table, unit_nodes};
+use lightquad::quadrature::nodes::product_sum;
+
+fn gl_nodes(c: &mut Criterion) {
+    let mut g = c.benchmark_group("gl_nodes");
+    g.warm_up_time(Duration::from_millis(500));
+    for n in [10usize, 1_000, 100_000, 1_000_000] {
+        g.sample_size(if n >= 100_000 { 20 } else { 50 });
+        g.measurement_time(Duration::from_secs(if n >= 100_000 { 4 } else { 2 }));
+        g.bench_with_input(BenchmarkId::new("lightquad", n), &n, |b, &n| {
+            b.iter(|| table(black_box(n)))
+        });
+        g.bench_with_input(BenchmarkId::new("bilby", n), &n, |b, &n| {
+            b.iter(|| bilby::GaussLegendre::new(black_box(n)))
+        });
+        g.bench_with_input(BenchmarkId::new("bilby-par", n), &n, |b, &n| {
+            b.iter(|| bilby::GaussLegendre::new_par(black_box(n)))
+        });
+        let nz = std::num::NonZeroUsize::new(n).unwrap_or(std::num::NonZeroUsize::MIN);
+        g.bench_with_input(BenchmarkId::new("gauss-quad", n), &nz, |b, &nz| {
+            b.iter(|| gauss_quad::GaussLegendre::new(black_box(nz)))
+        });
+        g.bench_with_input(BenchmarkId::new("gauss-quad-par", n), &nz, |b, &nz| {
+            b.iter(|| gauss_quad::GaussLegendre::par_new(black_box(nz)))
+        });
+    }
+    g.finish();
+}
+
+fn integrand(x: f64) -> f64 {
+    (50.0 * x).cos()
+}
+
+fn gl_integrate(c: &mut Criterion) {
+    let n = 1_000_000;
+    let mut g = c.benchmark_group("gl_integrate");
+    g.sample_size(20).measurement_time(Duration::from_secs(4));
+    let Ok(nodes) = unit_nodes(n) else { return };
+    g.bench_function(BenchmarkId::new("lightquad", n), |b| {
+        // [-1, 1] from the unit interval: x = 2u - 1, dx = 2 du.
+        b.iter(|| product_sum([nodes.as_ref()], |u: [f64; 1]| integrand(2.0 * u[0] - 1.0)))
+    });
+    let Ok(bil) = bilby::GaussLegendre::new(n) else {
+        return;
+    };
+    g.bench_function(BenchmarkId::new("bilby", n), |b| {
+        b.iter(|| bil.rule().integrate(-1.0, 1.0, integrand))
+    });
+    let gq = gauss_quad::GaussLegendre::new(std::num::NonZeroUsize::MIN.saturating_add(n - 1));
+    g.bench_function(BenchmarkId::new("gauss-quad", n), |b| {
+        b.iter(|| gq.integrate(-1.0, 1.0, integrand))
+    });
+    g.finish();
+}
+
+fn sum_overhead(c: &mut Criterion) {
+    let mut g = c.benchmark_group("sum_overhead");
+    g.sample_size(30).measurement_time(Duration::from_secs(3));
+    for n in [1_000usize, 10_000, 100_000, 1_000_000] {
+        let Ok(nodes) = unit_nodes(n) else { return };
+        g.bench_with_input(BenchmarkId::new("product_sum", n), &n, |b, _| {
+            b.iter(|| product_sum([nodes.as_ref()], |u: [f64; 1]| integrand(u[0])))
+        });
+        g.bench_with_input(BenchmarkId::new("bare_evaluations", n), &n, |b, _| {
+            b.iter(|| {
+                // Only the evaluations, kept alive by a plain running sum.
+                let mut s = 0.0;
+                for &u in &nodes.u {
+                    s += integrand(black_box(u));
+                }
+                s
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, gl_nodes, gl_integrate, sum_overhead);
+criterion_main!(benches);

@@ -1,0 +1,129 @@
+//! A parallelogram patch (a rectangle when its edges are perpendicular): area
+//! lights, quads of a scene.
+//!
+//! `p(u) = o + u_1 e_1 + u_2 e_2`, `|J| = |e_1 x e_2|` (constant: the map is
+//! affine, so a rule sees the integrand itself, and Gauss–Legendre integrates
+//! polynomials in `p` exactly).
+
+use super::{Domain, Vec3, invert_slack, require_finite_vec3, snap_unit, within};
+use crate::error::QuadError;
+
+/// Relative area below which two edges count as parallel: `|e_1 x e_2|` must
+/// exceed `DEGENERATE_SIN |e_1| |e_2|` (the sine of the angle between them).
+const DEGENERATE_SIN: f64 = 1e-12;
+
+/// The parallelogram `{o + u_1 e_1 + u_2 e_2 : u in [0, 1]^2}`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rectangle {
+    origin: Vec3,
+    edge_u: Vec3,
+    edge_v: Vec3,
+    /// `e_1 x e_2`, cached.
+    cross: Vec3,
+    /// `|e_1 x e_2|`, cached.
+    area: f64,
+}
+
+impl Rectangle {
+    /// The parallelogram at `origin` spanned by `edge_u` and `edge_v`; all
+    /// finite, the edges non-zero and not parallel (non-zero area).
+    pub fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Result<Self, QuadError> {
+        require_finite_vec3("origin", origin)?;
+        require_finite_vec3("edge_u", edge_u)?;
+        require_finite_vec3("edge_v", edge_v)?;
+        let (len_u, len_v) = (edge_u.norm(), edge_v.norm());
+        if !(len_u > 0.0 && len_u.is_finite()) {
+            return Err(QuadError::invalid(
+                "edge_u",
+                format!("{:?}", edge_u.as_slice()),
+                "a non-zero vector of finite length",
+            ));
+        }
+        if !(len_v > 0.0 && len_v.is_finite()) {
+            return Err(QuadError::invalid(
+                "edge_v",
+                format!("{:?}", edge_v.as_slice()),
+                "a non-zero vector of finite length",
+            ));
+        }
+        let cross = edge_u.cross(&edge_v);
+        let area = cross.norm();
+        if !(area > DEGENERATE_SIN * len_u * len_v && area.is_finite()) {
+            return Err(QuadError::invalid(
+                "edge_v",
+                format!("{:?}", edge_v.as_slice()),
+                format!(
+                    "a vector not parallel to edge_u = {:?} (the patch has zero area)",
+                    edge_u.as_slice()
+                ),
+            ));
+        }
+        Ok(Rectangle {
+            origin,
+            edge_u,
+            edge_v,
+            cross,
+            area,
+        })
+    }
+
+    /// The corner `p(0, 0)`.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// The edge `e_1` (direction of `u_1`).
+    pub fn edge_u(&self) -> Vec3 {
+        self.edge_u
+    }
+
+    /// The edge `e_2` (direction of `u_2`).
+    pub fn edge_v(&self) -> Vec3 {
+        self.edge_v
+    }
+
+    /// The unit normal `e_1 x e_2 / |e_1 x e_2|`.
+    pub fn normal(&self) -> Vec3 {
+        self.cross / self.area
+    }
+
+    /// The area `|e_1 x e_2|`.
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+}
+
+impl Domain<2> for Rectangle {
+    type Point = Vec3;
+
+    /// `p = o + u_1 e_1 + u_2 e_2`, `|J| = |e_1 x e_2|`.
+    fn map(&self, u: [f64; 2]) -> (Vec3, f64) {
+        (
+            self.origin + self.edge_u * u[0] + self.edge_v * u[1],
+            self.area,
+        )
+    }
+
+    /// With `d = p - o` and `n = e_1 x e_2`: `u_1 = ((d x e_2) . n) / |n|^2`,
+    /// `u_2 = ((e_1 x d) . n) / |n|^2`; `None` when `p` is farther than the
+    /// tolerance from the plane or outside the patch.
+    fn invert(&self, p: &Vec3) -> Option<[f64; 2]> {
+        let (len_u, len_v) = (self.edge_u.norm(), self.edge_v.norm());
+        let size = len_u.max(len_v);
+        // Rounding of the coordinates counts against the shorter edge.
+        let slack = invert_slack(len_u.min(len_v), self.origin.norm() + p.norm());
+        let d = p - self.origin;
+        let n2 = self.area * self.area;
+        let height = d.dot(&self.cross) / self.area;
+        if !within(height, slack * size) {
+            return None;
+        }
+        let u1 = d.cross(&self.edge_v).dot(&self.cross) / n2;
+        let u2 = self.edge_u.cross(&d).dot(&self.cross) / n2;
+        Some([snap_unit(u1, slack)?, snap_unit(u2, slack)?])
+    }
+
+    fn measure(&self) -> f64 {
+        self.area
+    }
+}

@@ -1,0 +1,134 @@
+//! A triangle `abc`: mesh faces, triangle lights.
+//!
+//! The collapsed-square (Duffy) map: the edge `u_1 = 0` of the square collapses
+//! onto the vertex `a`, and each segment `u_1 = const` runs parallel to `bc`:
+//!
+//! `p(u) = a + u_1 (b - a) + u_1 u_2 (c - b)`,
+//! `dp/du_1 = (b - a) + u_2 (c - b)`, `dp/du_2 = u_1 (c - b)`,
+//! `|J| = u_1 |(b - a) x (c - b)| = 2 A u_1`, `A` the area.
+//!
+//! The map is polynomial (bilinear), so a polynomial integrand of degree `k` in
+//! `p` becomes a polynomial of degree `k + 1` in `u_1` and `k` in `u_2`, which
+//! Gauss–Legendre with `m >= (k + 2) / 2` nodes per axis integrates exactly; a
+//! smooth integrand stays smooth, with no singularity at the collapsed vertex.
+
+use super::{Domain, Vec3, invert_slack, require_finite_vec3, snap_unit, within};
+use crate::error::QuadError;
+
+/// Relative area below which a triangle counts as degenerate:
+/// `|(b - a) x (c - b)|` must exceed `DEGENERATE_SIN |b - a| |c - b|`.
+const DEGENERATE_SIN: f64 = 1e-12;
+
+/// The triangle with vertices `a`, `b`, `c`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Triangle {
+    a: Vec3,
+    b: Vec3,
+    c: Vec3,
+    /// `(b - a) x (c - b)`, cached.
+    cross: Vec3,
+    /// `|(b - a) x (c - b)|`, twice the area, cached.
+    double_area: f64,
+}
+
+impl Triangle {
+    /// The triangle `abc`; vertices finite, `b != a`, and `c` not on the line
+    /// through `a` and `b` (non-zero area).
+    pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Result<Self, QuadError> {
+        require_finite_vec3("a", a)?;
+        require_finite_vec3("b", b)?;
+        require_finite_vec3("c", c)?;
+        let (ab, bc) = (b - a, c - b);
+        let (len_ab, len_bc) = (ab.norm(), bc.norm());
+        if !(len_ab > 0.0 && len_ab.is_finite()) {
+            return Err(QuadError::invalid(
+                "b",
+                format!("{:?}", b.as_slice()),
+                format!(
+                    "a point distinct from a = {:?} (the triangle has zero area)",
+                    a.as_slice()
+                ),
+            ));
+        }
+        let cross = ab.cross(&bc);
+        let double_area = cross.norm();
+        if !(double_area > DEGENERATE_SIN * len_ab * len_bc && double_area.is_finite()) {
+            return Err(QuadError::invalid(
+                "c",
+                format!("{:?}", c.as_slice()),
+                format!(
+                    "a point off the line through a = {:?} and b = {:?} (the triangle has zero area)",
+                    a.as_slice(),
+                    b.as_slice()
+                ),
+            ));
+        }
+        Ok(Triangle {
+            a,
+            b,
+            c,
+            cross,
+            double_area,
+        })
+    }
+
+    /// The vertices `[a, b, c]`.
+    pub fn vertices(&self) -> [Vec3; 3] {
+        [self.a, self.b, self.c]
+    }
+
+    /// The unit normal `(b - a) x (c - a) / |(b - a) x (c - a)|`.
+    pub fn normal(&self) -> Vec3 {
+        self.cross / self.double_area
+    }
+
+    /// The area `|(b - a) x (c - a)| / 2`.
+    pub fn area(&self) -> f64 {
+        0.5 * self.double_area
+    }
+}
+
+impl Domain<2> for Triangle {
+    type Point = Vec3;
+
+    /// `p = a + u_1 (b - a) + u_1 u_2 (c - b)`, `|J| = u_1 |(b - a) x (c - b)|`.
+    fn map(&self, u: [f64; 2]) -> (Vec3, f64) {
+        let p = self.a + (self.b - self.a) * u[0] + (self.c - self.b) * (u[0] * u[1]);
+        (p, u[0] * self.double_area)
+    }
+
+    /// With `d = p - a`, `n = (b - a) x (c - b)`, write `d = s (b - a) + t (c - b)`:
+    /// `s = ((d x (c - b)) . n) / |n|^2`, `t = (((b - a) x d) . n) / |n|^2`;
+    /// then `u_1 = s`, `u_2 = t / s` (`0` at the vertex `a`, where it is
+    /// undefined). `None` when `p` is off the plane or outside `0 <= t <= s <= 1`
+    /// by more than the tolerance.
+    fn invert(&self, p: &Vec3) -> Option<[f64; 2]> {
+        let (ab, bc) = (self.b - self.a, self.c - self.b);
+        let edges = [ab.norm(), bc.norm(), (self.a - self.c).norm()];
+        let size = edges.iter().fold(0.0_f64, |m, &e| m.max(e));
+        let shortest = edges.iter().fold(f64::INFINITY, |m, &e| m.min(e));
+        let slack = invert_slack(shortest, self.a.norm() + p.norm());
+        let d = p - self.a;
+        let height = d.dot(&self.cross) / self.double_area;
+        if !within(height, slack * size) {
+            return None;
+        }
+        let n2 = self.double_area * self.double_area;
+        let s = d.cross(&bc).dot(&self.cross) / n2;
+        let t = ab.cross(&d).dot(&self.cross) / n2;
+        if !(-slack <= t && t <= s + slack) {
+            return None;
+        }
+        let u1 = snap_unit(s, slack)?;
+        let u2 = if u1 > 0.0 {
+            (t / u1).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        Some([u1, u2])
+    }
+
+    fn measure(&self) -> f64 {
+        0.5 * self.double_area
+    }
+}

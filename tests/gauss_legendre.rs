@@ -1,0 +1,221 @@
+//! Gauss–Legendre against independent references: 40-digit tables (mpmath,
+//! scripts/gen_quadrature_reference.py), polynomial exactness with the closed-form
+//! error of the first inexact degree, and integrals with closed forms at
+//! n = 1e3, 1e5, 1e6.
+//!
+//! Tolerances: nodes to 2 ulps absolute (the representation error of `x` near
+//! +-1 is 0.5 ulp), `1 - |x|` and weights to 6 ulps relative — "a few ulps".
+
+mod common;
+use common::*;
+use lightquad::QuadError;
+use lightquad::quadrature::gauss_legendre::{half_node, table, unit_nodes};
+use lightquad::quadrature::{GaussLegendre, Rule};
+
+#[test]
+fn nodes_and_weights_match_40_digit_tables_for_n_1_to_20() {
+    let small = data("gauss_legendre_small.json");
+    let rules = small["rules"].as_array().expect("rules");
+    assert_eq!(rules.len(), 20);
+    for r in rules {
+        let n = r["n"].as_u64().expect("n") as usize;
+        let (x, w) = (nums(&r["nodes"]), nums(&r["weights"]));
+        let t = table(n).expect("valid n");
+        for i in 0..n {
+            assert!(
+                (t.x[i] - x[i]).abs() <= 2.0 * EPS,
+                "n={n} i={i}: x {} vs {}",
+                t.x[i],
+                x[i]
+            );
+            assert!(
+                rel(t.w[i], w[i]) <= 6.0 * EPS,
+                "n={n} i={i}: w {} vs {} ({:.1} ulps)",
+                t.w[i],
+                w[i],
+                rel(t.w[i], w[i]) / EPS
+            );
+            // The table only has x rounded to f64, so 1 - |x| is known to
+            // an absolute ulp here (the large-n test checks it relatively).
+            let k = if x[i] < 0.0 { i + 1 } else { n - i };
+            assert!((half_node(n, k).one_minus_x - (1.0 - x[i].abs())).abs() <= EPS);
+        }
+    }
+}
+
+#[test]
+fn sampled_nodes_match_40_digit_values_for_large_n() {
+    let large = data("gauss_legendre_large.json");
+    for r in large["rules"].as_array().expect("rules") {
+        let n = r["n"].as_u64().expect("n") as usize;
+        let t = table(n).expect("valid n");
+        for node in r["nodes"].as_array().expect("nodes") {
+            // k = 1 is the largest node: index n - k ascending; the mirror is k - 1.
+            let k = node["k"].as_u64().expect("k") as usize;
+            let (x, y, w) = (
+                num(&node["x"]),
+                num(&node["one_minus_x"]),
+                num(&node["weight"]),
+            );
+            for (i, sign) in [(n - k, 1.0), (k - 1, -1.0)] {
+                assert!(
+                    (t.x[i] - sign * x).abs() <= 2.0 * EPS,
+                    "n={n} k={k}: x {} vs {}",
+                    t.x[i],
+                    sign * x
+                );
+                let got = half_node(n, k).one_minus_x;
+                assert!(
+                    rel(got, y) <= 6.0 * EPS,
+                    "n={n} k={k}: 1-|x| {got} vs {y} ({:.1} ulps)",
+                    rel(got, y) / EPS
+                );
+                assert!(
+                    rel(t.w[i], w) <= 6.0 * EPS,
+                    "n={n} k={k}: w {} vs {w} ({:.1} ulps)",
+                    t.w[i],
+                    rel(t.w[i], w) / EPS
+                );
+            }
+        }
+    }
+}
+
+/// `int_{-1}^{1} ((1 + x)/2)^d dx = 2/(d + 1)`, by the n-point rule.
+///
+/// `(1 + x)/2` is `1 - y/2` (`y = 1 - |x|`) for positive nodes; raising a
+/// rounded base to the power 2n - 1 would amplify its rounding n-fold, so the
+/// power is taken as `exp(d ln(1 - y/2))`, which the accurate `y` makes exact
+/// to a few ulps.
+fn shifted_monomial(t: &lightquad::quadrature::gauss_legendre::Table, d: i32) -> f64 {
+    let n = t.x.len();
+    lightquad::sum::sum_f64(t.x.iter().zip(&t.w).enumerate().map(|(i, (x, w))| {
+        let k = if *x < 0.0 { i + 1 } else { n - i };
+        let y = half_node(n, k).one_minus_x;
+        let power = if *x < 0.0 {
+            (0.5 * y).powi(d)
+        } else {
+            (d as f64 * (-0.5 * y).ln_1p()).exp()
+        };
+        w * power
+    }))
+}
+
+#[test]
+fn exact_for_degree_2n_minus_1() {
+    for n in (1..=40).chain([50, 64, 99, 100, 101, 150, 500, 1000, 4096]) {
+        let t = table(n).expect("valid n");
+        let d = 2 * n as i32 - 1;
+        let got = shifted_monomial(&t, d);
+        let exact = 2.0 / (d as f64 + 1.0);
+        assert!(rel(got, exact) <= 1e-14, "n={n}: {got} vs {exact}");
+        // The even monomial of degree 2n - 2 as well (no odd-symmetry help).
+        if n >= 2 {
+            let got = shifted_monomial(&t, d - 1);
+            assert!(rel(got, 2.0 / d as f64) <= 1e-14, "n={n}");
+        }
+    }
+}
+
+#[test]
+fn not_exact_for_degree_2n_and_the_error_is_the_closed_form() {
+    // E_n[x^(2n)] = int x^(2n) - Q_n = 2^(2n+1) (n!)^4 / ((2n+1) ((2n)!)^2) * ... which
+    // for f = x^(2n) (f^(2n) = (2n)!) is 2^(2n+1) (n!)^4 / ((2n+1) ((2n)!)^2).
+    // (Abramowitz & Stegun 25.4.30.)
+    for n in 1..=12usize {
+        let t = table(n).expect("valid n");
+        let q =
+            lightquad::sum::sum_f64(t.x.iter().zip(&t.w).map(|(x, w)| w * x.powi(2 * n as i32)));
+        let exact = 2.0 / (2.0 * n as f64 + 1.0);
+        let lgamma = |k: usize| (1..=k).map(|j| (j as f64).ln()).sum::<f64>();
+        let predicted = ((2 * n + 1) as f64 * 2f64.ln() + 4.0 * lgamma(n)
+            - ((2 * n + 1) as f64).ln()
+            - 2.0 * lgamma(2 * n))
+        .exp();
+        let err = exact - q;
+        assert!(
+            err > 1e3 * EPS * exact,
+            "n={n}: degree 2n should not be exact"
+        );
+        assert!(
+            rel(err, predicted) < 1e-6,
+            "n={n}: error {err} vs {predicted}"
+        );
+    }
+}
+
+#[test]
+fn large_n_weights_sum_to_two_and_cos_50x_is_exact() {
+    // int_{-1}^{1} cos(50 x) dx = 2 sin(50) / 50.
+    let exact = 2.0 * 50f64.sin() / 50.0;
+    for n in [1_000usize, 100_000, 1_000_000] {
+        let t = table(n).expect("valid n");
+        let sum_w = lightquad::sum::sum_f64(t.w.iter().copied());
+        assert!((sum_w - 2.0).abs() <= 1e-13, "n={n}: sum w = {sum_w}");
+        let q = lightquad::sum::sum_f64(t.x.iter().zip(&t.w).map(|(x, w)| w * (50.0 * x).cos()));
+        assert!((q - exact).abs() <= 1e-13, "n={n}: {q} vs {exact}");
+    }
+}
+
+#[test]
+fn unit_rule_keeps_nodes_near_zero_to_full_relative_precision() {
+    // The smallest node of the n-point rule on [0, 1] is (1 - x_1)/2; its
+    // 40-digit value for n = 1e6 is in the large table.
+    let large = data("gauss_legendre_large.json");
+    let r = &large["rules"][3];
+    assert_eq!(r["n"].as_u64(), Some(1_000_000));
+    let y1 = num(&r["nodes"][0]["one_minus_x"]);
+    let nodes = unit_nodes(1_000_000).expect("valid n");
+    assert!(
+        rel(nodes.u[0], 0.5 * y1) <= 4.0 * EPS,
+        "{} vs {}",
+        nodes.u[0],
+        0.5 * y1
+    );
+    // A near-singular integrand: int_0^1 u^(-1/2) du = 2 converges only if
+    // the nodes near 0 are right; at n = 1e5 the GL error is ~ 1/n.
+    let est = GaussLegendre::default()
+        .integrate(100_000, &mut rng(0), |u: [f64; 1]| u[0].powf(-0.5))
+        .expect("finite");
+    assert!((est.value - 2.0).abs() < 1e-4, "{}", est.value);
+}
+
+#[test]
+fn exponential_convergence_error_below_1e_14_by_n_20() {
+    // int_0^1 exp(u) du = e - 1.
+    let exact = std::f64::consts::E - 1.0;
+    let rule = GaussLegendre::default();
+    let mut last = f64::INFINITY;
+    for n in 1..=20 {
+        let est = rule
+            .integrate(n, &mut rng(0), |u: [f64; 1]| u[0].exp())
+            .expect("finite");
+        let err = (est.value - exact).abs();
+        if n <= 6 {
+            assert!(err < last, "n={n}: error must fall ({err} >= {last})");
+            // The estimate |Q_n - Q_{n-1}| bounds the true error here.
+            assert!(est.error >= err, "n={n}");
+        }
+        last = err;
+        if n == 20 {
+            assert!(err < 1e-14, "n=20: error {err}");
+        }
+    }
+}
+
+#[test]
+fn bad_orders_are_clear_errors() {
+    for n in [0usize, 100_000_001] {
+        let e = table(n).expect_err("out of range");
+        let msg = e.to_string();
+        assert!(
+            msg.contains("n = ") && msg.contains("1..=100000000"),
+            "{msg}"
+        );
+        assert!(matches!(e, QuadError::InvalidParameter { .. }));
+    }
+    let e = GaussLegendre::default()
+        .integrate(0, &mut rng(0), |u: [f64; 1]| u[0])
+        .expect_err("n = 0");
+    assert!(e.to_string().contains("invalid n = 0"), "{e}");
+}

@@ -1,0 +1,323 @@
+//! Every rule against closed forms: observed convergence orders fitted by least
+//! squares on budget sweeps, error estimates against true errors, the
+//! Gauss–Kronrod constants against a 40-digit table, the Sobol' net property,
+//! and clear errors on bad input.
+//!
+//! Randomised rules are averaged over seeds (root-mean-square error), every
+//! seed fixed, so the fitted orders are reproducible.
+
+mod common;
+use common::*;
+use lightquad::QuadError;
+use lightquad::Rgb;
+use lightquad::quadrature::sobol::{owen_scramble, sobol_u32};
+use lightquad::quadrature::{
+    AnyRule, GaussKronrod, GaussLegendre, MonteCarlo, Rule, Sobol, Stratified, Trapezoid,
+};
+use std::f64::consts::{E, PI};
+
+/// `int_0^1 exp(u) du = e - 1`.
+fn exp1(u: [f64; 1]) -> f64 {
+    u[0].exp()
+}
+const EXP1: f64 = E - 1.0;
+
+/// `int_[0,1]^2 exp(u + v) du dv = (e - 1)^2`.
+fn exp2(u: [f64; 2]) -> f64 {
+    (u[0] + u[1]).exp()
+}
+const EXP2: f64 = (E - 1.0) * (E - 1.0);
+
+/// Root-mean-square error of a randomised rule over `seeds` seeds, and the mean
+/// evaluations.
+fn rms<const D: usize>(
+    rule: &impl Rule,
+    n: usize,
+    seeds: u64,
+    f: fn([f64; D]) -> f64,
+    exact: f64,
+) -> (f64, f64) {
+    let mut sq = 0.0;
+    let mut evals = 0.0;
+    for s in 0..seeds {
+        let est = rule.integrate(n, &mut rng(1000 + s), f).expect("finite");
+        sq += (est.value - exact).powi(2);
+        evals += est.evaluations as f64;
+    }
+    ((sq / seeds as f64).sqrt(), evals / seeds as f64)
+}
+
+#[test]
+fn trapezoid_converges_at_order_two_and_richardson_estimates_the_error() {
+    let mut pts = Vec::new();
+    for j in 3..=10 {
+        let n = (1 << j) + 1;
+        let est = Trapezoid.integrate(n, &mut rng(0), exp1).expect("finite");
+        let err = (est.value - EXP1).abs();
+        // (T_h - T_2h)/3 is the leading error term: within 1% of the truth.
+        assert!(
+            rel(est.error, err) < 0.01,
+            "n={n}: est {} true {err}",
+            est.error
+        );
+        pts.push((est.evaluations as f64 - 1.0, err));
+    }
+    let order = fitted_order(&pts);
+    assert!((order + 2.0).abs() < 0.1, "trapezoid order {order}");
+}
+
+#[test]
+fn trapezoid_2d_product_rule_converges_at_order_one_in_total_evaluations() {
+    let mut pts = Vec::new();
+    for j in 3..=7 {
+        let m = (1usize << j) + 1;
+        let est = Trapezoid
+            .integrate(m * m, &mut rng(0), exp2)
+            .expect("finite");
+        assert_eq!(est.evaluations, (m * m) as u64);
+        pts.push((((m - 1) * (m - 1)) as f64, (est.value - EXP2).abs()));
+    }
+    // h^2 = N^-1 in two dimensions.
+    let order = fitted_order(&pts);
+    assert!((order + 1.0).abs() < 0.05, "order {order}");
+}
+
+#[test]
+fn plain_monte_carlo_converges_at_order_minus_one_half() {
+    let pts: Vec<(f64, f64)> = (6..=14)
+        .step_by(2)
+        .map(|j| {
+            let (err, evals) = rms(&MonteCarlo, 1 << j, 64, exp1, EXP1);
+            (evals, err)
+        })
+        .collect();
+    let order = fitted_order(&pts);
+    assert!((order + 0.5).abs() < 0.1, "plain MC order {order}");
+}
+
+#[test]
+fn stratified_2d_converges_at_order_minus_one() {
+    let pts: Vec<(f64, f64)> = [8usize, 16, 32, 64, 128]
+        .iter()
+        .map(|m| {
+            let (err, evals) = rms(&Stratified, m * m, 32, exp2, EXP2);
+            (evals, err)
+        })
+        .collect();
+    let order = fitted_order(&pts);
+    assert!((order + 1.0).abs() < 0.15, "stratified 2-D order {order}");
+}
+
+#[test]
+fn stratified_1d_converges_at_order_minus_three_halves() {
+    // N^(-1/2 - 1/D) with D = 1.
+    let pts: Vec<(f64, f64)> = (6..=14)
+        .step_by(2)
+        .map(|j| {
+            let (err, evals) = rms(&Stratified, 1 << j, 32, exp1, EXP1);
+            (evals, err)
+        })
+        .collect();
+    let order = fitted_order(&pts);
+    assert!((order + 1.5).abs() < 0.15, "stratified 1-D order {order}");
+}
+
+#[test]
+fn scrambled_sobol_beats_monte_carlo_order() {
+    // Owen scrambling of a (0, m, 2)-net: RMSE ~ N^(-3/2) (log factors aside)
+    // for smooth integrands (Owen 1997).
+    let pts: Vec<(f64, f64)> = (6..=14)
+        .step_by(2)
+        .map(|j| {
+            let (err, evals) = rms(&Sobol::default(), 1 << j, 32, exp2, EXP2);
+            (evals, err)
+        })
+        .collect();
+    let order = fitted_order(&pts);
+    assert!(
+        order < -1.25 && order > -1.9,
+        "scrambled Sobol' order {order}"
+    );
+}
+
+#[test]
+fn monte_carlo_standard_errors_cover_the_truth_at_the_nominal_rate() {
+    // Over 400 seeds, |error| <= 1.96 SE should hold ~95% of the time; with
+    // 400 trials the binomial standard deviation is 1.1%, so [0.91, 0.99]
+    // is a > 3.5 sigma band (alpha < 5e-4).
+    for (name, rule) in [
+        ("monte-carlo", AnyRule::MonteCarlo(MonteCarlo)),
+        ("stratified", AnyRule::Stratified(Stratified)),
+        ("sobol", AnyRule::Sobol(Sobol::default())),
+    ] {
+        let mut covered = 0;
+        for s in 0..400 {
+            let est = rule.integrate(1024, &mut rng(s), exp2).expect("finite");
+            if (est.value - EXP2).abs() <= 1.96 * est.error {
+                covered += 1;
+            }
+        }
+        let rate = covered as f64 / 400.0;
+        // Sobol' has 8 replicates: a t(7) interval would be wider than 1.96,
+        // so its coverage sits lower (t_7 at 1.96 gives ~91%).
+        let low = if name == "sobol" { 0.84 } else { 0.91 };
+        assert!(rate >= low && rate <= 0.995, "{name}: coverage {rate}");
+    }
+}
+
+#[test]
+fn gauss_kronrod_constants_match_the_40_digit_table() {
+    use lightquad::quadrature::gauss_kronrod::{WG, WGK, XGK};
+    let t = data("gauss_kronrod_15.json");
+    let (xk, wk) = (nums(&t["kronrod_nodes"]), nums(&t["kronrod_weights"]));
+    let (xg, wg) = (nums(&t["gauss_nodes"]), nums(&t["gauss_weights"]));
+    // Ascending tables: index 14 - j is the node +XGK[j].
+    for j in 0..8 {
+        assert!((XGK[j] - xk[14 - j]).abs() <= EPS, "xgk[{j}]");
+        assert!(rel(WGK[j], wk[14 - j]) <= 2.0 * EPS, "wgk[{j}]");
+    }
+    for j in 0..4 {
+        assert!((XGK[2 * j + 1] - xg[6 - j]).abs() <= EPS);
+        assert!(rel(WG[j], wg[6 - j]) <= 2.0 * EPS, "wg[{j}]");
+    }
+}
+
+#[test]
+fn gauss_kronrod_one_panel_is_exact_to_degree_22() {
+    let rule = GaussKronrod::default();
+    for d in 0..=22 {
+        let est = rule
+            .integrate(15, &mut rng(0), |u: [f64; 1]| u[0].powi(d))
+            .expect("finite");
+        let exact = 1.0 / (d as f64 + 1.0);
+        assert!(rel(est.value, exact) < 1e-14, "degree {d}: {}", est.value);
+    }
+    let est = rule
+        .integrate(15, &mut rng(0), |u: [f64; 1]| (2.0 * u[0] - 1.0).powi(24))
+        .expect("finite");
+    assert!(
+        rel(est.value, 1.0 / 25.0) > 1e-10,
+        "degree 24 must not be exact"
+    );
+}
+
+#[test]
+fn adaptive_gauss_kronrod_resolves_a_peak_and_its_estimate_bounds_the_error() {
+    // int_0^1 1/((u - 0.3)^2 + 1e-4) du = 100 (atan(70) + atan(30)).
+    let exact = 100.0 * (70f64.atan() + 30f64.atan());
+    let f = |u: [f64; 1]| 1.0 / ((u[0] - 0.3).powi(2) + 1e-4);
+    let rule = GaussKronrod {
+        abs_tol: 0.0,
+        rel_tol: 1e-10,
+    };
+    let est = rule.integrate(100_000, &mut rng(0), f).expect("finite");
+    let err = (est.value - exact).abs();
+    assert!(err < 1e-9 * exact, "error {err}");
+    assert!(
+        est.error >= err,
+        "estimate {} below true error {err}",
+        est.error
+    );
+    assert!(
+        est.evaluations < 3000,
+        "adaptive: {} evaluations",
+        est.evaluations
+    );
+    // A fixed-order Gauss–Legendre rule of similar cost is far less accurate.
+    let gl = GaussLegendre {
+        error_estimate: false,
+    }
+    .integrate(est.evaluations as usize, &mut rng(0), f)
+    .expect("finite");
+    assert!((gl.value - exact).abs() > 100.0 * err);
+}
+
+#[test]
+fn sobol_points_form_scrambled_nets() {
+    // Every elementary box of area 2^-m (2^a by 2^(m-a) cells) holds exactly
+    // one of the first 2^m points, before and after Owen scrambling.
+    let m = 10u32;
+    for seeds in [None, Some((0x1234_5678u32, 0x9abc_def0u32))] {
+        let pts: Vec<(u32, u32)> = (0..1u32 << m)
+            .map(|i| {
+                let (x, y) = (sobol_u32(i, 0), sobol_u32(i, 1));
+                match seeds {
+                    None => (x, y),
+                    Some((s0, s1)) => (owen_scramble(x, s0), owen_scramble(y, s1)),
+                }
+            })
+            .collect();
+        for a in 0..=m {
+            let mut seen = vec![false; 1 << m];
+            for &(x, y) in &pts {
+                let cell = ((x >> (32 - a).min(31)) as usize * (a > 0) as usize) << (m - a)
+                    | if m - a > 0 {
+                        (y >> (32 - (m - a))) as usize
+                    } else {
+                        0
+                    };
+                assert!(!seen[cell], "box a={a} hit twice ({seeds:?})");
+                seen[cell] = true;
+            }
+        }
+    }
+}
+
+#[test]
+fn rgb_integrands_integrate_per_channel() {
+    let f = |u: [f64; 1]| Rgb::new(u[0].exp(), 2.0 * u[0], (PI * u[0]).sin());
+    let exact = [EXP1, 1.0, 2.0 / PI];
+    for name in [
+        "trapezoid",
+        "gauss-legendre",
+        "gauss-kronrod",
+        "stratified",
+        "sobol",
+    ] {
+        let rule = AnyRule::by_name(name).expect("known");
+        let est = rule.integrate(4097, &mut rng(3), f).expect("finite");
+        let tol = if name == "stratified" || name == "sobol" {
+            1e-4
+        } else {
+            1e-6
+        };
+        for (c, want) in exact.iter().enumerate() {
+            assert!((est.value[c] - want).abs() < tol, "{name} channel {c}");
+            assert!(est.error[c] >= 0.0);
+        }
+    }
+}
+
+#[test]
+fn bad_input_is_a_clear_error_never_a_panic() {
+    for (name, _) in lightquad::quadrature::RULES {
+        let rule = AnyRule::by_name(name).expect("known");
+        let e = rule
+            .integrate(0, &mut rng(0), |u: [f64; 1]| u[0])
+            .expect_err("n = 0");
+        assert!(e.to_string().contains("invalid n = 0"), "{name}: {e}");
+        // A NaN integrand names the point.
+        let e = rule
+            .integrate(64, &mut rng(0), |_: [f64; 1]| f64::NAN)
+            .expect_err("NaN");
+        assert!(
+            matches!(e, QuadError::NonFiniteIntegrand { .. }),
+            "{name}: {e}"
+        );
+        assert!(e.to_string().contains("NaN"), "{e}");
+    }
+    let e = AnyRule::by_name("simpsons").expect_err("unknown");
+    assert!(e.to_string().contains("unknown rule `simpsons`"), "{e}");
+    assert!(e.to_string().contains("gauss-legendre"), "{e}");
+    let e = GaussKronrod::default()
+        .integrate(100, &mut rng(0), |u: [f64; 2]| u[0])
+        .expect_err("2-D");
+    assert!(e.to_string().contains("dimension 2"), "{e}");
+    let e = GaussKronrod {
+        abs_tol: f64::NAN,
+        rel_tol: 0.0,
+    }
+    .integrate(100, &mut rng(0), exp1)
+    .expect_err("NaN tol");
+    assert!(e.to_string().contains("abs_tol"), "{e}");
+}
