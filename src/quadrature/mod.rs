@@ -11,7 +11,7 @@
 //! | `gauss-legendre` | Gauss–Legendre of any order, product in D > 1 | `|Q_m - Q_{m-1}|` |
 //! | `gauss-kronrod` | adaptive Gauss–Kronrod G7–K15 (D = 1) | embedded G7 |
 //! | `monte-carlo` | plain Monte Carlo | standard error |
-//! | `stratified` | jittered Monte Carlo, one sample per cell | paired-cell standard error |
+//! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
 //! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles |
 
 pub mod gauss_kronrod;
@@ -90,7 +90,7 @@ pub const RULES: &[(&str, &str)] = &[
     ("monte-carlo", "plain Monte Carlo, seeded; standard error"),
     (
         "stratified",
-        "stratified (jittered) Monte Carlo, one sample per cell; paired-cell standard error",
+        "stratified (jittered) Monte Carlo, one sample per cell; second-difference standard error",
     ),
     (
         "sobol",
