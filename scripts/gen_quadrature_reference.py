@@ -15,16 +15,23 @@ by assertions (listed below); the script aborts if any of them fails.
 
 Files written (under tests/data/):
 
-1. gauss_legendre_small.json -- Gauss-Legendre rules on [-1, 1], n = 1..20,
+1. gauss_legendre_small.json -- full Gauss-Legendre rules on [-1, 1] for
+   n = 1..20 and n = 24, 32, 33, 47, 50, 64, 75, 99, 100 (in that order),
    nodes ascending with their weights.  Computed at mp.dps = 60: Newton's
    method on x, with P_n(x) and P_n'(x) = n (x P_n - P_{n-1}) / (x^2 - 1)
    from the three-term recurrence
        (k + 1) P_{k+1} = (2k + 1) x P_k - k P_{k-1},
    iterated until |dx| < 1e-55; w_i = 2 / ((1 - x_i^2) P_n'(x_i)^2).  The
    rule is made exactly symmetric by mirroring the positive nodes.
-   Checks: sum w = 2 and sum w x^(2n-2) = 2/(2n-1) to 1e-45 (and the rule is
-   *not* exact for x^(2n)); agreement to 1e-45 with mpmath's independent
-   Golub-Welsch routine mp.gauss_quadrature(n, "legendre").
+   Checks: sum w = 2 and sum w x^(2n-2) = 2/(2n-1) to 1e-45; agreement to
+   1e-45 with mpmath's independent Golub-Welsch routine
+   mp.gauss_quadrature(n, "legendre").  The rule is *not* exact for x^(2n):
+   its error there is exactly -||p_n||^2 = -2^(2n+1) (n!)^4 / ((2n+1) ((2n)!)^2)
+   (p_n the monic Legendre polynomial), ~ -pi/4^n, which is below 1e-20 for
+   n >= 35 and at the dps-60 rounding level for n ~ 100.  So the same rule is
+   recomputed at mp.dps = 120 (|dx| < 1e-115), must agree with the dps-60
+   rule to 1e-55, and its x^(2n) error must equal -||p_n||^2 to 1e-30
+   relative.
 
 2. gauss_legendre_large.json -- sampled nodes of the n = 101, 1000, 100000,
    1000000 point rules.  Index k = 1 is the LARGEST node (nearest +1), k grows
@@ -128,9 +135,11 @@ def legendre_pair_mp(n, x):
 
 
 # ----------------------------------------------------------------------------
-# 1. small Gauss-Legendre rules, n = 1..20
+# 1. small Gauss-Legendre rules, n = 1..20 and selected n up to 100
 # ----------------------------------------------------------------------------
 
+SMALL_EXTRA_NS = [24, 32, 33, 47, 50, 64, 75, 99, 100]  # appended after n = 20
+SMALL_NS = list(range(1, 21)) + SMALL_EXTRA_NS
 SMALL_DPS = 60
 
 
@@ -175,11 +184,18 @@ def exact_monomial(m):
     return mpf(0) if m % 2 else mpf(2) / (m + 1)
 
 
+def gauss_remainder(n):
+    """Error of the n-point rule for x^(2n), with the sign removed: the squared
+    norm 2^(2n+1) (n!)^4 / ((2n+1) ((2n)!)^2) of the monic Legendre polynomial."""
+    return mpf(2) ** (2 * n + 1) * mp.factorial(n) ** 4 / (
+        (2 * n + 1) * mp.factorial(2 * n) ** 2)
+
+
 def gen_small():
     rules = []
     with mp.workdps(SMALL_DPS):
         tol = mpf("1e-45")
-        for n in range(1, 21):
+        for n in SMALL_NS:
             nodes, weights = gauss_legendre_mp(n)
             check(abs(mp.fsum(weights) - 2) < tol, f"n={n}: sum of weights != 2")
             m = 2 * n - 2
@@ -187,9 +203,19 @@ def gen_small():
                   f"n={n}: x^{m} not integrated exactly")
             check(abs(quad_monomial(nodes, weights, 2 * n - 1)) < tol,
                   f"n={n}: x^{2 * n - 1} not integrated exactly")
+            # non-exactness for x^(2n): the error -||p_n||^2 ~ -pi/4^n is not
+            # resolvable at dps 60 for n ~ 100, so check it on the same rule
+            # recomputed at twice the precision (which must agree with this one)
             m = 2 * n
-            check(abs(quad_monomial(nodes, weights, m) - exact_monomial(m)) > mpf("1e-20"),
-                  f"n={n}: x^{m} unexpectedly exact")
+            with mp.workdps(2 * SMALL_DPS):
+                hi_nodes, hi_weights = gauss_legendre_mp(n)
+                for (x, w), (hx, hw) in zip(zip(nodes, weights), zip(hi_nodes, hi_weights)):
+                    check(abs(x - hx) < mpf("1e-55") and abs(w - hw) < mpf("1e-55"),
+                          f"n={n}: dps {SMALL_DPS} and dps {2 * SMALL_DPS} rules disagree")
+                err = quad_monomial(hi_nodes, hi_weights, m) - exact_monomial(m)
+                rem = gauss_remainder(n)
+                check(abs(err + rem) < mpf("1e-30") * rem,
+                      f"n={n}: x^{m} error {err} is not -||p_n||^2 = {-rem}")
             # independent algorithm: mpmath's Golub-Welsch implementation
             gx, gw = mp.gauss_quadrature(n, "legendre")
             ref = sorted(zip(gx, gw), key=lambda t: t[0])
@@ -201,13 +227,16 @@ def gen_small():
                           "weights": [fmt(w) for w in weights]})
     write_json("gauss_legendre_small.json", {
         "source": (
-            f"{SCRIPT} (mpmath {mpmath.__version__}): Gauss-Legendre rules on [-1, 1], "
+            f"{SCRIPT} (mpmath {mpmath.__version__}): full Gauss-Legendre rules on "
+            "[-1, 1] for n = 1..20, " + ", ".join(str(n) for n in SMALL_EXTRA_NS) + ", "
             f"nodes ascending. Newton iteration on x at mp.dps = {SMALL_DPS} with P_n, "
             "P_n' from the three-term recurrence (|dx| < 1e-55), weights "
             "2/((1-x^2) P_n'(x)^2); nodes mirrored for exact symmetry. Asserted: "
-            "sum w = 2 and exactness for x^(2n-2), x^(2n-1) to 1e-45, non-exactness "
-            "for x^(2n), agreement with mpmath gauss_quadrature (Golub-Welsch) to "
-            f"1e-45. Rounded to {DIGITS} significant digits."),
+            "sum w = 2 and exactness for x^(2n-2), x^(2n-1) to 1e-45, agreement with "
+            "mpmath gauss_quadrature (Golub-Welsch) to 1e-45; non-exactness for x^(2n): "
+            f"the rule recomputed at mp.dps = {2 * SMALL_DPS} agrees to 1e-55 and its "
+            "x^(2n) error equals -2^(2n+1) (n!)^4/((2n+1) ((2n)!)^2) to 1e-30 relative. "
+            f"Rounded to {DIGITS} significant digits."),
         "digits": DIGITS,
         "rules": rules,
     })

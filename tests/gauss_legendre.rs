@@ -3,8 +3,10 @@
 //! error of the first inexact degree, and integrals with closed forms at
 //! n = 1e3, 1e5, 1e6.
 //!
-//! Tolerances: nodes to 2 ulps absolute (the representation error of `x` near
-//! +-1 is 0.5 ulp), `1 - |x|` and weights to 6 ulps relative — "a few ulps".
+//! Tolerances: n <= 100 (Newton, finished in double-double) must be correctly
+//! rounded to within one ulp; n > 100 (Bogaert's expansion in f64) within
+//! 2 ulps absolute for nodes (`x` itself is representable only to 0.5 ulp near
+//! +-1) and 4 ulps relative for `1 - |x|` and the weights.
 
 mod common;
 use common::*;
@@ -13,23 +15,23 @@ use lightquad::quadrature::gauss_legendre::{half_node, table, unit_nodes};
 use lightquad::quadrature::{GaussLegendre, Rule};
 
 #[test]
-fn nodes_and_weights_match_40_digit_tables_for_n_1_to_20() {
+fn nodes_and_weights_match_40_digit_tables_for_n_up_to_100() {
     let small = data("gauss_legendre_small.json");
     let rules = small["rules"].as_array().expect("rules");
-    assert_eq!(rules.len(), 20);
+    assert_eq!(rules.len(), 29);
     for r in rules {
         let n = r["n"].as_u64().expect("n") as usize;
         let (x, w) = (nums(&r["nodes"]), nums(&r["weights"]));
         let t = table(n).expect("valid n");
         for i in 0..n {
             assert!(
-                (t.x[i] - x[i]).abs() <= 2.0 * EPS,
+                (t.x[i] - x[i]).abs() <= EPS * x[i].abs().max(0.5),
                 "n={n} i={i}: x {} vs {}",
                 t.x[i],
                 x[i]
             );
             assert!(
-                rel(t.w[i], w[i]) <= 6.0 * EPS,
+                rel(t.w[i], w[i]) <= EPS,
                 "n={n} i={i}: w {} vs {} ({:.1} ulps)",
                 t.w[i],
                 w[i],
@@ -66,12 +68,12 @@ fn sampled_nodes_match_40_digit_values_for_large_n() {
                 );
                 let got = half_node(n, k).one_minus_x;
                 assert!(
-                    rel(got, y) <= 6.0 * EPS,
+                    rel(got, y) <= 4.0 * EPS,
                     "n={n} k={k}: 1-|x| {got} vs {y} ({:.1} ulps)",
                     rel(got, y) / EPS
                 );
                 assert!(
-                    rel(t.w[i], w) <= 6.0 * EPS,
+                    rel(t.w[i], w) <= 4.0 * EPS,
                     "n={n} k={k}: w {} vs {w} ({:.1} ulps)",
                     t.w[i],
                     rel(t.w[i], w) / EPS

@@ -16,6 +16,7 @@
 
 mod bessel;
 pub mod bogaert;
+mod double_double;
 pub mod newton;
 
 use std::collections::HashMap;
