@@ -42,23 +42,33 @@ const TABLE: [(f64, f64); 20] = [
 /// (DLMF 10.17.3 evaluated at McMahon's zero).
 #[inline]
 pub fn j0_zero_and_j1_squared(k: usize) -> (f64, f64) {
-    if k <= TABLE.len() {
-        return TABLE[k - 1];
+    match TABLE.get(k.wrapping_sub(1)) {
+        Some(&pair) => pair,
+        None => mcmahon(k),
     }
+}
+
+/// Number of tabulated zeros; [`mcmahon`] serves k above it.
+pub const TABULATED: usize = 20;
+
+/// McMahon's expansions for `j_{0,k}` and `J_1(j_{0,k})^2`, accurate for k > 20.
+#[inline(always)]
+pub fn mcmahon(k: usize) -> (f64, f64) {
     let beta = (k as f64 - 0.25) * std::f64::consts::PI;
-    let t = 1.0 / (beta * beta);
+    let inv_beta = 1.0 / beta;
+    let t = inv_beta * inv_beta;
     let zero = beta
         + (0.125
             + t * (-31.0 / 384.0
                 + t * (3779.0 / 15360.0
                     + t * (-6_277_237.0 / 3_440_640.0 + t * (2_092_163_573.0 / 82_575_360.0)))))
-            / beta;
+            * inv_beta;
     let series = 1.0
         + t * t
             * (-7.0 / 48.0
                 + t * (151.0 / 160.0
                     + t * (-172_913.0 / 16_128.0
                         + t * (461_797.0 / 2304.0 - t * (171_497_088_497.0 / 30_412_800.0)))));
-    let j1_squared = 2.0 / (std::f64::consts::PI * beta) * series;
+    let j1_squared = std::f64::consts::FRAC_2_PI * inv_beta * series;
     (zero, j1_squared)
 }

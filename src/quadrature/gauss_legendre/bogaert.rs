@@ -26,20 +26,29 @@
 //! (the thresholds are stated at the constants). The truncation error
 //! `O(v^8)` is below double precision for n > 100; smaller n use Newton's method.
 //!
-//! Only one `sin_cos` is evaluated per node: `cos theta` and `1 - cos theta` follow
-//! from `sin alpha`, `cos alpha` and the small `delta = theta - alpha` by the
-//! angle-addition formula, without cancellation.
+//! Only one `sin_cos` is evaluated per node (an inline polynomial, [`super::trig`]):
+//! `cos theta` and `1 - cos theta` follow from `sin alpha`, `cos alpha` and the
+//! small `delta = theta - alpha` by the angle-addition formula, without
+//! cancellation.
 
 use super::bessel::j0_zero_and_j1_squared;
 
-/// F2 is kept below this n: above it `v^4 |F2| < 1e-21` for every node.
-const F2_BELOW: usize = 100_000;
-/// F3 is kept below this n: above it `v^6 |F3| < 1e-21`.
-const F3_BELOW: usize = 3_000;
-/// W2 is kept below this n: above it `v^4 |W2| < 1e-20` relative.
-const W2_BELOW: usize = 20_000;
-/// W3 is kept below this n: above it `v^6 |W3| < 1e-20` relative.
-const W3_BELOW: usize = 3_000;
+/// From this n on, only the `v^2` terms (F1, W1) are kept: the `v^4` terms are
+/// below `1e-20 |F2|, 1e-20 |W2|` (|F2|, |W2| < 0.05 for every node).
+pub const FIRST_ORDER_FROM: usize = 100_000;
+/// From this n on, the `v^6` terms (F3, W3) are dropped: below `1.4e-21 |F3|`.
+pub const SECOND_ORDER_FROM: usize = 3_000;
+
+/// How many terms of the expansion an order n needs (1, 2 or 3).
+pub fn terms_for(n: usize) -> usize {
+    if n >= FIRST_ORDER_FROM {
+        1
+    } else if n >= SECOND_ORDER_FROM {
+        2
+    } else {
+        3
+    }
+}
 
 /// One node of the upper half: `x = cos theta`, `y = 1 - x` (accurate even when
 /// `x` rounds to 1), and the weight.
@@ -54,25 +63,39 @@ pub struct HalfNode {
 }
 
 /// The k-th node counted from `x = +1` (k in 1..=ceil(n/2)) of the n-point rule.
-#[inline]
 pub fn node(n: usize, k: usize) -> HalfNode {
+    let (j, j1_squared) = j0_zero_and_j1_squared(k);
+    match terms_for(n) {
+        1 => node_from::<1>(n, j, j1_squared),
+        2 => node_from::<2>(n, j, j1_squared),
+        _ => node_from::<3>(n, j, j1_squared),
+    }
+}
+
+/// The node and weight for the Bessel zero `j = j_{0,k}` and `J_1(j)^2`, keeping
+/// `TERMS` terms of each expansion. Straight-line code, so a loop over k
+/// overlaps consecutive nodes in the pipeline.
+#[inline(always)]
+pub fn node_from<const TERMS: usize>(n: usize, j: f64, j1_squared: f64) -> HalfNode {
     let v = 1.0 / (n as f64 + 0.5);
     let v2 = v * v;
-    let (j, j1_squared) = j0_zero_and_j1_squared(k);
     let alpha = j * v;
-    let (s, c) = alpha.sin_cos();
-    let u = c / s;
-    let ia = 1.0 / alpha;
+    let (s, c) = super::trig::sin_cos(alpha);
+    // One division for both 1/alpha and cot(alpha) = c / s.
+    let r = 1.0 / (alpha * s);
+    let ia = s * r;
+    let u = c * (alpha * r);
     let u2 = u * u;
 
     // Node angle: theta = alpha + delta.
     let f1 = (u - ia) * 0.125;
+    const INV_384: f64 = 1.0 / 384.0;
     let mut delta_over_v2 = f1;
-    if n < F2_BELOW {
+    if TERMS >= 2 {
         let ia3 = ia * ia * ia;
-        let f2 = (6.0 * (1.0 + u2) * ia + 25.0 * ia3 - u * (31.0 * u2 + 33.0)) / 384.0;
+        let f2 = (6.0 * (1.0 + u2) * ia + 25.0 * ia3 - u * (31.0 * u2 + 33.0)) * INV_384;
         let mut tail = f2;
-        if n < F3_BELOW {
+        if TERMS >= 3 {
             let ia2 = ia * ia;
             let ia5 = ia3 * ia2;
             let f3 = u * (2595.0 + u2 * (6350.0 + 3779.0 * u2)) / 15360.0 - 1073.0 / 5120.0 * ia5
@@ -96,15 +119,15 @@ pub fn node(n: usize, k: usize) -> HalfNode {
     // Weight.
     let ua = u * alpha;
     let a2 = alpha * alpha;
-    let w1 = (ua + a2 - 1.0) / (8.0 * a2);
+    let w1 = (ua + a2 - 1.0) * (0.125 * ia * ia);
     let mut correction = w1;
-    if n < W2_BELOW {
+    if TERMS >= 2 {
         let a4 = a2 * a2;
         let w2 = (81.0 - 31.0 * ua - 3.0 * (1.0 - 2.0 * u2) * a2 + 6.0 * ua * a2
             - (27.0 + u2 * (84.0 + 56.0 * u2)) * a4)
-            / (384.0 * a4);
+            * (INV_384 * (ia * ia) * (ia * ia));
         let mut tail = w2;
-        if n < W3_BELOW {
+        if TERMS >= 3 {
             let u4 = u2 * u2;
             let w3 =
                 (187.0 / 96.0 * u4 + 295.0 / 256.0 * u2 + 151.0 / 160.0 * u4 * u2 + 153.0 / 1024.0)

@@ -14,9 +14,10 @@
 //! uses it to keep nodes near 0 accurate (near-singular integrands need that).
 //! Unit-interval rules are cached per n.
 
-mod bessel;
+pub mod bessel;
 pub mod bogaert;
 mod double_double;
+mod trig;
 pub mod newton;
 
 use std::collections::HashMap;
@@ -94,13 +95,49 @@ fn fill_symmetric(
     // of the upper half counted from the end, filled back to front.
     let fill = |first_k: usize, xl: &mut [f64], wl: &mut [f64], xh: &mut [f64], wh: &mut [f64]| {
         let len = xl.len();
-        for i in 0..len {
-            let node = half_node(n, first_k + i);
+        let mut store = |i: usize, node: HalfNode| {
             let (lo, hi) = place(&node);
             xl[i] = lo;
             xh[len - 1 - i] = hi;
             wl[i] = scale * node.weight;
             wh[len - 1 - i] = scale * node.weight;
+        };
+        // Nodes with tabulated Bessel zeros (or a small n) one by one; the rest
+        // in a branch-free loop per expansion order.
+        let special = if n <= NEWTON_MAX_ORDER {
+            len
+        } else {
+            bessel::TABULATED.saturating_sub(first_k - 1).min(len)
+        };
+        for i in 0..special {
+            store(i, half_node(n, first_k + i));
+        }
+        // Four nodes per step: independent, isomorphic straight-line code the
+        // compiler interleaves (and pairs into SIMD), hiding the latency of each
+        // node's long dependency chain.
+        macro_rules! bulk {
+            ($terms:literal) => {{
+                let mut i = special;
+                while i + 4 <= len {
+                    let nodes: [HalfNode; 4] = std::array::from_fn(|l| {
+                        let (j, j1_squared) = bessel::mcmahon(first_k + i + l);
+                        bogaert::node_from::<$terms>(n, j, j1_squared)
+                    });
+                    for (l, node) in nodes.into_iter().enumerate() {
+                        store(i + l, node);
+                    }
+                    i += 4;
+                }
+                for i in i..len {
+                    let (j, j1_squared) = bessel::mcmahon(first_k + i);
+                    store(i, bogaert::node_from::<$terms>(n, j, j1_squared));
+                }
+            }};
+        }
+        match bogaert::terms_for(n) {
+            1 => bulk!(1),
+            2 => bulk!(2),
+            _ => bulk!(3),
         }
     };
     if n >= PARALLEL_FROM {
