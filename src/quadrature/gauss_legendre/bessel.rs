@@ -1,74 +1,185 @@
-//! Zeros of the Bessel function `J_0` and `J_1` squared at those zeros, the two
-//! Bessel quantities Bogaert's expansion of the Gauss–Legendre rule needs.
+//! Zeros of the Bessel function `J_0` and the weight factor
+//! `p_k = (pi/2) j_{0,k} J_1(j_{0,k})^2`, the two Bessel quantities Bogaert's
+//! expansion of the Gauss–Legendre rule needs. (`p_k -> 1` as k grows; keeping
+//! the product rather than `J_1^2` alone saves roundings in the weight.)
 //!
-//! The first 20 values are tabulated (computed with mpmath at 40 digits,
-//! `besseljzero(0, k)` and `besselj(1, z)**2`); beyond them the McMahon
-//! expansions below are accurate to better than 1e-19 relative (checked against
-//! mpmath for k = 21..100 when this table was made).
+//! The first 20 values are tabulated (mpmath at 40 digits: `besseljzero(0, k)`,
+//! `pi/2 * z * besselj(1, z)**2`); beyond them McMahon's expansions are accurate
+//! to better than 1e-18 relative (checked against mpmath for k = 21..100 when
+//! this table was made).
 
-/// `(j_{0,k}, J_1(j_{0,k})^2)` for k = 1..=20, mpmath at 40 digits.
-// The digits are kept as computed; the compiler rounds them correctly.
-#[allow(clippy::excessive_precision)]
-const TABLE: [(f64, f64); 20] = [
-    (2.404_825_557_695_772_768_6, 0.269_514_123_941_916_926_14),
-    (5.520_078_110_286_310_649_6, 0.115_780_138_582_203_695_81),
-    (8.653_727_912_911_012_217, 0.073_686_351_136_408_215_141),
-    (11.791_534_439_014_281_614, 0.054_037_573_198_116_282_042),
-    (14.930_917_708_487_785_948, 0.042_661_429_017_243_091_266),
-    (18.071_063_967_910_922_543, 0.035_242_103_490_996_101_359),
-    (21.211_636_629_879_258_959, 0.030_021_070_103_054_672_675),
-    (24.352_471_530_749_302_737, 0.026_147_391_495_308_088_59),
-    (27.493_479_132_040_254_796, 0.023_159_121_824_691_392_265),
-    (30.634_606_468_431_975_118, 0.020_783_829_122_267_857_604),
-    (33.775_820_213_573_568_684, 0.018_850_450_669_317_667_816),
-    (36.917_098_353_664_043_98, 0.017_246_157_569_665_008_3),
-    (40.058_425_764_628_239_295, 0.015_893_518_105_923_597_803),
-    (43.199_791_713_176_730_358, 0.014_737_626_096_472_189_59),
-    (46.341_188_371_661_814_019, 0.013_738_465_145_387_117_918),
-    (49.482_609_897_397_817_174, 0.012_866_181_737_615_132_879),
-    (52.624_051_841_114_996_029, 0.012_098_051_548_626_797_547),
-    (55.765_510_755_019_979_312, 0.011_416_471_224_491_608_517),
-    (58.906_983_926_080_942_133, 0.010_807_592_791_180_204_012),
-    (62.048_469_190_227_169_883, 0.010_260_372_926_280_762_811),
+use super::lanes::{Lanes, quick_two_sum, two_prod};
+
+/// `(j_{0,k}` as `hi + lo`, `p_k - 1)` for k = 1..=20, where
+/// `p_k = (pi/2) j_{0,k} J_1(j_{0,k})^2`; mpmath at 50 digits, each part
+/// correctly rounded.
+const TABLE: [(f64, f64, f64); 20] = [
+    (
+        2.404825557695773,
+        -1.176691651530894e-16,
+        0.018087218694297996,
+    ),
+    (
+        5.520078110286311,
+        8.088597146146722e-17,
+        0.00392013621674922,
+    ),
+    (
+        8.653727912911013,
+        -2.92812607320779e-16,
+        0.001636551843562515,
+    ),
+    (
+        11.791534439014281,
+        2.812956912778735e-16,
+        0.0008892796349325885,
+    ),
+    (
+        14.930917708487787,
+        -7.070514505983074e-16,
+        0.000556868684819165,
+    ),
+    (
+        18.071063967910924,
+        -9.658048089426209e-16,
+        0.0003809718021230442,
+    ),
+    (
+        21.21163662987926,
+        4.947077428784068e-16,
+        0.0002768652596050394,
+    ),
+    (
+        24.352471530749302,
+        9.169067133951066e-16,
+        0.00021022693776474386,
+    ),
+    (
+        27.493479132040253,
+        1.6191941793302084e-15,
+        0.00016502823272164556,
+    ),
+    (
+        30.634606468431976,
+        -5.390359852115135e-16,
+        0.00013297372137155157,
+    ),
+    (
+        33.77582021357357,
+        1.454224241250595e-15,
+        0.0001094222755141307,
+    ),
+    (
+        36.917098353664045,
+        -9.276489358569364e-16,
+        9.16133256630134e-05,
+    ),
+    (
+        40.05842576462824,
+        -2.6782651477149736e-16,
+        7.782167548719328e-05,
+    ),
+    (
+        43.19979171317673,
+        8.55713303876733e-16,
+        6.692432209045039e-05,
+    ),
+    (
+        46.341188371661815,
+        -9.07797413846536e-16,
+        5.816481661508719e-05,
+    ),
+    (
+        49.482609897397815,
+        2.382582551864974e-15,
+        5.101855968357026e-05,
+    ),
+    (
+        52.624051841115,
+        -1.7558469541662502e-15,
+        4.511249113423512e-05,
+    ),
+    (
+        55.76551075501998,
+        -2.2474605782970157e-15,
+        4.017545054632166e-05,
+    ),
+    (
+        58.90698392608094,
+        1.8824761533828545e-15,
+        3.6006519266516735e-05,
+    ),
+    (
+        62.048469190227166,
+        3.5462261037501757e-15,
+        3.2454268447740936e-05,
+    ),
 ];
 
-/// The k-th positive zero `j_{0,k}` of `J_0` and `J_1(j_{0,k})^2`, k >= 1.
-///
-/// For k > 20, McMahon's expansion (DLMF 10.21.19) in `beta = (k - 1/4) pi`:
-/// `j = beta + 1/(8 beta) - 31/(384 beta^3) + 3779/(15360 beta^5)
-///      - 6277237/(3440640 beta^7) + 2092163573/(82575360 beta^9)`,
-/// and `J_1(j)^2 = (2/(pi beta)) [1 + t^2 (-7/48 + t (151/160 + t (-172913/16128
-///      + t (461797/2304 - t 171497088497/30412800))))]`, `t = 1/beta^2`
-/// (DLMF 10.17.3 evaluated at McMahon's zero).
+/// `alpha_k = j_{0,k} / (n + 1/2)` as `hi + lo` (double-double) and `p_k - 1`,
+/// where `p_k = (pi/2) j_{0,k} J_1(j_{0,k})^2`, k >= 1.
 #[inline]
-pub fn j0_zero_and_j1_squared(k: usize) -> (f64, f64) {
+pub fn alpha_and_weight_factor(k: usize, n: usize) -> (f64, f64, f64) {
     match TABLE.get(k.wrapping_sub(1)) {
-        Some(&pair) => pair,
-        None => mcmahon(k),
+        Some(&(hi, lo, p)) => {
+            let (a_hi, a_lo) = div_dd(Lanes([hi]), Lanes([lo]), n as f64 + 0.5);
+            (a_hi.0[0], a_lo.0[0], p)
+        }
+        None => {
+            let (a_hi, a_lo, p) = mcmahon(Lanes([k as f64]), n);
+            (a_hi.0[0], a_lo.0[0], p.0[0])
+        }
     }
+}
+
+/// `(hi + lo) / m` as a double-double, for `|lo| <= ulp(hi)`.
+#[inline(always)]
+fn div_dd<const L: usize>(hi: Lanes<L>, lo: Lanes<L>, m: f64) -> (Lanes<L>, Lanes<L>) {
+    let q1 = hi / m;
+    let (p, e) = two_prod(q1, m);
+    // hi - p is exact (Sterbenz: p is within an ulp of hi).
+    let q2 = (((hi - p) - e) + lo) / m;
+    quick_two_sum(q1, q2)
 }
 
 /// Number of tabulated zeros; [`mcmahon`] serves k above it.
 pub const TABULATED: usize = 20;
 
-/// McMahon's expansions for `j_{0,k}` and `J_1(j_{0,k})^2`, accurate for k > 20.
+/// McMahon's expansions (DLMF 10.21.19) for k > 20, lane-wise (`k` as a float):
+/// `alpha_k = j_{0,k} / (n + 1/2)` as a double-double `(hi, lo)` and `p_k - 1`.
+/// With `beta = (k - 1/4) pi` (formed exactly as a double-double) and
+/// `t = 1/beta^2`:
+///
+/// `j_{0,k} = beta (1 + t/8 - 31 t^2/384 + 3779 t^3/15360 - 6277237 t^4/3440640
+///            + 2092163573 t^5/82575360)`,
+///
+/// and, multiplying that by `J_1(j)^2 = (2/(pi beta)) (1 - 7 t^2/48 + 151 t^3/160
+/// - 172913 t^4/16128 + 461797 t^5/2304 - ...)` (DLMF 10.17.3 at McMahon's zero),
+///
+/// `p_k = (pi/2) j J_1(j)^2 = 1 + t/8 - 29 t^2/128 + 3599 t^3/3072
+///        - 6102707 t^4/491520 + 2058116637 t^5/9175040`.
+///
+/// Both are accurate to 1e-18 relative or better for k > 20 (t < 2.4e-4).
 #[inline(always)]
-pub fn mcmahon(k: usize) -> (f64, f64) {
-    let beta = (k as f64 - 0.25) * std::f64::consts::PI;
-    let inv_beta = 1.0 / beta;
+pub fn mcmahon<const L: usize>(k: Lanes<L>, n: usize) -> (Lanes<L>, Lanes<L>, Lanes<L>) {
+    /// `pi - PI`, the tail of pi beyond f64.
+    const PI_LO: f64 = 1.224_646_799_147_353_2e-16;
+    let quarter_off = k - 0.25;
+    let (beta, beta_lo) = two_prod(quarter_off, std::f64::consts::PI);
+    let beta_lo = beta_lo + quarter_off * PI_LO;
+    let inv_beta = Lanes::splat(1.0) / beta;
     let t = inv_beta * inv_beta;
-    let zero = beta
-        + (0.125
-            + t * (-31.0 / 384.0
-                + t * (3779.0 / 15360.0
-                    + t * (-6_277_237.0 / 3_440_640.0 + t * (2_092_163_573.0 / 82_575_360.0)))))
-            * inv_beta;
-    let series = 1.0
-        + t * t
-            * (-7.0 / 48.0
-                + t * (151.0 / 160.0
-                    + t * (-172_913.0 / 16_128.0
-                        + t * (461_797.0 / 2304.0 - t * (171_497_088_497.0 / 30_412_800.0)))));
-    let j1_squared = std::f64::consts::FRAC_2_PI * inv_beta * series;
-    (zero, j1_squared)
+    // j - beta, small: its own rounding is far below an ulp of j.
+    let zero_tail = (0.125
+        + t * (-31.0 / 384.0
+            + t * (3779.0 / 15360.0
+                + t * (-6_277_237.0 / 3_440_640.0 + t * (2_092_163_573.0 / 82_575_360.0)))))
+        * inv_beta;
+    let (alpha, alpha_lo) = div_dd(beta, beta_lo + zero_tail, n as f64 + 0.5);
+    let weight_factor_minus_one = t
+        * (0.125
+            + t * (-29.0 / 128.0
+                + t * (3599.0 / 3072.0
+                    + t * (-6_102_707.0 / 491_520.0 + t * (2_058_116_637.0 / 9_175_040.0)))));
+    (alpha, alpha_lo, weight_factor_minus_one)
 }

@@ -12,7 +12,9 @@
 //! - `F3 = u (2595 + 6350 u^2 + 3779 u^4)/15360 - 1073/(5120 alpha^5)
 //!        + (1 + u^2) (-(31 u^2 + 11)/(1024 alpha) + u/(512 alpha^2) - 25/(3072 alpha^3))`,
 //!
-//! and the weight is `w_k = 2 / (J_1(j_{0,k})^2 (alpha / sin alpha) (1/v^2 + W1 + W2 v^2 + W3 v^4))`
+//! and the weight is `w_k = 2 / (J_1(j_{0,k})^2 (alpha / sin alpha) (1/v^2 + W1 + W2 v^2 + W3 v^4))`,
+//! evaluated as `(pi v) sin(alpha) / (p_k (1 + v^2 (W1 + W2 v^2 + W3 v^4)))` with
+//! `p_k = (pi/2) j_{0,k} J_1(j_{0,k})^2`
 //! with
 //!
 //! - `W1 = (u alpha + alpha^2 - 1) / (8 alpha^2)`
@@ -31,7 +33,8 @@
 //! small `delta = theta - alpha` by the angle-addition formula, without
 //! cancellation.
 
-use super::bessel::j0_zero_and_j1_squared;
+use super::bessel::alpha_and_weight_factor;
+use super::lanes::Lanes;
 
 /// From this n on, only the `v^2` terms (F1, W1) are kept: the `v^4` terms are
 /// below `1e-20 |F2|, 1e-20 |W2|` (|F2|, |W2| < 0.05 for every node).
@@ -52,37 +55,51 @@ pub fn terms_for(n: usize) -> usize {
 
 /// One node of the upper half: `x = cos theta`, `y = 1 - x` (accurate even when
 /// `x` rounds to 1), and the weight.
+/// `T` is `f64` for one node or [`Lanes`] for several.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HalfNode {
+pub struct HalfNode<T = f64> {
     /// The node `x_k = cos(theta_k)`.
-    pub x: f64,
+    pub x: T,
     /// `1 - x_k`, computed without cancellation.
-    pub one_minus_x: f64,
+    pub one_minus_x: T,
     /// The weight `w_k`.
-    pub weight: f64,
+    pub weight: T,
 }
 
 /// The k-th node counted from `x = +1` (k in 1..=ceil(n/2)) of the n-point rule.
 pub fn node(n: usize, k: usize) -> HalfNode {
-    let (j, j1_squared) = j0_zero_and_j1_squared(k);
-    match terms_for(n) {
-        1 => node_from::<1>(n, j, j1_squared),
-        2 => node_from::<2>(n, j, j1_squared),
-        _ => node_from::<3>(n, j, j1_squared),
+    let (a, a_lo, p) = alpha_and_weight_factor(k, n);
+    let (a, a_lo, p) = (Lanes([a]), Lanes([a_lo]), Lanes([p]));
+    let node = match terms_for(n) {
+        1 => node_from::<1, 1>(n, a, a_lo, p),
+        2 => node_from::<1, 2>(n, a, a_lo, p),
+        _ => node_from::<1, 3>(n, a, a_lo, p),
+    };
+    HalfNode {
+        x: node.x.0[0],
+        one_minus_x: node.one_minus_x.0[0],
+        weight: node.weight.0[0],
     }
 }
 
-/// The node and weight for the Bessel zero `j = j_{0,k}` and `J_1(j)^2`, keeping
-/// `TERMS` terms of each expansion. Straight-line code, so a loop over k
-/// overlaps consecutive nodes in the pipeline.
+/// The node and weight for `alpha = j_{0,k} / (n + 1/2)` (as `alpha + alpha_lo`)
+/// and `p - 1` for the weight factor `p = (pi/2) j_{0,k} J_1(j_{0,k})^2`
+/// ([`super::bessel`]),
+/// keeping
+/// `TERMS` terms of each expansion, for `L` nodes in lock step. Straight-line
+/// code without branches.
 #[inline(always)]
-pub fn node_from<const TERMS: usize>(n: usize, j: f64, j1_squared: f64) -> HalfNode {
+pub fn node_from<const L: usize, const TERMS: usize>(
+    n: usize,
+    alpha: Lanes<L>,
+    alpha_lo: Lanes<L>,
+    weight_factor_minus_one: Lanes<L>,
+) -> HalfNode<Lanes<L>> {
     let v = 1.0 / (n as f64 + 0.5);
     let v2 = v * v;
-    let alpha = j * v;
-    let (s, c) = super::trig::sin_cos(alpha);
+    let (s, c) = super::trig::sin_cos(alpha, alpha_lo);
     // One division for both 1/alpha and cot(alpha) = c / s.
-    let r = 1.0 / (alpha * s);
+    let r = Lanes::splat(1.0) / (alpha * s);
     let ia = s * r;
     let u = c * (alpha * r);
     let u2 = u * u;
@@ -101,9 +118,9 @@ pub fn node_from<const TERMS: usize>(n: usize, j: f64, j1_squared: f64) -> HalfN
             let f3 = u * (2595.0 + u2 * (6350.0 + 3779.0 * u2)) / 15360.0 - 1073.0 / 5120.0 * ia5
                 + (1.0 + u2)
                     * (-(31.0 * u2 + 11.0) / 1024.0 * ia + u / 512.0 * ia2 - 25.0 / 3072.0 * ia3);
-            tail += v2 * f3;
+            tail = tail + v2 * f3;
         }
-        delta_over_v2 += v2 * tail;
+        delta_over_v2 = delta_over_v2 + v2 * tail;
     }
     let delta = v2 * delta_over_v2;
 
@@ -137,12 +154,19 @@ pub fn node_from<const TERMS: usize>(n: usize, j: f64, j1_squared: f64) -> HalfN
                     + (-7.0 / 384.0 * u2 + 53.0 / 3072.0) * (ia * ia) * (ia * ia)
                     + 3749.0 / 15360.0 * u * (ia * ia) * (ia * ia) * ia
                     - 1125.0 / 1024.0 * (ia * ia * ia) * (ia * ia * ia);
-            tail += v2 * w3;
+            tail = tail + v2 * w3;
         }
-        correction += v2 * tail;
+        correction = correction + v2 * tail;
     }
     // w = 2 v^2 sin(alpha) / (J1^2 alpha (1 + v^2 (W1 + ...)))
-    let weight = 2.0 * v2 * s / (j1_squared * alpha * (1.0 + v2 * correction));
+    //   = (pi v) sin(alpha) / (p (1 + v^2 (W1 + ...)))   with alpha = v j, p = (pi/2) j J1^2,
+    // which spends fewer roundings than the first form.
+    // The denominator p (1 + v^2 W) = 1 + [(p - 1) + v^2 W (1 + (p - 1))] is
+    // rounded once, after the small parts are summed.
+    let pi_v = std::f64::consts::PI / (n as f64 + 0.5);
+    let pm1 = weight_factor_minus_one;
+    let vw = v2 * correction;
+    let weight = s * pi_v / ((pm1 + vw + pm1 * vw) + 1.0);
     HalfNode {
         x,
         one_minus_x,

@@ -17,8 +17,9 @@
 pub mod bessel;
 pub mod bogaert;
 mod double_double;
-mod trig;
+pub mod lanes;
 pub mod newton;
+mod trig;
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -31,6 +32,7 @@ use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
 use bogaert::HalfNode;
+use lanes::Lanes;
 
 /// Largest order accepted (a table takes 16 bytes a node).
 pub const MAX_ORDER: usize = 100_000_000;
@@ -112,25 +114,29 @@ fn fill_symmetric(
         for i in 0..special {
             store(i, half_node(n, first_k + i));
         }
-        // Four nodes per step: independent, isomorphic straight-line code the
-        // compiler interleaves (and pairs into SIMD), hiding the latency of each
-        // node's long dependency chain.
+        // Four nodes per step in lock step (SIMD lanes), then the remainder.
         macro_rules! bulk {
             ($terms:literal) => {{
+                const L: usize = 4;
                 let mut i = special;
-                while i + 4 <= len {
-                    let nodes: [HalfNode; 4] = std::array::from_fn(|l| {
-                        let (j, j1_squared) = bessel::mcmahon(first_k + i + l);
-                        bogaert::node_from::<$terms>(n, j, j1_squared)
-                    });
-                    for (l, node) in nodes.into_iter().enumerate() {
-                        store(i + l, node);
+                while i + L <= len {
+                    let k = Lanes(std::array::from_fn(|l| (first_k + i + l) as f64));
+                    let (a, a_lo, p) = bessel::mcmahon(k, n);
+                    let node = bogaert::node_from::<L, $terms>(n, a, a_lo, p);
+                    for l in 0..L {
+                        store(
+                            i + l,
+                            HalfNode {
+                                x: node.x.0[l],
+                                one_minus_x: node.one_minus_x.0[l],
+                                weight: node.weight.0[l],
+                            },
+                        );
                     }
-                    i += 4;
+                    i += L;
                 }
                 for i in i..len {
-                    let (j, j1_squared) = bessel::mcmahon(first_k + i);
-                    store(i, bogaert::node_from::<$terms>(n, j, j1_squared));
+                    store(i, bogaert::node(n, first_k + i));
                 }
             }};
         }

@@ -9,31 +9,42 @@
 //! (truncation `< (pi/4)^19 / 19! = 8e-20`) and
 //! `cos r = 1 - r^2/2 + ... + r^18/18!` (truncation `< 4e-21`), with the
 //! `1 - r^2/2` step done in two parts to keep its rounding below half an ulp.
-//! Error: within one ulp of the correctly rounded value (tested below against
-//! the platform's libm over the whole range).
+//! The rounding error of the reflected angle is carried as `r_lo` and added to
+//! first order, as libm does. Error: within one ulp of the correctly rounded
+//! value (tested below against the platform's libm over the whole range).
 
 use std::f64::consts::FRAC_PI_4;
+
+use super::lanes::Lanes;
 
 /// The f64 nearest `pi/2`.
 const PIO2_HI: f64 = std::f64::consts::FRAC_PI_2;
 /// `pi/2 - PIO2_HI`.
 const PIO2_LO: f64 = 6.123_233_995_736_766e-17;
 
-/// `(sin a, cos a)` for `a` in `[0, pi/2 + 1e-3]`.
+/// `(sin a, cos a)` for the angle `a + a_lo` (`|a_lo| <= ulp(a)`) in
+/// `[0, pi/2 + 1e-3]`, lane-wise.
 #[inline(always)]
-pub fn sin_cos(a: f64) -> (f64, f64) {
-    let reflect = a > FRAC_PI_4;
-    let r = if reflect { (PIO2_HI - a) + PIO2_LO } else { a };
+pub fn sin_cos<const L: usize>(a: Lanes<L>, a_lo: Lanes<L>) -> (Lanes<L>, Lanes<L>) {
+    // The angle is a + a_lo (double-double). Reflected, r + r_lo keeps the
+    // rounding error of (PIO2_HI - a) + (PIO2_LO - a_lo) in r_lo.
+    let near = PIO2_HI - a; // exact (Sterbenz) for a in [pi/4, pi/2 + 1e-3]
+    let far = PIO2_LO - a_lo;
+    let head = near + far;
+    let tail = (near - head) + far;
+    let r = a.select_gt(FRAC_PI_4, head, a);
+    let r_lo = a.select_gt(FRAC_PI_4, tail, a_lo);
     let z = r * r;
-    // sin r = r + r z (-1/3! + z (1/5! - ...))
     let sin_poly = -1.0 / 6.0
         + z * (1.0 / 120.0
             + z * (-1.0 / 5040.0
                 + z * (1.0 / 362_880.0
                     + z * (-1.0 / 39_916_800.0
                         + z * (1.0 / 6_227_020_800.0
-                            + z * (-1.0 / 1_307_674_368_000.0 + z * (1.0 / 355_687_428_096_000.0)))))));
-    let sin_r = r + r * z * sin_poly;
+                            + z * (-1.0 / 1_307_674_368_000.0
+                                + z * (1.0 / 355_687_428_096_000.0)))))));
+    // sin(r + r_lo) = sin r + r_lo cos r, and cos r = 1 to the order needed.
+    let sin_r = r + (r * z * sin_poly + r_lo);
     // cos r = (1 - z/2) + z^2 (1/4! - z (1/6! - ...)), with 1 - z/2 split as
     // hz + ((1 - hz) - z/2) so its rounding error is kept.
     let cos_poly = 1.0 / 24.0
@@ -46,12 +57,12 @@ pub fn sin_cos(a: f64) -> (f64, f64) {
                                 + z * (-1.0 / 6_402_373_705_728_000.0)))))));
     let half_z = 0.5 * z;
     let hz = 1.0 - half_z;
-    let cos_r = hz + (((1.0 - hz) - half_z) + z * z * cos_poly);
-    if reflect {
-        (cos_r, sin_r)
-    } else {
-        (sin_r, cos_r)
-    }
+    // cos(r + r_lo) = cos r - r_lo sin r, and sin r = r to the order needed.
+    let cos_r = hz + ((((1.0 - hz) - half_z) + z * z * cos_poly) - r * r_lo);
+    (
+        a.select_gt(FRAC_PI_4, cos_r, sin_r),
+        a.select_gt(FRAC_PI_4, sin_r, cos_r),
+    )
 }
 
 #[cfg(test)]
@@ -71,7 +82,8 @@ mod tests {
         let steps = 2_000_000;
         for i in 1..=steps {
             let a = (std::f64::consts::FRAC_PI_2 + 1e-3) * i as f64 / steps as f64;
-            let (s, c) = sin_cos(a);
+            let (s, c) = sin_cos(Lanes([a]), Lanes([0.0]));
+            let (s, c) = (s.0[0], c.0[0]);
             worst.0 = worst.0.max(ulps(s, a.sin()));
             if a < std::f64::consts::FRAC_PI_2 {
                 worst.1 = worst.1.max(ulps(c, a.cos()));
@@ -80,10 +92,14 @@ mod tests {
         // Tiny angles, where relative accuracy of sin matters most.
         for e in 1..300 {
             let a = 10f64.powi(-e);
-            let (s, c) = sin_cos(a);
+            let (s, c) = sin_cos(Lanes([a]), Lanes([0.0]));
+            let (s, c) = (s.0[0], c.0[0]);
             worst.0 = worst.0.max(ulps(s, a.sin()));
             worst.1 = worst.1.max(ulps(c, a.cos()));
         }
-        assert!(worst.0 <= 1 && worst.1 <= 1, "worst ulps (sin, cos) = {worst:?}");
+        assert!(
+            worst.0 <= 1 && worst.1 <= 1,
+            "worst ulps (sin, cos) = {worst:?}"
+        );
     }
 }
