@@ -62,20 +62,32 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> V>(
         });
     }
 
-    // One dimension: a straight loop the compiler can keep tight.
+    // One dimension: straight loops without index checks the compiler can keep
+    // tight, one with and one without the companion weights.
     if D == 1 {
         let a = axes[0];
-        let companion = a.companion.as_deref();
-        for i in 0..a.u.len() {
-            let mut p = [0.0; D];
-            p[0] = a.u[i];
-            let y = f(p);
-            if !y.all_finite() {
-                return Err(non_finite(&p, &y));
+        let mut p = [0.0; D];
+        match a.companion.as_deref() {
+            None => {
+                for (&u, &w) in a.u.iter().zip(&a.w) {
+                    p[0] = u;
+                    let y = f(p);
+                    if !y.all_finite() {
+                        return Err(non_finite(&p, &y));
+                    }
+                    acc.add(y.map(|v| v * w));
+                }
             }
-            acc.add(y.map(|v| v * a.w[i]));
-            if let Some(c) = companion {
-                acc_c.add(y.map(|v| v * c[i]));
+            Some(companion) => {
+                for ((&u, &w), &c) in a.u.iter().zip(&a.w).zip(companion) {
+                    p[0] = u;
+                    let y = f(p);
+                    if !y.all_finite() {
+                        return Err(non_finite(&p, &y));
+                    }
+                    acc.add(y.map(|v| v * w));
+                    acc_c.add(y.map(|v| v * c));
+                }
             }
         }
         evaluations = a.u.len() as u64;
