@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use lightquad::experiment::core_study;
-use lightquad::quadrature::{RULES, gauss_legendre};
+use lightquad::quadrature::{PRODUCT_RULE, RULES, gauss_legendre};
 
 /// How accurate is each numerical approximation of a light-transport integral,
 /// and what does it cost?
@@ -56,7 +56,7 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
     let mut out = BufWriter::new(stdout.lock());
     match command {
         Command::Rules => {
-            for (name, about) in RULES {
+            for (name, about) in RULES.iter().chain([&PRODUCT_RULE]) {
                 writeln!(out, "{name:<16} {about}")?;
             }
         }

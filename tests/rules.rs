@@ -146,9 +146,12 @@ fn monte_carlo_standard_errors_cover_the_truth_at_the_nominal_rate() {
     // 400 trials the binomial standard deviation is 1.1%, so [0.91, 0.99]
     // is a > 3.5 sigma band (alpha < 5e-4).
     for (name, rule) in [
-        ("monte-carlo", AnyRule::MonteCarlo(MonteCarlo)),
-        ("stratified", AnyRule::Stratified(Stratified)),
-        ("sobol", AnyRule::Sobol(Sobol::default())),
+        (
+            "monte-carlo",
+            AnyRule::by_name("monte-carlo").expect("known"),
+        ),
+        ("stratified", AnyRule::by_name("stratified").expect("known")),
+        ("sobol", AnyRule::by_name("sobol").expect("known")),
     ] {
         let mut covered = 0;
         for s in 0..400 {
@@ -320,4 +323,60 @@ fn bad_input_is_a_clear_error_never_a_panic() {
     .integrate(100, &mut rng(0), exp1)
     .expect_err("NaN tol");
     assert!(e.to_string().contains("abs_tol"), "{e}");
+}
+
+#[test]
+fn product_of_gauss_legendre_and_trapezoid_is_spectral_on_a_periodic_azimuth() {
+    // int_0^1 int_0^1 exp(u) (1 + cos(2 pi v)^2) dv du = (e - 1) * 3/2:
+    // Gauss–Legendre in u, the trapezoid rule in the periodic v.
+    let f = |p: [f64; 2]| p[0].exp() * (1.0 + (2.0 * PI * p[1]).cos().powi(2));
+    let exact = EXP1 * 1.5;
+    let rule = AnyRule::by_name("product(gauss-legendre, trapezoid)").expect("known");
+    let est = rule.integrate(31 * 31, &mut rng(0), f).expect("finite");
+    assert!(rel(est.value, exact) < 1e-14, "{}", est.value);
+    assert!(est.error < 1e-10, "error estimate {}", est.error);
+    // The same product of two Gauss–Legendre rules agrees with the built-in
+    // tensor-product rule (a different code path) to rounding.
+    let gl2 = AnyRule::by_name("product(gauss-legendre,gauss-legendre)").expect("known");
+    let a = gl2.integrate(400, &mut rng(0), exp2).expect("finite");
+    let b = GaussLegendre::default()
+        .integrate(400, &mut rng(0), exp2)
+        .expect("finite");
+    assert!(rel(a.value, b.value) < 1e-14 && rel(a.value, EXP2) < 1e-14);
+}
+
+#[test]
+fn product_with_a_random_inner_rule_is_unbiased_and_its_error_covers() {
+    // Gauss–Legendre outside, stratified sampling inside: the outer rule is
+    // exact for the u-dependence, so the error is the inner Monte Carlo's.
+    let rule = AnyRule::by_name("product(gauss-legendre,stratified)").expect("known");
+    let mut inside = 0;
+    let runs = 200;
+    for s in 0..runs {
+        let est = rule.integrate(400, &mut rng(s), exp2).expect("finite");
+        assert_eq!(est.evaluations, 20 * 20 + 19 * 20);
+        if (est.value - EXP2).abs() <= 3.0 * est.error {
+            inside += 1;
+        }
+    }
+    assert!(
+        inside >= runs * 95 / 100,
+        "{inside}/{runs} within 3 estimated errors"
+    );
+}
+
+#[test]
+fn product_names_and_dimensions_are_checked() {
+    let e = AnyRule::by_name("product(gauss-legendre)").expect_err("one argument");
+    assert!(e.to_string().contains("product(A,B)"), "{e}");
+    let e = AnyRule::by_name("product(gauss-legendre,simpson)").expect_err("unknown inner");
+    assert!(e.to_string().contains("unknown rule `simpson`"), "{e}");
+    let e =
+        AnyRule::by_name("product(product(trapezoid,trapezoid),trapezoid)").expect_err("nested");
+    assert!(e.to_string().contains("unknown rule"), "{e}");
+    let e = AnyRule::by_name("product(trapezoid,trapezoid)")
+        .expect("known")
+        .integrate(100, &mut rng(0), exp1)
+        .expect_err("1-D");
+    assert!(e.to_string().contains("dimension 1"), "{e}");
 }

@@ -13,11 +13,13 @@
 //! | `monte-carlo` | plain Monte Carlo | standard error |
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
 //! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles |
+//! | `product(A,B)` | iterated 2-D rule from any two 1-D rules | outer estimate + integrated inner estimates |
 
 pub mod gauss_kronrod;
 pub mod gauss_legendre;
 pub mod monte_carlo;
 pub mod nodes;
+pub mod product;
 pub mod sobol;
 pub mod stratified;
 pub mod trapezoid;
@@ -25,6 +27,7 @@ pub mod trapezoid;
 pub use gauss_kronrod::GaussKronrod;
 pub use gauss_legendre::GaussLegendre;
 pub use monte_carlo::MonteCarlo;
+pub use product::Product;
 pub use sobol::Sobol;
 pub use stratified::Stratified;
 pub use trapezoid::Trapezoid;
@@ -73,7 +76,7 @@ pub fn per_axis<const D: usize>(n: usize, min: usize, name: &str) -> Result<usiz
     Ok(m.max(min))
 }
 
-/// One line of `lightquad rules`: name and description.
+/// One line of `lightquad rules` per single rule: name and description.
 pub const RULES: &[(&str, &str)] = &[
     (
         "trapezoid",
@@ -98,9 +101,15 @@ pub const RULES: &[(&str, &str)] = &[
     ),
 ];
 
-/// A rule selected at run time.
+/// The `lightquad rules` line for products, which take two rule names.
+pub const PRODUCT_RULE: (&str, &str) = (
+    "product(A,B)",
+    "2-D iterated rule from any two rules above: A over the first coordinate, B over the second",
+);
+
+/// A single rule selected at run time (every rule but the product).
 #[derive(Debug, Clone, PartialEq)]
-pub enum AnyRule {
+pub enum BaseRule {
     /// [`Trapezoid`].
     Trapezoid(Trapezoid),
     /// [`GaussLegendre`].
@@ -115,19 +124,29 @@ pub enum AnyRule {
     Sobol(Sobol),
 }
 
-impl AnyRule {
+/// Any rule selected at run time, products included.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnyRule {
+    /// One rule.
+    Base(BaseRule),
+    /// The [`Product`] of two rules (kept apart from [`BaseRule`] so a product
+    /// of products, which the type system could not bound, cannot be named).
+    Product(Box<Product<BaseRule, BaseRule>>),
+}
+
+impl BaseRule {
     /// The rule named `name` with its default parameters.
-    pub fn by_name(name: &str) -> Result<AnyRule, QuadError> {
-        Ok(match name {
-            "trapezoid" => AnyRule::Trapezoid(Trapezoid),
-            "gauss-legendre" => AnyRule::GaussLegendre(GaussLegendre::default()),
-            "gauss-kronrod" => AnyRule::GaussKronrod(GaussKronrod::default()),
-            "monte-carlo" => AnyRule::MonteCarlo(MonteCarlo),
-            "stratified" => AnyRule::Stratified(Stratified),
-            "sobol" => AnyRule::Sobol(Sobol::default()),
-            _ => {
+    pub fn by_name(name: &str) -> Result<BaseRule, QuadError> {
+        Ok(match name.trim() {
+            "trapezoid" => BaseRule::Trapezoid(Trapezoid),
+            "gauss-legendre" => BaseRule::GaussLegendre(GaussLegendre::default()),
+            "gauss-kronrod" => BaseRule::GaussKronrod(GaussKronrod::default()),
+            "monte-carlo" => BaseRule::MonteCarlo(MonteCarlo),
+            "stratified" => BaseRule::Stratified(Stratified),
+            "sobol" => BaseRule::Sobol(Sobol::default()),
+            other => {
                 return Err(QuadError::UnknownRule {
-                    name: name.to_string(),
+                    name: other.to_string(),
                     known: RULES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
                 });
             }
@@ -135,15 +154,46 @@ impl AnyRule {
     }
 }
 
-impl Rule for AnyRule {
+impl AnyRule {
+    /// The rule named `name` with its default parameters; `product(A,B)` names
+    /// the iterated product of two named rules.
+    pub fn by_name(name: &str) -> Result<AnyRule, QuadError> {
+        let name = name.trim();
+        if let Some(args) = name
+            .strip_prefix("product(")
+            .and_then(|rest| rest.strip_suffix(')'))
+        {
+            let Some((outer, inner)) = split_top_level_comma(args) else {
+                return Err(QuadError::invalid(
+                    "rule",
+                    name,
+                    "product(A,B) with two rule names, e.g. product(gauss-legendre,trapezoid)",
+                ));
+            };
+            return Ok(AnyRule::Product(Box::new(Product {
+                outer: BaseRule::by_name(outer)?,
+                inner: BaseRule::by_name(inner)?,
+            })));
+        }
+        BaseRule::by_name(name).map(AnyRule::Base)
+    }
+}
+
+impl From<BaseRule> for AnyRule {
+    fn from(rule: BaseRule) -> Self {
+        AnyRule::Base(rule)
+    }
+}
+
+impl Rule for BaseRule {
     fn name(&self) -> &'static str {
         match self {
-            AnyRule::Trapezoid(r) => r.name(),
-            AnyRule::GaussLegendre(r) => r.name(),
-            AnyRule::GaussKronrod(r) => r.name(),
-            AnyRule::MonteCarlo(r) => r.name(),
-            AnyRule::Stratified(r) => r.name(),
-            AnyRule::Sobol(r) => r.name(),
+            BaseRule::Trapezoid(r) => r.name(),
+            BaseRule::GaussLegendre(r) => r.name(),
+            BaseRule::GaussKronrod(r) => r.name(),
+            BaseRule::MonteCarlo(r) => r.name(),
+            BaseRule::Stratified(r) => r.name(),
+            BaseRule::Sobol(r) => r.name(),
         }
     }
 
@@ -154,12 +204,47 @@ impl Rule for AnyRule {
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
         match self {
-            AnyRule::Trapezoid(r) => r.integrate(n, rng, f),
-            AnyRule::GaussLegendre(r) => r.integrate(n, rng, f),
-            AnyRule::GaussKronrod(r) => r.integrate(n, rng, f),
-            AnyRule::MonteCarlo(r) => r.integrate(n, rng, f),
-            AnyRule::Stratified(r) => r.integrate(n, rng, f),
-            AnyRule::Sobol(r) => r.integrate(n, rng, f),
+            BaseRule::Trapezoid(r) => r.integrate(n, rng, f),
+            BaseRule::GaussLegendre(r) => r.integrate(n, rng, f),
+            BaseRule::GaussKronrod(r) => r.integrate(n, rng, f),
+            BaseRule::MonteCarlo(r) => r.integrate(n, rng, f),
+            BaseRule::Stratified(r) => r.integrate(n, rng, f),
+            BaseRule::Sobol(r) => r.integrate(n, rng, f),
         }
     }
+}
+
+impl Rule for AnyRule {
+    fn name(&self) -> &'static str {
+        match self {
+            AnyRule::Base(r) => r.name(),
+            AnyRule::Product(r) => r.name(),
+        }
+    }
+
+    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+        &self,
+        n: usize,
+        rng: &mut R,
+        f: F,
+    ) -> Result<Estimate<V>, QuadError> {
+        match self {
+            AnyRule::Base(r) => r.integrate(n, rng, f),
+            AnyRule::Product(r) => r.integrate(n, rng, f),
+        }
+    }
+}
+
+/// Splits `A,B` at the comma that is not inside parentheses.
+fn split_top_level_comma(s: &str) -> Option<(&str, &str)> {
+    let mut depth = 0i32;
+    for (i, ch) in s.char_indices() {
+        match ch {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            ',' if depth == 0 => return Some((s[..i].trim(), s[i + 1..].trim())),
+            _ => {}
+        }
+    }
+    None
 }
