@@ -687,3 +687,35 @@ fn pixel_rejects_bad_input() {
     }
     assert_names(Pixel::new(f64::MAX, 0.0, f64::MAX, 1.0), "width");
 }
+
+#[test]
+fn segment_break_points_make_a_kink_exact_and_bad_segments_are_named() {
+    use lightquad::domain::Segment;
+    // int_0^2 |t - 1| dt = 1: exact with 2 Gauss nodes per smooth piece when
+    // the kink is a break point, not without it.
+    let rule = GaussLegendre::default();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+    let f = |t: f64| (t - 1.0).abs();
+    let with = Segment::with_breaks(0.0, 2.0, vec![1.0])
+        .expect("valid")
+        .integrate(&rule, 2, &mut rng, f)
+        .expect("finite");
+    assert!((with.value - 1.0).abs() < 1e-15, "{}", with.value);
+    let without = Segment::new(0.0, 2.0)
+        .expect("valid")
+        .integrate(&rule, 2, &mut rng, f)
+        .expect("finite");
+    assert!((without.value - 1.0).abs() > 1e-3);
+
+    let e = Segment::new(1.0, 0.0).expect_err("reversed");
+    assert!(
+        e.to_string().contains("invalid b = 0") && e.to_string().contains("b >= a"),
+        "{e}"
+    );
+    let e = Segment::new(f64::NAN, 1.0).expect_err("NaN");
+    assert!(e.to_string().contains("invalid a = NaN"), "{e}");
+    let e = Segment::new(0.0, f64::INFINITY).expect_err("infinite");
+    assert!(e.to_string().contains("invalid b = inf"), "{e}");
+    let e = Segment::with_breaks(0.0, 1.0, vec![0.5, 2.0]).expect_err("outside");
+    assert!(e.to_string().contains("breaks[1] = 2"), "{e}");
+}

@@ -63,6 +63,7 @@ fn trapezoid_converges_at_order_two_and_richardson_estimates_the_error() {
         pts.push((est.evaluations as f64 - 1.0, err));
     }
     let order = fitted_order(&pts);
+    eprintln!("trapezoid order {order:.3}");
     assert!((order + 2.0).abs() < 0.1, "trapezoid order {order}");
 }
 
@@ -79,6 +80,7 @@ fn trapezoid_2d_product_rule_converges_at_order_one_in_total_evaluations() {
     }
     // h^2 = N^-1 in two dimensions.
     let order = fitted_order(&pts);
+    eprintln!("order {order:.3}");
     assert!((order + 1.0).abs() < 0.05, "order {order}");
 }
 
@@ -92,6 +94,7 @@ fn plain_monte_carlo_converges_at_order_minus_one_half() {
         })
         .collect();
     let order = fitted_order(&pts);
+    eprintln!("plain MC order {order:.3}");
     assert!((order + 0.5).abs() < 0.1, "plain MC order {order}");
 }
 
@@ -105,6 +108,7 @@ fn stratified_2d_converges_at_order_minus_one() {
         })
         .collect();
     let order = fitted_order(&pts);
+    eprintln!("stratified 2-D order {order:.3}");
     assert!((order + 1.0).abs() < 0.15, "stratified 2-D order {order}");
 }
 
@@ -119,6 +123,7 @@ fn stratified_1d_converges_at_order_minus_three_halves() {
         })
         .collect();
     let order = fitted_order(&pts);
+    eprintln!("stratified 1-D order {order:.3}");
     assert!((order + 1.5).abs() < 0.15, "stratified 1-D order {order}");
 }
 
@@ -134,6 +139,7 @@ fn scrambled_sobol_beats_monte_carlo_order() {
         })
         .collect();
     let order = fitted_order(&pts);
+    eprintln!("scrambled Sobol' 2-D order {order:.3}");
     assert!(
         order < -1.25 && order > -1.9,
         "scrambled Sobol' order {order}"
@@ -161,6 +167,7 @@ fn monte_carlo_standard_errors_cover_the_truth_at_the_nominal_rate() {
             }
         }
         let rate = covered as f64 / 400.0;
+        eprintln!("{name}: 95% interval coverage {rate:.3}");
         // Sobol' has 8 replicates: a t(7) interval would be wider than 1.96,
         // so its coverage sits lower (t_7 at 1.96 gives ~91%).
         let low = if name == "sobol" { 0.84 } else { 0.91 };
