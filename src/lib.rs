@@ -35,10 +35,13 @@
 pub mod domain;
 pub mod error;
 pub mod estimate;
+pub mod exact;
 pub mod experiment;
+pub mod geometry;
 pub mod quadrature;
 pub mod sum;
 pub mod value;
+pub mod volume;
 
 pub use error::QuadError;
 pub use estimate::Estimate;

@@ -57,6 +57,24 @@ impl Segment {
         self.b
     }
 
+    /// The part `[lo, hi]` of this segment (`a <= lo <= hi <= b`), keeping the
+    /// break points inside it.
+    pub fn restrict(&self, lo: f64, hi: f64) -> Result<Segment, QuadError> {
+        let (lo, hi) = (lo.max(self.a), hi.min(self.b));
+        let breaks = self
+            .breaks
+            .iter()
+            .copied()
+            .filter(|&t| lo < t && t < hi)
+            .collect();
+        Segment::with_breaks(lo, hi, breaks)
+    }
+
+    /// The interior break points.
+    pub fn breaks(&self) -> &[f64] {
+        &self.breaks
+    }
+
     /// The smooth pieces `[t_i, t_{i+1}]` between break points.
     pub fn pieces(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
         let knots: Vec<f64> = std::iter::once(self.a)

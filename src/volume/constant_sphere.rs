@@ -1,0 +1,64 @@
+//! The documents' worked medium: a sphere of constant density `kappa`
+//! (EQUATIONS.md, V-tau: `sigma = lambda kappa` inside, 0 outside).
+
+use super::medium::Medium;
+use crate::domain::{Segment, Vec3};
+use crate::error::QuadError;
+use crate::geometry::{Ray, Sphere};
+
+/// `v_r = kappa` inside the sphere, 0 outside.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConstantSphere {
+    /// The sphere.
+    pub sphere: Sphere,
+    /// The density inside.
+    pub kappa: f64,
+}
+
+impl ConstantSphere {
+    /// A constant-density sphere; `kappa` finite and >= 0.
+    pub fn new(centre: Vec3, radius: f64, kappa: f64) -> Result<Self, QuadError> {
+        if !(kappa.is_finite() && kappa >= 0.0) {
+            return Err(QuadError::invalid("kappa", kappa, "a finite density >= 0"));
+        }
+        Ok(ConstantSphere {
+            sphere: Sphere::new(centre, radius)?,
+            kappa,
+        })
+    }
+}
+
+impl Medium for ConstantSphere {
+    fn name(&self) -> &'static str {
+        "constant-sphere"
+    }
+
+    fn density(&self, p: Vec3) -> f64 {
+        if (p - self.sphere.centre).norm() <= self.sphere.radius {
+            self.kappa
+        } else {
+            0.0
+        }
+    }
+
+    fn support(&self, ray: &Ray, t_min: f64, t_max: f64) -> Vec<Segment> {
+        self.sphere
+            .clip(ray, t_min, t_max)
+            .and_then(|(a, b)| Segment::new(a, b).ok())
+            .into_iter()
+            .collect()
+    }
+
+    fn max_density(&self, _ray: &Ray, _t0: f64, _t1: f64) -> f64 {
+        self.kappa
+    }
+
+    /// `kappa` times the chord length inside `[t0, t1]`.
+    fn density_integral(&self, ray: &Ray, t0: f64, t1: f64) -> Option<f64> {
+        Some(
+            self.sphere
+                .clip(ray, t0, t1)
+                .map_or(0.0, |(a, b)| self.kappa * (b - a)),
+        )
+    }
+}

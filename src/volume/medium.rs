@@ -1,0 +1,40 @@
+//! Media: scalar density fields `v_r(x) >= 0` whose extinction is
+//! `sigma(x) = lambda v_r(x)` (EQUATIONS.md, V-tau).
+//!
+//! A medium knows where along a ray it can be non-zero and where its density is
+//! not smooth, so quadrature only ever sees smooth pieces; it may know its line
+//! integral in closed form, and it bounds its density for the tracking
+//! estimators.
+
+use crate::domain::{Segment, Vec3};
+use crate::geometry::Ray;
+
+/// A density field `v_r`.
+pub trait Medium: std::fmt::Debug + Send + Sync {
+    /// A short name for reports (`constant-sphere`, `gaussian-blobs`, ...).
+    fn name(&self) -> &'static str;
+
+    /// The density `v_r(p) >= 0`.
+    fn density(&self, p: Vec3) -> f64;
+
+    /// The pieces of `[t_min, t_max]` along `ray` where the density can be
+    /// non-zero, each cut at the points where the density is not smooth.
+    /// Outside them the density is zero (or below 1e-30 of its peak, for
+    /// fields that never vanish; the medium says which in its docs).
+    fn support(&self, ray: &Ray, t_min: f64, t_max: f64) -> Vec<Segment>;
+
+    /// An upper bound of the density on `[t0, t1]` along `ray` (a majorant for
+    /// delta and ratio tracking).
+    fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64;
+
+    /// `int_{t0}^{t1} v_r(ray(t)) dt` in closed form, when the medium has one.
+    fn density_integral(&self, _ray: &Ray, _t0: f64, _t1: f64) -> Option<f64> {
+        None
+    }
+}
+
+/// Clips `[t_min, t_max]` to `[a, b]`, `None` when empty.
+pub fn overlap(t_min: f64, t_max: f64, a: f64, b: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = (t_min.max(a), t_max.min(b));
+    (lo < hi).then_some((lo, hi))
+}

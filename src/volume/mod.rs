@@ -1,0 +1,18 @@
+//! Volume rendering with a directional light (EQUATIONS.md, V-tau .. V-I;
+//! seeds/000): media as density fields, the terms along an eye ray with any
+//! rule, closed forms in [`crate::exact`], the document's printed formulas in
+//! [`audit`], and the stochastic transmittance estimators renderers use.
+
+pub mod audit;
+pub mod constant_sphere;
+pub mod gaussian_blobs;
+pub mod medium;
+pub mod scene;
+pub mod terms;
+pub mod tracking;
+
+pub use constant_sphere::ConstantSphere;
+pub use gaussian_blobs::{GaussianBlob, GaussianBlobs};
+pub use medium::Medium;
+pub use scene::{DirectionalLight, EmissionMap, VolumeScene};
+pub use terms::{DepthScheme, ShadowMethod, Term, VolumeResult, evaluate};

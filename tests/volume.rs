@@ -1,0 +1,448 @@
+//! Volume rendering (EQUATIONS.md, V-*) against closed forms (src/exact),
+//! high-order quadrature and each other; stiff and extreme cases; the audit of
+//! the printed formulas; what a scene without a part costs.
+
+mod common;
+use common::*;
+use lightquad::domain::Vec3;
+use lightquad::exact::volume as exact;
+use lightquad::geometry::Ray;
+use lightquad::quadrature::{AnyRule, GaussKronrod, GaussLegendre};
+use lightquad::volume::{
+    ConstantSphere, DepthScheme, DirectionalLight, EmissionMap, GaussianBlob, GaussianBlobs,
+    ShadowMethod, VolumeScene, audit, evaluate,
+};
+use std::sync::Arc;
+
+/// A ray along +x at height `h` above the centre of a sphere of radius `r`
+/// at the origin, starting `3r` before it: chord `2 sqrt(r^2 - h^2)`.
+fn ray_at_height(r: f64, h: f64) -> Ray {
+    Ray::new(Vec3::new(-3.0 * r, h, 0.0), Vec3::x()).expect("valid ray")
+}
+
+fn sphere_scene(r: f64, kappa: f64, lambda: f64, h: f64) -> VolumeScene {
+    let mut scene = VolumeScene::new(ray_at_height(r, h));
+    scene.medium = Some(Arc::new(
+        ConstantSphere::new(Vec3::zeros(), r, kappa).expect("valid medium"),
+    ));
+    scene.lambda = lambda;
+    scene
+}
+
+fn gl() -> GaussLegendre {
+    GaussLegendre::default()
+}
+
+#[test]
+fn constant_sphere_terms_match_closed_forms_over_six_decades_of_optical_depth() {
+    let (r, h): (f64, f64) = (1.0, 0.3);
+    let chord = 2.0 * (r * r - h * h).sqrt();
+    for depth in [1e-3, 1e-2, 1e-1, 1.0, 10.0, 100.0, 1e3] {
+        let sigma = depth / chord;
+        let mut scene = sphere_scene(r, sigma, 1.0, h);
+        scene.emission = Some(EmissionMap::Constant(2.0));
+        scene.background = Some(0.5);
+        // Light straight ahead along the ray, single scattering on.
+        scene.light = Some(DirectionalLight::new(Vec3::x(), 3.0, Some(0.7)).expect("valid"));
+        // Stiff exponentials (depth 1e3) need an adaptive rule to reach 1e-12.
+        let rule = AnyRule::from(lightquad::quadrature::BaseRule::GaussKronrod(
+            GaussKronrod {
+                abs_tol: 0.0,
+                rel_tol: 1e-14,
+            },
+        ));
+        let res = evaluate(
+            &scene,
+            &rule,
+            3000,
+            DepthScheme::Cumulative,
+            ShadowMethod::ClosedFormWhereAvailable,
+            &mut rng(0),
+        )
+        .expect("finite");
+        assert!(rel(res.optical_depth.value, depth) < 1e-13, "depth {depth}");
+        assert!(
+            rel(
+                res.log_transmittance,
+                exact::log_transmittance(sigma, chord)
+            ) < 1e-13
+        );
+        let e = res.emission.expect("emits").value;
+        assert!(
+            rel(e, exact::emission(sigma, chord, 2.0)) < 1e-12,
+            "I_E at depth {depth}: {e}"
+        );
+        let b = res.background.expect("background").value;
+        assert!(rel(b, 0.5 * (-depth).exp()) < 1e-13);
+        let l = res.light.expect("light").value;
+        let want = exact::light_ahead(sigma, chord, 3.0, Some(0.7));
+        assert!(rel(l, want) < 1e-12, "I_L at depth {depth}: {l} vs {want}");
+        assert!(rel(res.total, e + b + l) < 1e-15);
+    }
+}
+
+#[test]
+fn gauss_legendre_200_reaches_1e_12_up_to_optical_depth_30() {
+    let (r, h): (f64, f64) = (2.0, 0.5);
+    let chord = 2.0 * (r * r - h * h).sqrt();
+    for depth in [1e-3, 1.0, 10.0, 30.0] {
+        let sigma = depth / chord;
+        let mut scene = sphere_scene(r, sigma, 1.0, h);
+        scene.emission = Some(EmissionMap::Constant(1.0));
+        scene.light = Some(DirectionalLight::new(-Vec3::x(), 1.0, None).expect("valid"));
+        let res = evaluate(
+            &scene,
+            &gl(),
+            200,
+            DepthScheme::Cumulative,
+            ShadowMethod::ClosedFormWhereAvailable,
+            &mut rng(0),
+        )
+        .expect("finite");
+        let e = res.emission.expect("emits").value;
+        assert!(
+            rel(e, exact::emission(sigma, chord, 1.0)) < 1e-12,
+            "depth {depth}"
+        );
+        let l = res.light.expect("light").value;
+        assert!(
+            rel(l, exact::light_behind(sigma, chord, 1.0, None)) < 1e-12,
+            "depth {depth}"
+        );
+    }
+}
+
+#[test]
+fn optical_depth_1e5_is_exact_in_log_space_and_tau_underflow_is_flagged() {
+    let mut scene = sphere_scene(1.0, 5e4, 1.0, 0.0); // chord 2, depth 1e5
+    scene.background = Some(1.0);
+    scene.emission = Some(EmissionMap::Constant(1.0));
+    let res = evaluate(
+        &scene,
+        &gl(),
+        64,
+        DepthScheme::Cumulative,
+        ShadowMethod::ClosedFormWhereAvailable,
+        &mut rng(0),
+    )
+    .expect("finite");
+    assert!(rel(res.log_transmittance, -1e5) < 1e-14);
+    assert!(res.underflow && res.transmittance == 0.0);
+    assert_eq!(res.background.expect("bg").value, 0.0);
+    // I_E = c (1 - e^{-1e5}) / sigma = 1 / 5e4 to rounding: the integrand is
+    // a boundary layer of width 2e-5 in a chord of 2, which GL(64) cannot
+    // resolve, but the value stays finite and the error estimate says so.
+    let e = res.emission.expect("emits");
+    assert!(e.value.is_finite() && e.error.is_finite());
+}
+
+#[test]
+fn grazing_inside_missing_and_scaled_rays_are_finite_and_right() {
+    let r: f64 = 1.0;
+    // Impact parameter R (1 - 1e-9): chord 2 sqrt((R - h)(R + h)) ~ 8.9e-5.
+    let h = r * (1.0 - 1e-9);
+    let chord = 2.0 * ((r - h) * (r + h)).sqrt();
+    let scene = sphere_scene(r, 3.0, 1.0, h);
+    let res = evaluate(
+        &scene,
+        &gl(),
+        8,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect("finite");
+    let (tn, tf) = res.chord.expect("hits");
+    // t_n and t_f are near 3, so their difference is known to ~ulp(3) = 4e-16
+    // absolute (5e-12 relative to this chord): the representation limit.
+    assert!(
+        ((tf - tn) - chord).abs() <= 4.0 * EPS * 3.0,
+        "grazing chord {} vs {chord}",
+        tf - tn
+    );
+    assert!((res.optical_depth.value - 3.0 * chord).abs() <= 12.0 * EPS * 3.0 * 3.0);
+
+    // Origin inside: the chord starts at t = 0.
+    let mut inside = VolumeScene::new(
+        Ray::new(Vec3::new(0.2, 0.1, 0.0), Vec3::new(1.0, 1.0, 0.0)).expect("ray"),
+    );
+    inside.medium = Some(Arc::new(
+        ConstantSphere::new(Vec3::zeros(), 1.0, 1.0).expect("medium"),
+    ));
+    let res = evaluate(
+        &inside,
+        &gl(),
+        8,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect("finite");
+    let p = Vec3::new(0.2, 0.1, 0.0);
+    let d = Vec3::new(1.0, 1.0, 0.0).normalize();
+    assert_eq!(res.chord.expect("inside").0, 0.0);
+    assert!(rel(res.optical_depth.value, audit::s_corrected(p, d, 1.0)) < 1e-13);
+
+    // A miss: nothing is integrated, tau = 1, the background passes.
+    let mut miss = sphere_scene(1.0, 1.0, 1.0, 1.5);
+    miss.background = Some(0.25);
+    miss.emission = Some(EmissionMap::Constant(1.0));
+    let res = evaluate(
+        &miss,
+        &gl(),
+        8,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect("finite");
+    assert!(res.chord.is_none() && res.transmittance == 1.0);
+    assert_eq!(res.total, 0.25);
+
+    // Scaling lengths by s and density by 1/s keeps tau; I_E scales with s.
+    let base = {
+        let mut s = sphere_scene(1.0, 2.0, 1.0, 0.4);
+        s.emission = Some(EmissionMap::Constant(1.0));
+        evaluate(
+            &s,
+            &gl(),
+            100,
+            DepthScheme::Cumulative,
+            ShadowMethod::Quadrature,
+            &mut rng(0),
+        )
+        .expect("finite")
+    };
+    for scale in [1e-6, 1e6] {
+        let mut s = sphere_scene(scale, 2.0 / scale, 1.0, 0.4 * scale);
+        s.emission = Some(EmissionMap::Constant(1.0));
+        let res = evaluate(
+            &s,
+            &gl(),
+            100,
+            DepthScheme::Cumulative,
+            ShadowMethod::Quadrature,
+            &mut rng(0),
+        )
+        .expect("finite");
+        assert!(
+            rel(res.optical_depth.value, base.optical_depth.value) < 1e-12,
+            "scale {scale}"
+        );
+        let e = res.emission.expect("emits").value;
+        assert!(
+            rel(e / scale, base.emission.expect("emits").value) < 1e-12,
+            "scale {scale}"
+        );
+    }
+}
+
+#[test]
+fn printed_s_is_nan_and_the_corrected_one_matches_the_shadow_ray_by_quadrature() {
+    let r = 1.5;
+    let d = Vec3::new(0.3, 0.8, -0.2).normalize();
+    for p in [
+        Vec3::new(0.1, 0.2, 0.3),
+        Vec3::new(-1.0, 0.5, 0.2),
+        Vec3::new(0.0, 0.0, 1.4),
+    ] {
+        // Off the line through the centre along d: the printed radicand is
+        // <p,d>^2 - <p,p> < 0.
+        assert!(audit::s_printed(p, d).is_nan());
+        assert!(audit::light_printed(p, d, 2.0, 1.0).is_nan());
+        let s = audit::s_corrected(p, d, r);
+        assert!(s > 0.0 && ((p + d * s).norm() - r).abs() < 1e-14);
+    }
+    // The light term with s(t) from the root and with a quadrature shadow ray.
+    let mut scene = sphere_scene(r, 0.8, 1.0, 0.2);
+    scene.light = Some(DirectionalLight::new(d, 1.0, None).expect("light"));
+    let closed = evaluate(
+        &scene,
+        &gl(),
+        64,
+        DepthScheme::Cumulative,
+        ShadowMethod::ClosedFormWhereAvailable,
+        &mut rng(0),
+    )
+    .expect("finite");
+    let quad = evaluate(
+        &scene,
+        &gl(),
+        64,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect("finite");
+    let (a, b) = (closed.light.expect("l"), quad.light.expect("l"));
+    assert!(rel(a.value, b.value) < 1e-13, "{} vs {}", a.value, b.value);
+    assert!(
+        b.evaluations > 10 * a.evaluations,
+        "the shadow quadrature costs ~n per node"
+    );
+}
+
+#[test]
+fn gaussian_blob_line_integrals_match_high_order_quadrature() {
+    let blobs = GaussianBlobs::new(vec![
+        GaussianBlob {
+            centre: Vec3::new(0.0, 0.1, 0.0),
+            amplitude: 2.0,
+            width: 0.3,
+        },
+        GaussianBlob {
+            centre: Vec3::new(0.5, -0.2, 0.1),
+            amplitude: 0.7,
+            width: 0.15,
+        },
+        GaussianBlob {
+            centre: Vec3::new(5.0, 0.0, 0.0),
+            amplitude: 1.0,
+            width: 0.05,
+        },
+    ])
+    .expect("valid");
+    use lightquad::volume::Medium;
+    let ray = Ray::new(Vec3::new(-3.0, 0.05, 0.02), Vec3::new(1.0, 0.01, 0.0)).expect("ray");
+    let closed = blobs
+        .density_integral(&ray, 0.0, f64::INFINITY)
+        .expect("closed form");
+    let mut scene = VolumeScene::new(ray);
+    scene.medium = Some(Arc::new(blobs));
+    let res = evaluate(
+        &scene,
+        &gl(),
+        200,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect("finite");
+    assert!(
+        rel(res.optical_depth.value, closed) < 1e-12,
+        "{} vs {closed}",
+        res.optical_depth.value
+    );
+}
+
+#[test]
+fn nested_and_cumulative_agree_and_cost_n_squared_against_n() {
+    let blobs = GaussianBlobs::new(vec![GaussianBlob {
+        centre: Vec3::zeros(),
+        amplitude: 1.5,
+        width: 0.4,
+    }])
+    .expect("valid");
+    let mut scene = VolumeScene::new(Ray::new(Vec3::new(-4.0, 0.1, 0.0), Vec3::x()).expect("ray"));
+    scene.medium = Some(Arc::new(blobs));
+    scene.emission = Some(EmissionMap::Proportional(1.0));
+    let mut costs = Vec::new();
+    let mut values = Vec::new();
+    for scheme in [DepthScheme::Nested, DepthScheme::Cumulative] {
+        for n in [20usize, 40] {
+            let rule = GaussLegendre {
+                error_estimate: false,
+            };
+            let res = evaluate(
+                &scene,
+                &rule,
+                n,
+                scheme,
+                ShadowMethod::Quadrature,
+                &mut rng(0),
+            )
+            .expect("finite");
+            let e = res.emission.expect("emits");
+            costs.push(e.evaluations as f64);
+            values.push(e.value);
+        }
+    }
+    // Nested: doubling n quadruples the cost; cumulative: doubles it.
+    assert!((costs[1] / costs[0] - 4.0).abs() < 0.3, "nested {costs:?}");
+    assert!(
+        (costs[3] / costs[2] - 2.0).abs() < 0.2,
+        "cumulative {costs:?}"
+    );
+    assert!(rel(values[1], values[3]) < 1e-12, "{values:?}");
+}
+
+#[test]
+fn a_scene_evaluates_only_the_terms_it_has() {
+    // No medium: tau = 1 without a single evaluation.
+    let mut empty = VolumeScene::new(ray_at_height(1.0, 0.0));
+    empty.background = Some(2.0);
+    let res = evaluate(
+        &empty,
+        &gl(),
+        50,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect("finite");
+    assert_eq!(res.optical_depth.evaluations, 0);
+    assert_eq!((res.transmittance, res.total), (1.0, 2.0));
+    assert_eq!(res.evaluated, vec!["V-tau", "V-B", "V-I"]);
+    // A medium without emission or light: no V-E or V-L work.
+    let scene = sphere_scene(1.0, 1.0, 1.0, 0.0);
+    let res = evaluate(
+        &scene,
+        &gl(),
+        50,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect("finite");
+    assert!(res.emission.is_none() && res.light.is_none() && res.background.is_none());
+    assert_eq!(res.evaluated, vec!["V-tau", "V-I"]);
+    assert_eq!(res.optical_depth.evaluations, 50 + 49);
+}
+
+#[test]
+fn bad_volume_input_is_a_clear_error() {
+    let e = Ray::new(Vec3::zeros(), Vec3::zeros()).expect_err("zero direction");
+    assert!(
+        e.to_string().contains("direction") && e.to_string().contains("non-zero"),
+        "{e}"
+    );
+    let e = Ray::new(Vec3::new(f64::NAN, 0.0, 0.0), Vec3::x()).expect_err("NaN origin");
+    assert!(e.to_string().contains("origin"), "{e}");
+    let e = ConstantSphere::new(Vec3::zeros(), 1.0, -1.0).expect_err("negative kappa");
+    assert!(e.to_string().contains("kappa = -1"), "{e}");
+    let e = ConstantSphere::new(Vec3::zeros(), f64::NAN, 1.0).expect_err("NaN radius");
+    assert!(e.to_string().contains("radius = NaN"), "{e}");
+    let mut scene = sphere_scene(1.0, 1.0, -2.0, 0.0);
+    let e = evaluate(
+        &scene,
+        &gl(),
+        8,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect_err("negative lambda");
+    assert!(e.to_string().contains("lambda = -2"), "{e}");
+    scene.lambda = 1.0;
+    scene.t_min = 2.0;
+    scene.t_max = 1.0;
+    let e = evaluate(
+        &scene,
+        &gl(),
+        8,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect_err("t_f < t_n");
+    assert!(e.to_string().contains("t_max = 1"), "{e}");
+    let e = DirectionalLight::new(Vec3::x(), f64::NAN, None).expect_err("NaN intensity");
+    assert!(e.to_string().contains("intensity = NaN"), "{e}");
+    let e = GaussianBlobs::new(vec![GaussianBlob {
+        centre: Vec3::zeros(),
+        amplitude: 1.0,
+        width: 0.0,
+    }])
+    .expect_err("zero width");
+    assert!(e.to_string().contains("blobs[0].width = 0"), "{e}");
+}
