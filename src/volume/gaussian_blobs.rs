@@ -8,10 +8,11 @@
 //!     [erf((t1 - t_c)/(w sqrt 2)) - erf((t0 - t_c)/(w sqrt 2))]`,
 //!
 //! with the difference of erfs taken as a difference of erfcs in the tail,
-//! where it would otherwise cancel. Blobs never vanish: the support is cut at
+//! where it would otherwise cancel (libm's erf and erfc, accurate to an ulp;
+//! statrs's are only good to ~1e-11). Blobs never vanish: the support is cut at
 //! 12 widths, where the density is below `e^-72 = 5e-32` of the peak.
 
-use statrs::function::erf::{erf, erfc};
+use libm::{erf, erfc};
 
 use super::medium::Medium;
 use crate::domain::{Segment, Vec3};
