@@ -6,13 +6,17 @@
 pub mod audit;
 pub mod constant_sphere;
 pub mod gaussian_blobs;
+pub mod linear_gradient;
 pub mod medium;
 pub mod scene;
 pub mod terms;
 pub mod tracking;
+pub mod voxel_grid;
 
 pub use constant_sphere::ConstantSphere;
 pub use gaussian_blobs::{GaussianBlob, GaussianBlobs};
+pub use linear_gradient::LinearGradient;
 pub use medium::Medium;
 pub use scene::{DirectionalLight, EmissionMap, VolumeScene};
 pub use terms::{DepthScheme, ShadowMethod, Term, VolumeResult, evaluate};
+pub use voxel_grid::VoxelGrid;

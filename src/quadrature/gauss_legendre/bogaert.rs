@@ -28,7 +28,7 @@
 //! (the thresholds are stated at the constants). The truncation error
 //! `O(v^8)` is below double precision for n > 100; smaller n use Newton's method.
 //!
-//! Only one `sin_cos` is evaluated per node (an inline polynomial, [`super::trig`]):
+//! Only one `sin_cos` is evaluated per node (an inline polynomial, module `trig`):
 //! `cos theta` and `1 - cos theta` follow from `sin alpha`, `cos alpha` and the
 //! small `delta = theta - alpha` by the angle-addition formula, without
 //! cancellation.
