@@ -4,7 +4,7 @@ use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use lightquad::experiment::core_study;
+use lightquad::experiment::{core_study, volume_study};
 use lightquad::quadrature::{PRODUCT_RULE, RULES, gauss_legendre};
 
 /// How accurate is each numerical approximation of a light-transport integral,
@@ -28,8 +28,10 @@ enum Command {
         /// Number of nodes (Gauss–Legendre: 1..=100000000; trapezoid: >= 2).
         n: usize,
     },
-    /// Run the built-in study: every rule on integrals with closed forms, over a
-    /// budget sweep; prints a Markdown report of error, cost and fitted order.
+    /// Run the built-in studies: every rule on integrals with closed forms, over a
+    /// budget sweep, and the volume equations (audit of the printed V-Lp, V-E and
+    /// V-L nested and cumulative); prints a Markdown report of error, cost and
+    /// fitted order.
     Run {
         /// Largest budget is 4^max_power evaluations.
         #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=11))]
@@ -97,6 +99,7 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
         Command::Run { max_power, seed } => {
             let rows = core_study::run(max_power, seed);
             write!(out, "{}", core_study::markdown(&rows))?;
+            write!(out, "{}", volume_study::markdown())?;
         }
     }
     out.flush()?;

@@ -1,7 +1,39 @@
-//! Closed forms of the volume-rendering terms (EQUATIONS.md, V-*) for the
-//! constant-density sphere, `sigma = lambda kappa` on a chord of length `L`.
+//! Closed forms of the volume-rendering terms (EQUATIONS.md, V-*): V-tau for
+//! the constant-density sphere and for Gaussian blobs; V-E and V-L for the
+//! constant sphere, `sigma = lambda kappa` on a chord of length `L`.
 
 use std::f64::consts::PI;
+
+use libm::{erf, erfc};
+
+use crate::domain::Vec3;
+
+/// `erf(b) - erf(a)` for `a <= b`, as a difference of erfcs in either tail,
+/// where the difference of erfs would cancel. (libm's erf and erfc are
+/// accurate to an ulp; statrs's are only good to ~1e-11.)
+pub fn erf_difference(a: f64, b: f64) -> f64 {
+    if a >= 0.0 {
+        erfc(a) - erfc(b)
+    } else if b <= 0.0 {
+        erfc(-b) - erfc(-a)
+    } else {
+        erf(b) - erf(a)
+    }
+}
+
+/// V-tau's line integral of a unit Gaussian blob
+/// `exp(-|x - c|^2 / (2 w^2))` along `p + t d` (unit d) over `[t0, t1]`:
+///
+/// `|p + t d - c|^2 = h^2 + (t - t_c)^2` with `t_c = (c - p) . d` and `h` the
+/// distance of `c` from the line, so the integral is
+/// `e^{-h^2/(2w^2)} w sqrt(pi/2) [erf((t1 - t_c)/(w sqrt 2)) - erf((t0 - t_c)/(w sqrt 2))]`.
+pub fn gaussian_line_integral(c: Vec3, w: f64, p: Vec3, d: Vec3, t0: f64, t1: f64) -> f64 {
+    let tc = (c - p).dot(&d);
+    let h2 = (p + d * tc - c).norm_squared();
+    let s = w * std::f64::consts::SQRT_2;
+    let diff = erf_difference((t0 - tc) / s, (t1.max(t0) - tc) / s);
+    (-h2 / (2.0 * w * w)).exp() * w * (PI / 2.0).sqrt() * diff
+}
 
 /// V-tau, in log space: `ln tau = -sigma L`.
 pub fn log_transmittance(sigma: f64, chord: f64) -> f64 {

@@ -7,16 +7,13 @@
 //! `int_{t0}^{t1} a e^{-|x-c|^2/(2w^2)} dt = a e^{-h^2/(2w^2)} w sqrt(pi/2)
 //!     [erf((t1 - t_c)/(w sqrt 2)) - erf((t0 - t_c)/(w sqrt 2))]`,
 //!
-//! with the difference of erfs taken as a difference of erfcs in the tail,
-//! where it would otherwise cancel (libm's erf and erfc, accurate to an ulp;
-//! statrs's are only good to ~1e-11). Blobs never vanish: the support is cut at
+//! ([`crate::exact::volume::gaussian_line_integral`]). Blobs never vanish: the support is cut at
 //! 12 widths, where the density is below `e^-72 = 5e-32` of the peak.
-
-use libm::{erf, erfc};
 
 use super::medium::Medium;
 use crate::domain::{Segment, Vec3};
 use crate::error::QuadError;
+use crate::exact::volume::gaussian_line_integral;
 use crate::geometry::{Ray, require_finite_vec};
 
 /// Support radius in widths.
@@ -65,17 +62,6 @@ impl GaussianBlobs {
     /// The blobs.
     pub fn blobs(&self) -> &[GaussianBlob] {
         &self.blobs
-    }
-}
-
-/// `erf(b) - erf(a)` for `a <= b` without cancellation in either tail.
-pub fn erf_difference(a: f64, b: f64) -> f64 {
-    if a >= 0.0 {
-        erfc(a) - erfc(b)
-    } else if b <= 0.0 {
-        erfc(-b) - erfc(-a)
-    } else {
-        erf(b) - erf(a)
     }
 }
 
@@ -133,22 +119,16 @@ impl Medium for GaussianBlobs {
             .sum()
     }
 
+    /// The erf closed form, [`crate::exact::volume::gaussian_line_integral`].
     fn density_integral(&self, ray: &Ray, t0: f64, t1: f64) -> Option<f64> {
-        let total = self
-            .blobs
-            .iter()
-            .map(|b| {
-                let tc = (b.centre - ray.origin).dot(&ray.dir);
-                let h2 = (ray.at(tc) - b.centre).norm_squared();
-                let s = b.width * std::f64::consts::SQRT_2;
-                let diff = erf_difference((t0 - tc) / s, (t1.max(t0) - tc) / s);
-                b.amplitude
-                    * (-h2 / (2.0 * b.width * b.width)).exp()
-                    * b.width
-                    * (std::f64::consts::PI / 2.0).sqrt()
-                    * diff
-            })
-            .sum();
-        Some(total)
+        Some(
+            self.blobs
+                .iter()
+                .map(|b| {
+                    b.amplitude
+                        * gaussian_line_integral(b.centre, b.width, ray.origin, ray.dir, t0, t1)
+                })
+                .sum(),
+        )
     }
 }
