@@ -4,7 +4,11 @@ use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use lightquad::experiment::{core_study, volume_study};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use lightquad::experiment::run::RunOptions;
+use lightquad::experiment::{self, core_study, volume_study};
 use lightquad::quadrature::{PRODUCT_RULE, RULES, gauss_legendre};
 
 /// How accurate is each numerical approximation of a light-transport integral,
@@ -28,11 +32,46 @@ enum Command {
         /// Number of nodes (Gauss–Legendre: 1..=100000000; trapezoid: >= 2).
         n: usize,
     },
-    /// Run the built-in studies: every rule on integrals with closed forms, over a
-    /// budget sweep, and the volume equations (audit of the printed V-Lp, V-E and
-    /// V-L nested and cumulative); prints a Markdown report of error, cost and
-    /// fitted order.
+    /// Run experiments (default: every file in experiments/) and write a report
+    /// of error against run time: <out>/index.md, one folder per experiment.
     Run {
+        /// Experiment files; none runs the bundled experiments/ folder.
+        files: Vec<PathBuf>,
+        /// Output folder.
+        #[arg(long, default_value = "report")]
+        out: PathBuf,
+        /// Keep the jobs an interrupted run finished and run only the rest.
+        #[arg(long)]
+        resume: bool,
+        /// Run only shard k of n of every experiment's jobs (for a Slurm job
+        /// array or GNU parallel); join the shards with `lightquad merge`.
+        #[arg(long, value_parser = parse_shard)]
+        shard: Option<(usize, usize)>,
+        /// Worker threads (default: all cores). Results do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Validate experiment files without running them.
+    Check {
+        /// Experiment files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
+    /// Print the JSON Schema of experiment files.
+    Schema,
+    /// Join the results of `run --shard` folders into one report.
+    Merge {
+        /// Output folders of the shards.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// Output folder of the merged report.
+        #[arg(long, default_value = "report")]
+        out: PathBuf,
+    },
+    /// The built-in studies: every rule on integrals with closed forms, over a
+    /// budget sweep, and the volume equations (audit of the printed V-Lp, V-E and
+    /// V-L nested and cumulative); prints a Markdown report.
+    Study {
         /// Largest budget is 4^max_power evaluations.
         #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=11))]
         max_power: u32,
@@ -96,7 +135,63 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             write_json_array(&mut out, "], \"weights\": [", &w)?;
             writeln!(out, "]}}")?;
         }
-        Command::Run { max_power, seed } => {
+        Command::Run {
+            files,
+            out: dir,
+            resume,
+            shard,
+            threads,
+        } => {
+            if let Some(t) = threads {
+                if t == 0 {
+                    return Err("invalid --threads = 0: expected a number of threads >= 1".into());
+                }
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(t)
+                    .build_global()?;
+            }
+            let files = if files.is_empty() {
+                experiment::experiment_files(Path::new("experiments"))?
+            } else {
+                files
+            };
+            let opts = RunOptions {
+                out: dir,
+                resume,
+                shard,
+                progress: std::io::stderr().is_terminal(),
+            };
+            let index = experiment::run_files(&files, &opts)?;
+            if shard.is_none() {
+                writeln!(out, "report: {}", index.display())?;
+            } else {
+                writeln!(
+                    out,
+                    "shard written under {}; join shards with `lightquad merge`",
+                    opts.out.display()
+                )?;
+            }
+        }
+        Command::Check { files } => {
+            for f in files {
+                let (exp, hash) = experiment::load(&f)?;
+                writeln!(
+                    out,
+                    "{}: ok ({}, {} rule(s) x {} budget(s) x {} repeat(s), hash {hash})",
+                    f.display(),
+                    exp.spec.name,
+                    exp.spec.rules.len(),
+                    exp.budgets.len(),
+                    exp.spec.repeats
+                )?;
+            }
+        }
+        Command::Schema => writeln!(out, "{}", experiment::schema())?,
+        Command::Merge { inputs, out: dir } => {
+            let index = experiment::merge(&inputs, &dir)?;
+            writeln!(out, "report: {}", index.display())?;
+        }
+        Command::Study { max_power, seed } => {
             let rows = core_study::run(max_power, seed);
             write!(out, "{}", core_study::markdown(&rows))?;
             write!(out, "{}", volume_study::markdown())?;
@@ -117,4 +212,18 @@ fn write_json_array(out: &mut impl Write, prefix: &str, xs: &[f64]) -> std::io::
         write!(out, "{x:?}")?;
     }
     Ok(())
+}
+
+/// Parses `k/n` with 1 <= k <= n.
+fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("invalid shard {s:?}: expected k/n with 1 <= k <= n, e.g. 2/8");
+    let (k, n) = s.split_once('/').ok_or_else(bad)?;
+    let (k, n): (usize, usize) = (
+        k.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if k == 0 || k > n {
+        return Err(bad());
+    }
+    Ok((k, n))
 }

@@ -1,10 +1,264 @@
-//! Experiments: budget sweeps of rules over integrals with known values, and
-//! their reports (error against evaluations and time, fitted orders).
+//! Experiments: JSON files that describe a scene, the quantities to compute,
+//! the rules and budgets to compare and a reference; runs that write one JSON
+//! line per job; and reports of error against run time.
 //!
-//! Today this holds the built-in studies of the quadrature core
-//! ([`core_study`]) and of the volume equations ([`volume_study`]);
-//! JSON-described experiments over the equations grow here.
+//! Data flow: file -> [`spec`] (serde, unknown fields rejected, JSON paths in
+//! errors) -> [`validate`] (every number checked, the scene built) -> [`run`]
+//! (jobs in parallel, results appended as they finish) -> [`report`] (Markdown,
+//! SVG, CSV, index). The built-in studies ([`core_study`], [`volume_study`])
+//! are the `lightquad study` command.
 
 pub mod core_study;
 pub mod fit;
+pub mod report;
+pub mod run;
+pub mod spec;
+pub mod validate;
 pub mod volume_study;
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use rand::SeedableRng;
+
+use run::{JobResult, RunOptions, file_hash, read_results, run_experiment, write_atomic};
+use spec::Quantity;
+use validate::{Experiment, SpecError, parse, validate};
+
+use crate::quadrature::GaussLegendre;
+use crate::volume::evaluate;
+
+/// An error of a run, naming the file (and the JSON path when it is a spec fault).
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// A fault in an experiment file.
+    #[error("{file}: {source}")]
+    Spec {
+        /// The file.
+        file: String,
+        /// The fault.
+        source: SpecError,
+    },
+    /// A file or folder that cannot be read or written.
+    #[error("{path}: {message}")]
+    Io {
+        /// The path.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+fn io(path: &Path, e: impl std::fmt::Display) -> RunError {
+    RunError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// Reads, parses and validates one experiment file; returns it with its hash.
+pub fn load(path: &Path) -> Result<(Experiment, String), RunError> {
+    let bytes = fs::read(path).map_err(|e| io(path, e))?;
+    let text = String::from_utf8(bytes.clone()).map_err(|e| io(path, format!("not UTF-8: {e}")))?;
+    let spec_error = |source| RunError::Spec {
+        file: path.display().to_string(),
+        source,
+    };
+    let exp = validate(parse(&text).map_err(spec_error)?).map_err(spec_error)?;
+    Ok((exp, file_hash(&bytes)))
+}
+
+/// The experiment files of a folder, sorted.
+pub fn experiment_files(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
+    let mut files: Vec<PathBuf> = fs::read_dir(dir)
+        .map_err(|e| io(dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "json") && !p.ends_with("schema.json"))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+/// The reference values of an experiment and a sentence on where they come
+/// from; a converged reference is computed here, and its own convergence
+/// (n against 2n nodes) is reported.
+pub fn reference(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String) {
+    match &exp.spec.reference {
+        spec::ReferenceSpec::ClosedForm {} => (
+            exp.reference.clone(),
+            "closed forms (`lightquad::exact`).".into(),
+        ),
+        spec::ReferenceSpec::Value { uncertainty, .. } => (
+            exp.reference.clone(),
+            format!("literal values, uncertainty {uncertainty:e}."),
+        ),
+        spec::ReferenceSpec::Converged { n } => {
+            let rule = GaussLegendre {
+                error_estimate: false,
+            };
+            let run = |m: usize| {
+                let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+                let mut job = JobResult::empty();
+                if let Ok(res) = evaluate(
+                    &exp.scene,
+                    &rule,
+                    m,
+                    crate::volume::DepthScheme::Cumulative,
+                    crate::volume::ShadowMethod::ClosedFormWhereAvailable,
+                    &mut rng,
+                ) {
+                    run::collect_into(&res, &exp.spec.quantities, &mut job);
+                }
+                job.values
+            };
+            let (a, b) = (run(*n), run(2 * n));
+            let worst = exp
+                .spec
+                .quantities
+                .iter()
+                .filter_map(|q| {
+                    let (x, y) = (a.get(q)?, b.get(q)?);
+                    Some(if *y != 0.0 {
+                        ((x - y) / y).abs()
+                    } else {
+                        (x - y).abs()
+                    })
+                })
+                .fold(0.0, f64::max);
+            let verdict = if worst <= 1e-12 {
+                "converged"
+            } else {
+                "NOT converged: treat errors below this with suspicion"
+            };
+            (
+                b,
+                format!(
+                    "Gauss–Legendre with {} nodes per piece; against {n} nodes the largest relative change is {worst:.1e} ({verdict}).",
+                    2 * n
+                ),
+            )
+        }
+    }
+}
+
+/// Runs experiment files and writes their reports under `opts.out`.
+/// Every file is validated and the output folder checked before any job runs,
+/// so a bad input leaves nothing behind.
+pub fn run_files(files: &[PathBuf], opts: &RunOptions) -> Result<PathBuf, RunError> {
+    let loaded: Vec<(Experiment, String, PathBuf)> = files
+        .iter()
+        .map(|f| load(f).map(|(e, h)| (e, h, f.clone())))
+        .collect::<Result<_, _>>()?;
+    let mut names = std::collections::BTreeSet::new();
+    for (e, _, f) in &loaded {
+        if !names.insert(e.spec.name.clone()) {
+            return Err(RunError::Spec {
+                file: f.display().to_string(),
+                source: SpecError::at(
+                    "name",
+                    format!(
+                        "{:?} is used by another experiment in this run",
+                        e.spec.name
+                    ),
+                ),
+            });
+        }
+    }
+    fs::create_dir_all(&opts.out).map_err(|e| io(&opts.out, e))?;
+    let probe = opts.out.join(".lightquad-write-probe");
+    write_atomic(&probe, b"").map_err(|e| io(&opts.out, format!("not writable: {e}")))?;
+    let _ = fs::remove_file(&probe);
+
+    let total: usize = loaded
+        .iter()
+        .map(|(e, _, _)| run::jobs(e, opts.shard).len())
+        .sum();
+    let bar = if opts.progress {
+        indicatif::ProgressBar::new(total as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let mut entries = Vec::new();
+    for (exp, hash, file) in &loaded {
+        let dir = opts.out.join(&exp.spec.name);
+        fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
+        let text = fs::read(file).map_err(|e| io(file, e))?;
+        write_atomic(&dir.join("experiment.json"), &text).map_err(|e| io(&dir, e))?;
+        bar.set_message(exp.spec.name.clone());
+        let results = run_experiment(exp, hash, opts, &bar).map_err(|e| io(&dir, e))?;
+        if opts.shard.is_none() {
+            let (values, note) = reference(exp);
+            let summary = report::write_experiment(&dir, exp, &results, &values, &note)
+                .map_err(|e| io(&dir, e))?;
+            entries.push((exp.spec.name.clone(), exp.spec.description.clone(), summary));
+        }
+    }
+    bar.finish_and_clear();
+    if opts.shard.is_none() {
+        report::write_index(&opts.out, &entries).map_err(|e| io(&opts.out, e))?;
+    }
+    Ok(opts.out.join("index.md"))
+}
+
+/// Joins the shards' results under `out` (written by `run --shard k/n` into
+/// the same or copied folders) into one results file and report per experiment.
+pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
+    let mut by_experiment: BTreeMap<String, (Experiment, String, Vec<JobResult>)> = BTreeMap::new();
+    for input in inputs {
+        for entry in fs::read_dir(input)
+            .map_err(|e| io(input, e))?
+            .filter_map(Result::ok)
+        {
+            let dir = entry.path();
+            let spec_file = dir.join("experiment.json");
+            if !spec_file.is_file() {
+                continue;
+            }
+            let (exp, hash) = load(&spec_file)?;
+            let slot = by_experiment
+                .entry(exp.spec.name.clone())
+                .or_insert_with(|| (exp.clone(), hash.clone(), Vec::new()));
+            if slot.1 != hash {
+                return Err(io(
+                    &spec_file,
+                    "a different version of this experiment than the other shards (hash differs)",
+                ));
+            }
+            for f in fs::read_dir(&dir)
+                .map_err(|e| io(&dir, e))?
+                .filter_map(Result::ok)
+            {
+                let name = f.file_name().to_string_lossy().to_string();
+                if name.starts_with("results") && name.ends_with(".jsonl") {
+                    slot.2.extend(read_results(&f.path(), Some(&hash)));
+                }
+            }
+        }
+    }
+    fs::create_dir_all(out).map_err(|e| io(out, e))?;
+    let mut entries = Vec::new();
+    for (name, (exp, _, mut results)) in by_experiment {
+        results.sort_by_key(JobResult::key);
+        results.dedup_by_key(|r| r.key());
+        let dir = out.join(&name);
+        fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
+        let mut text = String::new();
+        for r in &results {
+            text.push_str(&serde_json::to_string(r).map_err(|e| io(&dir, e))?);
+            text.push('\n');
+        }
+        write_atomic(&dir.join("results.jsonl"), text.as_bytes()).map_err(|e| io(&dir, e))?;
+        let (values, note) = reference(&exp);
+        let summary = report::write_experiment(&dir, &exp, &results, &values, &note)
+            .map_err(|e| io(&dir, e))?;
+        entries.push((name, exp.spec.description.clone(), summary));
+    }
+    report::write_index(out, &entries).map_err(|e| io(out, e))?;
+    Ok(out.join("index.md"))
+}
+
+/// The JSON Schema of experiment files.
+pub fn schema() -> String {
+    serde_json::to_string_pretty(&schemars::schema_for!(spec::ExperimentSpec)).unwrap_or_default()
+}
