@@ -1,0 +1,359 @@
+//! The real `lightquad` binary on the bundled experiments and on deliberately
+//! broken files: exit status, messages that name the JSON path and what is
+//! accepted, nothing left behind; an interrupted run resumed to the same
+//! results; results independent of the thread count.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lightquad"))
+}
+
+/// A fresh scratch folder.
+fn scratch(tag: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "lightquad-test-{}-{tag}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::SeqCst)
+    ));
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+const VALID: &str = r#"{
+  "name": "t",
+  "equations": ["V-tau", "V-E"],
+  "scene": {
+    "ray": { "origin": [-3.0, 0.3, 0.0], "direction": [1.0, 0.0, 0.0] },
+    "medium": { "type": "constant-sphere", "centre": [0.0, 0.0, 0.0], "radius": 1.0, "kappa": 2.0 },
+    "emission": { "type": "constant", "c": 1.0 }
+  },
+  "quantities": ["tau", "I_E"],
+  "rules": [ { "rule": "gauss-legendre" }, { "rule": "stratified" } ],
+  "budgets": [4, 16, 64],
+  "repeats": 2,
+  "seed": 7,
+  "reference": { "type": "closed-form" }
+}"#;
+
+/// Runs `check` and `run` on `text`; both must fail naming `path` and `what`,
+/// and the run must leave no output folder.
+fn rejected(text: &str, path: &str, what: &str) {
+    let dir = scratch("bad");
+    let file = dir.join("e.json");
+    fs::write(&file, text).expect("write");
+    let check = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(
+        !check.status.success(),
+        "check accepted a broken file ({path})"
+    );
+    let msg = stderr(&check);
+    assert!(
+        msg.contains(&format!("at `{path}`")),
+        "no path `{path}` in: {msg}"
+    );
+    assert!(msg.contains(what), "no `{what}` in: {msg}");
+    let out = dir.join("out");
+    let run = bin()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("runs");
+    assert!(!run.status.success());
+    assert!(!out.exists(), "a failed run left {out:?} behind");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
+    rejected("{ \"name\": ", "name", "EOF while parsing");
+    rejected(
+        &VALID.replace("\"seed\": 7", "\"seed\": 7, \"colour\": 1"),
+        "colour",
+        "unknown field `colour`, expected one of",
+    );
+    rejected(
+        &VALID.replace("\"repeats\": 2", "\"repeats\": \"two\""),
+        "repeats",
+        "expected usize",
+    );
+    rejected(
+        &VALID.replace("\"quantities\": [\"tau\", \"I_E\"],", ""),
+        ".",
+        "missing field `quantities`",
+    );
+    rejected(
+        &VALID.replace("[4, 16, 64]", "[4, -16, 64]"),
+        "budgets[1]",
+        "an integer in 1..=100000000",
+    );
+    rejected(
+        &VALID.replace("\"kappa\": 2.0", "\"kappa\": -2.0"),
+        "scene.medium.kappa",
+        "a finite density >= 0",
+    );
+    rejected(
+        &VALID.replace("\"kappa\": 2.0", "\"kappa\": NaN"),
+        "scene.medium.kappa",
+        "expected value",
+    );
+    rejected(
+        &VALID.replace("\"rule\": \"stratified\"", "\"rule\": \"simpson\""),
+        "rules[1].rule",
+        "unknown variant `simpson`, expected one of",
+    );
+    rejected(
+        &VALID.replace("\"kappa\": 2.0", "\"kappa\": 2.0, \"sigma\": 1"),
+        "scene.medium",
+        "unknown field `sigma`",
+    );
+    rejected(
+        &VALID.replace("[1.0, 0.0, 0.0] }", "[0.0, 0.0, 0.0] }"),
+        "scene.ray.direction",
+        "a non-zero direction",
+    );
+    rejected(
+        &VALID.replace("\"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0", "\"type\": \"voxel-grid\", \"min\": [0,0,0], \"max\": [1,1,1], \"resolution\": [1,1,1], \"data\": [1.0]"),
+        "reference",
+        "has no closed form",
+    );
+}
+
+#[test]
+fn an_unwritable_output_folder_is_an_error_before_any_job() {
+    let dir = scratch("unwritable");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    // A regular file where the output folder should be.
+    let blocker = dir.join("blocker");
+    fs::write(&blocker, "x").expect("write");
+    let run = bin()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(blocker.join("out"))
+        .output()
+        .expect("runs");
+    assert!(!run.status.success());
+    assert!(stderr(&run).contains("blocker"), "{}", stderr(&run));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// The results of a run, sorted, without timing or machine fields.
+fn results(out: &Path, name: &str) -> Vec<String> {
+    let text = fs::read_to_string(out.join(name).join("results.jsonl")).expect("results");
+    let mut lines: Vec<String> = text
+        .lines()
+        .map(|l| {
+            let mut v: serde_json::Value = serde_json::from_str(l).expect("a whole JSON line");
+            if let Some(o) = v.as_object_mut() {
+                o.remove("seconds");
+                o.remove("machine");
+            }
+            v.to_string()
+        })
+        .collect();
+    lines.sort();
+    lines
+}
+
+#[test]
+fn results_are_identical_for_one_thread_and_all_threads() {
+    let dir = scratch("threads");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let mut runs = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.join(format!("out{threads}"));
+        let o = bin()
+            .args(["run", "--threads", threads, "--out"])
+            .arg(&out)
+            .arg(&file)
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{}", stderr(&o));
+        runs.push(results(&out, "t"));
+    }
+    assert_eq!(runs[0].len(), 2 * 3 * 2);
+    assert_eq!(runs[0], runs[1]);
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_killed_run_resumes_to_the_results_of_an_uninterrupted_one() {
+    let dir = scratch("resume");
+    let file = dir.join("e.json");
+    // Nested optical depth makes each job slow enough to kill the run midway.
+    let slow = VALID
+        .replace("[4, 16, 64]", "[64, 128, 256, 512, 768, 1024]")
+        .replace(
+            "\"repeats\": 2",
+            "\"repeats\": 3, \"depth_scheme\": \"nested\"",
+        );
+    fs::write(&file, &slow).expect("write");
+    let full = dir.join("full");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&full)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    let part = dir.join("part");
+    let mut child = bin()
+        .args(["run", "--threads", "1", "--out"])
+        .arg(&part)
+        .arg(&file)
+        .spawn()
+        .expect("spawns");
+    let jsonl = part.join("t").join("results.jsonl");
+    let start = Instant::now();
+    // Wait for some, not all, jobs to finish, then kill -9.
+    loop {
+        let lines = fs::read_to_string(&jsonl).map_or(0, |t| t.lines().count());
+        if lines >= 3 || start.elapsed() > Duration::from_secs(60) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().expect("SIGKILL");
+    let _ = child.wait();
+    let before = fs::read_to_string(&jsonl).map_or(0, |t| t.lines().count());
+    assert!(
+        before >= 1 && before < 36,
+        "killed after {before} of 36 jobs"
+    );
+
+    let o = bin()
+        .args(["run", "--resume", "--out"])
+        .arg(&part)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(results(&part, "t"), results(&full, "t"));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn shards_merge_into_the_full_report() {
+    let dir = scratch("shards");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let full = dir.join("full");
+    assert!(
+        bin()
+            .args(["run", "--out"])
+            .arg(&full)
+            .arg(&file)
+            .output()
+            .expect("runs")
+            .status
+            .success()
+    );
+    let shards = dir.join("shards");
+    for k in 1..=3 {
+        let o = bin()
+            .args(["run", "--shard", &format!("{k}/3"), "--out"])
+            .arg(&shards)
+            .arg(&file)
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let merged = dir.join("merged");
+    let o = bin()
+        .args(["merge", "--out"])
+        .arg(&merged)
+        .arg(&shards)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(results(&merged, "t"), results(&full, "t"));
+    assert!(merged.join("t").join("report.md").is_file() && merged.join("index.md").is_file());
+    let bad = bin()
+        .args(["run", "--shard", "4/3"])
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(!bad.status.success() && stderr(&bad).contains("1 <= k <= n"));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_bundled_experiments_run_and_report_every_quantity() {
+    let dir = scratch("bundled");
+    let out = dir.join("report");
+    let o = bin()
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["run", "--out"])
+        .arg(&out)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let index = fs::read_to_string(out.join("index.md")).expect("index");
+    let files =
+        fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments")).expect("folder");
+    let mut n = 0;
+    for f in files.filter_map(Result::ok) {
+        let p = f.path();
+        if p.extension().is_none_or(|x| x != "json") {
+            continue;
+        }
+        n += 1;
+        let spec: serde_json::Value =
+            serde_json::from_str(&fs::read_to_string(&p).expect("read")).expect("json");
+        let name = spec["name"].as_str().expect("name");
+        assert!(
+            index.contains(&format!("]({name}/report.md)")),
+            "index lacks {name}"
+        );
+        let report = fs::read_to_string(out.join(name).join("report.md")).expect("report");
+        for q in spec["quantities"].as_array().expect("quantities") {
+            let q = q.as_str().expect("name");
+            assert!(
+                report.contains(&format!("## {q} (reference")),
+                "{name} lacks {q}"
+            );
+            assert!(
+                out.join(name)
+                    .join(format!("{name}-{q}-time.svg"))
+                    .is_file()
+            );
+        }
+        assert!(
+            !report.contains("| NaN") && !report.contains("NaN |"),
+            "{name} reports a NaN"
+        );
+    }
+    assert!(n >= 6, "{n} bundled experiments");
+    // Every equation ID of the volume document is covered.
+    for id in ["V-tau", "V-E", "V-B", "V-Lp", "V-L", "V-I"] {
+        assert!(
+            fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments"))
+                .expect("folder")
+                .filter_map(Result::ok)
+                .any(|f| fs::read_to_string(f.path())
+                    .is_ok_and(|t| t.contains(&format!("\"{id}\"")))),
+            "no bundled experiment for {id}"
+        );
+    }
+    let schema = bin().arg("schema").output().expect("runs");
+    let schema: serde_json::Value =
+        serde_json::from_slice(&schema.stdout).expect("the schema is JSON");
+    assert!(schema["properties"]["scene"].is_object());
+    let _ = fs::remove_dir_all(&dir);
+}
