@@ -117,7 +117,7 @@ impl Sphere {
 
     /// Distance from `p` (inside or on the sphere) to the boundary along the
     /// unit direction `d`: the positive root `s(p)` of `|p + s d - c|^2 = R^2`
-    /// (EQUATIONS.md, V-Lp, as corrected in audit point 1). Zero outside.
+    /// (docs/EQUATIONS.md, V-Lp, as corrected in audit point 1). Zero outside.
     pub fn exit_distance(&self, p: Vec3, d: Vec3) -> f64 {
         match self.line_roots(p, d) {
             Some((_, t1)) => t1.max(0.0),

@@ -72,7 +72,7 @@ enum Command {
     /// budget sweep, and the volume equations (audit of the printed V-Lp, V-E and
     /// V-L nested and cumulative); prints a Markdown report.
     Study {
-        /// Largest budget is 4^max_power evaluations.
+        /// The largest budget is 4^max_power (1..=11).
         #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=11))]
         max_power: u32,
         /// Seed of the randomised rules.
@@ -124,9 +124,9 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                     (x, w)
                 }
                 other => {
-                    lightquad::quadrature::AnyRule::by_name(other)?;
                     return Err(format!(
-                        "rule `{other}` has no fixed node set to print: expected gauss-legendre or trapezoid"
+                        "invalid rule `{other}` for `nodes`: expected gauss-legendre or trapezoid \
+                         (the rules with a fixed node set)"
                     )
                     .into());
                 }

@@ -16,7 +16,7 @@ pub struct ExperimentSpec {
     /// What the experiment shows.
     #[serde(default)]
     pub description: String,
-    /// The equation IDs it instantiates (EQUATIONS.md: `V-tau`, `V-E`, ...).
+    /// The equation IDs it instantiates (docs/EQUATIONS.md: `V-tau`, `V-E`, ...).
     pub equations: Vec<String>,
     /// The scene: only the parts it has.
     pub scene: SceneSpec,

@@ -31,7 +31,7 @@ fn audit_section(out: &mut String) {
          d = (0.3, 0.8, -0.2)/|.|. `s` by quadrature is the shadow ray's optical depth \
          (64-node Gauss–Legendre) divided by lambda kappa. The printed radicand \
          <p,d>^2 - <p,p><d,d> is never positive (Cauchy–Schwarz): NaN off the line through \
-         the centre (EQUATIONS.md audit points 1 and 2).\n\n\
+         the centre (docs/EQUATIONS.md audit points 1 and 2).\n\n\
          | point p | s printed | s corrected | s by quadrature | I_p printed | I_p corrected |\n\
          |---|---:|---:|---:|---:|---:|\n",
     );

@@ -1,5 +1,5 @@
 //! The document's printed formulas for the light reaching a point (V-Lp), kept
-//! verbatim so reports can show where they go wrong (EQUATIONS.md, audit
+//! verbatim so reports can show where they go wrong (docs/EQUATIONS.md, audit
 //! points 1 and 2), beside the corrected ones.
 //!
 //! For a sphere of radius R centred at the origin and a point `p` inside it,

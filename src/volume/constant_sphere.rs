@@ -1,5 +1,5 @@
 //! The documents' worked medium: a sphere of constant density `kappa`
-//! (EQUATIONS.md, V-tau: `sigma = lambda kappa` inside, 0 outside).
+//! (docs/EQUATIONS.md, V-tau: `sigma = lambda kappa` inside, 0 outside).
 
 use super::medium::Medium;
 use crate::domain::{Segment, Vec3};

@@ -1,5 +1,5 @@
 //! Media: scalar density fields `v_r(x) >= 0` whose extinction is
-//! `sigma(x) = lambda v_r(x)` (EQUATIONS.md, V-tau).
+//! `sigma(x) = lambda v_r(x)` (docs/EQUATIONS.md, V-tau).
 //!
 //! A medium knows where along a ray it can be non-zero and where its density is
 //! not smooth, so quadrature only ever sees smooth pieces; it may know its line
