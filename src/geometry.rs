@@ -91,11 +91,19 @@ impl Sphere {
     /// (Haines et al., "Precision improvements for ray/sphere intersection",
     /// Ray Tracing Gems, 2019). The smaller-magnitude root comes from
     /// `t_0 t_1 = |f|^2 - R^2 = (|f| - R)(|f| + R)`, not from a difference.
+    ///
+    /// Lengths are scaled by `max(R, |f|)` first, so radii up to 1e308 neither
+    /// overflow in the products nor underflow near 1e-308.
     pub fn line_roots(&self, p: Vec3, d: Vec3) -> Option<(f64, f64)> {
-        let f = p - self.centre;
+        let f0 = p - self.centre;
+        let scale = self.radius.max(f0.amax());
+        if !(scale.is_finite() && scale > 0.0) {
+            return None;
+        }
+        let f = f0 / scale;
+        let r = self.radius / scale;
         let b = f.dot(&d);
         let h = (f - d * b).norm();
-        let r = self.radius;
         if h > r {
             return None;
         }
@@ -104,7 +112,7 @@ impl Sphere {
         let q = if b > 0.0 { -b - root } else { -b + root };
         let c = (f.norm() - r) * (f.norm() + r);
         let (a, other) = if q != 0.0 { (q, c / q) } else { (root, -root) };
-        Some((a.min(other), a.max(other)))
+        Some((a.min(other) * scale, a.max(other) * scale))
     }
 
     /// The part `[t_near, t_far]` of `[t_min, t_max]` along `ray` inside the
@@ -117,8 +125,12 @@ impl Sphere {
 
     /// Distance from `p` (inside or on the sphere) to the boundary along the
     /// unit direction `d`: the positive root `s(p)` of `|p + s d - c|^2 = R^2`
-    /// (docs/EQUATIONS.md, V-Lp, as corrected in audit point 1). Zero outside.
+    /// (docs/EQUATIONS.md, V-Lp, as corrected in audit point 1). Zero for a
+    /// point outside the sphere.
     pub fn exit_distance(&self, p: Vec3, d: Vec3) -> f64 {
+        if (p - self.centre).norm() > self.radius {
+            return 0.0;
+        }
         match self.line_roots(p, d) {
             Some((_, t1)) => t1.max(0.0),
             None => 0.0,

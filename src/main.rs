@@ -108,6 +108,17 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                     (t.x, t.w)
                 }
                 "trapezoid" => {
+                    if n > lightquad::quadrature::trapezoid::MAX_POINTS {
+                        return Err(lightquad::QuadError::invalid(
+                            "n",
+                            n,
+                            format!(
+                                "at most {} trapezoid nodes",
+                                lightquad::quadrature::trapezoid::MAX_POINTS
+                            ),
+                        )
+                        .into());
+                    }
                     if n < 2 {
                         return Err(lightquad::QuadError::invalid(
                             "n",

@@ -221,3 +221,30 @@ fn bad_orders_are_clear_errors() {
         .expect_err("n = 0");
     assert!(e.to_string().contains("invalid n = 0"), "{e}");
 }
+
+#[test]
+fn the_error_estimate_tracks_the_truth_for_algebraic_and_geometric_convergence() {
+    // int_0^1 sqrt(u) = 2/3 (error ~ m^-3), int_0^1 u^-1/2 = 2 (error ~ m^-1),
+    // int_0^1 exp(u) = e - 1 (geometric): the estimate must stay within a
+    // factor 10 of the true error either way (a plain |Q_m - Q_(m-1)| is 30 to
+    // 1000 times too small for the first two).
+    let cases: [(fn([f64; 1]) -> f64, f64, &[usize]); 3] = [
+        (|u| u[0].sqrt(), 2.0 / 3.0, &[20, 100, 1000]),
+        (|u| u[0].powf(-0.5), 2.0, &[20, 100, 1000]),
+        (|u| u[0].exp(), std::f64::consts::E - 1.0, &[3, 4, 5, 6]),
+    ];
+    for (f, exact, orders) in cases {
+        for &m in orders {
+            let est = GaussLegendre::default()
+                .integrate(m, &mut rng(0), f)
+                .expect("finite");
+            let truth = (est.value - exact).abs();
+            let ratio = est.error / truth;
+            assert!(
+                (0.5..=10.0).contains(&ratio),
+                "m = {m}: estimate {:.2e} vs true {truth:.2e}",
+                est.error
+            );
+        }
+    }
+}

@@ -8,7 +8,7 @@
 //! | name | rule | error estimate |
 //! |---|---|---|
 //! | `trapezoid` | composite trapezoid, product in D > 1 | Richardson, half step |
-//! | `gauss-legendre` | Gauss–Legendre of any order, product in D > 1 | `|Q_m - Q_{m-1}|` |
+//! | `gauss-legendre` | Gauss–Legendre of any order, product in D > 1 | geometric tail of `Q_{m-2}, Q_{m-1}, Q_m` |
 //! | `gauss-kronrod` | adaptive Gauss–Kronrod G7–K15 (D = 1) | embedded G7 |
 //! | `monte-carlo` | plain Monte Carlo | standard error |
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
@@ -84,7 +84,7 @@ pub const RULES: &[(&str, &str)] = &[
     ),
     (
         "gauss-legendre",
-        "Gauss–Legendre of any order 1..=1e8 (product rule in 2-D); error estimate |Q_m - Q_(m-1)|",
+        "Gauss–Legendre of any order 1..=1e8 (product rule in 2-D); error estimate from Q_m, Q_(m-1), Q_(m-2)",
     ),
     (
         "gauss-kronrod",

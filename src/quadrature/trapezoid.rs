@@ -13,6 +13,9 @@ use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
 
+/// Largest number of points per axis (the node table takes 24 bytes a point).
+pub const MAX_POINTS: usize = 100_000_000;
+
 /// Composite trapezoid rule (tensor product in D > 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Trapezoid;
@@ -51,6 +54,13 @@ impl Rule for Trapezoid {
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
         let mut m = per_axis::<D>(n, 3, "n")?;
+        if m > MAX_POINTS {
+            return Err(QuadError::invalid(
+                "n",
+                n,
+                format!("at most {MAX_POINTS} trapezoid points per axis"),
+            ));
+        }
         if m % 2 == 0 {
             m -= 1;
         }

@@ -128,6 +128,16 @@ impl VolumeScene {
                 format!("a number >= t_min = {} (t_f >= t_n)", self.t_min),
             ));
         }
+        if let Some(l) = self.light {
+            DirectionalLight::new(l.toward_light, l.intensity, l.albedo)?;
+            if ((l.toward_light.norm() - 1.0).abs()) > 1e-12 {
+                return Err(QuadError::invalid(
+                    "toward_light",
+                    format!("{:?}", l.toward_light.as_slice()),
+                    "a unit vector (build the light with DirectionalLight::new)",
+                ));
+            }
+        }
         if let Some(b) = self.background {
             if !(b.is_finite() && b >= 0.0) {
                 return Err(QuadError::invalid(

@@ -36,6 +36,10 @@ struct Span {
     majorant: f64,
 }
 
+/// Tentative collisions allowed per walk and span before tracking gives up
+/// (its cost grows with the majorant's optical depth).
+const MAX_COLLISIONS: u64 = 10_000_000;
+
 /// Which tracking estimator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Tracker {
@@ -78,6 +82,20 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
     n: usize,
     rng: &mut Rg,
 ) -> Result<Estimate<f64>, QuadError> {
+    if !(sigma.lambda.is_finite() && sigma.lambda >= 0.0) {
+        return Err(QuadError::invalid(
+            "lambda",
+            sigma.lambda,
+            "a finite number >= 0",
+        ));
+    }
+    if t0.is_nan() || t1.is_nan() || t1 < t0 {
+        return Err(QuadError::invalid(
+            "t1",
+            t1,
+            format!("a number >= t0 = {t0}"),
+        ));
+    }
     if n < 2 {
         return Err(QuadError::invalid(
             "n",
@@ -100,6 +118,13 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
             let s0 = a + width * i as f64;
             let s1 = if i + 1 == SPANS { b } else { s0 + width };
             let bar = lambda * medium.max_density(ray, s0, s1);
+            if !bar.is_finite() {
+                return Err(QuadError::invalid(
+                    "majorant",
+                    bar,
+                    "a finite extinction bound (lambda times the medium's density)",
+                ));
+            }
             let control = match tracker {
                 Tracker::ResidualRatio => {
                     let gl = crate::quadrature::gauss_legendre::unit_nodes(4)?;
@@ -139,6 +164,7 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
                 continue;
             }
             let mut t = span.a;
+            let mut collisions = 0u64;
             loop {
                 // Free flight: -ln(1 - xi) / majorant, xi in [0, 1).
                 t -= (-rng.random::<f64>()).ln_1p() / span.majorant;
@@ -146,6 +172,17 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
                     break;
                 }
                 evaluations += 1;
+                collisions += 1;
+                if collisions > MAX_COLLISIONS {
+                    return Err(QuadError::invalid(
+                        "optical depth",
+                        span.majorant * (span.b - span.a),
+                        format!(
+                            "at most {MAX_COLLISIONS} tentative collisions per walk and span: \
+                             the majorant's optical depth is too large for tracking"
+                        ),
+                    ));
+                }
                 let sigma = lambda * medium.density(ray.at(t));
                 match tracker {
                     Tracker::Delta => {
