@@ -228,7 +228,8 @@ fn the_error_estimate_tracks_the_truth_for_algebraic_and_geometric_convergence()
     // int_0^1 exp(u) = e - 1 (geometric): the estimate must stay within a
     // factor 10 of the true error either way (a plain |Q_m - Q_(m-1)| is 30 to
     // 1000 times too small for the first two).
-    let cases: [(fn([f64; 1]) -> f64, f64, &[usize]); 3] = [
+    type Case = (fn([f64; 1]) -> f64, f64, &'static [usize]);
+    let cases: [Case; 3] = [
         (|u| u[0].sqrt(), 2.0 / 3.0, &[20, 100, 1000]),
         (|u| u[0].powf(-0.5), 2.0, &[20, 100, 1000]),
         (|u| u[0].exp(), std::f64::consts::E - 1.0, &[3, 4, 5, 6]),
