@@ -29,6 +29,16 @@ pub fn require_finite_vec(name: &str, v: Vec3) -> Result<Vec3, QuadError> {
     }
 }
 
+/// `|v|` without overflow or underflow for components near 1e±308
+/// (scaled by the largest component first).
+pub fn norm(v: Vec3) -> f64 {
+    let scale = v.amax();
+    if scale == 0.0 || !scale.is_finite() {
+        return scale;
+    }
+    scale * (v / scale).norm()
+}
+
 /// `v / |v|`, or an error naming `name` for a zero or non-finite vector.
 /// The length is taken after scaling by the largest component, so vectors of
 /// size 1e-300 or 1e300 normalise without under- or overflow.
@@ -92,14 +102,17 @@ impl Sphere {
     /// Ray Tracing Gems, 2019). The smaller-magnitude root comes from
     /// `t_0 t_1 = |f|^2 - R^2 = (|f| - R)(|f| + R)`, not from a difference.
     ///
-    /// Lengths are scaled by `max(R, |f|)` first, so radii up to 1e308 neither
-    /// overflow in the products nor underflow near 1e-308.
+    /// Lengths are scaled by the power of two nearest below `max(R, |f|)`
+    /// first (exactly), so radii up to 1e308 neither overflow in the products
+    /// nor underflow near 1e-308.
     pub fn line_roots(&self, p: Vec3, d: Vec3) -> Option<(f64, f64)> {
         let f0 = p - self.centre;
-        let scale = self.radius.max(f0.amax());
-        if !(scale.is_finite() && scale > 0.0) {
+        let size = self.radius.max(f0.amax());
+        if !(size.is_finite() && size > 0.0) {
             return None;
         }
+        // A power of two, so the scaling itself is exact.
+        let scale = 2f64.powi(size.log2().floor() as i32);
         let f = f0 / scale;
         let r = self.radius / scale;
         let b = f.dot(&d);
@@ -128,7 +141,7 @@ impl Sphere {
     /// (docs/EQUATIONS.md, V-Lp, as corrected in audit point 1). Zero for a
     /// point outside the sphere.
     pub fn exit_distance(&self, p: Vec3, d: Vec3) -> f64 {
-        if (p - self.centre).norm() > self.radius {
+        if norm(p - self.centre) > self.radius {
             return 0.0;
         }
         match self.line_roots(p, d) {

@@ -719,3 +719,29 @@ fn segment_break_points_make_a_kink_exact_and_bad_segments_are_named() {
     let e = Segment::with_breaks(0.0, 1.0, vec![0.5, 2.0]).expect_err("outside");
     assert!(e.to_string().contains("breaks[1] = 2"), "{e}");
 }
+
+#[test]
+fn projected_hemisphere_lets_every_rule_integrate_cosine_weighted_integrands() {
+    use lightquad::domain::Hemisphere;
+    use lightquad::quadrature::AnyRule;
+    // int cos(theta) d omega = pi as int 1 in projected solid angle; the
+    // trapezoid rule has nodes on the rim, where the Cosine map's Jacobian is
+    // infinite.
+    let h = Hemisphere::projected();
+    assert!((h.measure() - PI).abs() < 1e-15);
+    for name in [
+        "trapezoid",
+        "gauss-legendre",
+        "product(gauss-legendre,trapezoid)",
+    ] {
+        let rule = AnyRule::by_name(name).expect("known");
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+        let one = integrate_over(&rule, &h, 33 * 33, &mut rng, |_| 1.0).expect("finite");
+        assert!((one.value - PI).abs() < 1e-12, "{name}: {}", one.value);
+        // int sin^2(theta) cos(theta) d omega = pi / 2: g = 1 - z^2 = u_1 is
+        // linear in the map's coordinate, so every rule here is exact.
+        let s2 = integrate_over(&rule, &h, 33 * 33, &mut rng, |w: Vec3| 1.0 - w.z * w.z)
+            .expect("finite");
+        assert!((s2.value - PI / 2.0).abs() < 1e-12, "{name}: {}", s2.value);
+    }
+}

@@ -24,6 +24,26 @@ fn ascending(mut pairs: Vec<(f64, f64)>) -> (Vec<f64>, Vec<f64>) {
 }
 
 #[test]
+fn the_two_term_regime_agrees_with_bilby() {
+    // 3000 <= n < 1e5 keeps F1, F2, W1, W2 only: no 40-digit sample there,
+    // so every node of n = 5000 and 20000 is held against bilby's.
+    for n in [5000usize, 20_000] {
+        let ours = table(n).expect("valid n");
+        let bil = bilby::GaussLegendre::new(n).expect("n > 0");
+        let (bx, bw) = ascending(
+            bil.rule()
+                .nodes
+                .iter()
+                .copied()
+                .zip(bil.rule().weights.iter().copied())
+                .collect(),
+        );
+        let (dx, dw) = max_diff(&ours.x, &ours.w, &bx, &bw);
+        assert!(dx <= 4.0 && dw <= 6.0, "n={n}: {dx} eps, {dw} eps");
+    }
+}
+
+#[test]
 fn agrees_with_bilby_and_gauss_quad_and_is_at_least_as_accurate() {
     let large = data("gauss_legendre_large.json");
     let mut results = Vec::new();

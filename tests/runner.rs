@@ -187,7 +187,7 @@ fn results_are_identical_for_one_thread_and_all_threads() {
         runs.push(results(&out, "t"));
     }
     assert_eq!(runs[0].len(), 2 * 3 * 2);
-    assert_eq!(runs[0], runs[1]);
+    same(&runs[0], &runs[1]);
     let _ = fs::remove_dir_all(&dir);
 }
 
@@ -244,8 +244,16 @@ fn a_killed_run_resumes_to_the_results_of_an_uninterrupted_one() {
         .output()
         .expect("runs");
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(results(&part, "t"), results(&full, "t"));
+    same(&results(&part, "t"), &results(&full, "t"));
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// Two result sets are equal; on failure, says how they first differ.
+fn same(a: &[String], b: &[String]) {
+    assert_eq!(a.len(), b.len(), "{} against {} results", a.len(), b.len());
+    if let Some((x, y)) = a.iter().zip(b).find(|(x, y)| x != y) {
+        panic!("first difference:\n{x}\n{y}");
+    }
 }
 
 #[test]
@@ -282,7 +290,7 @@ fn shards_merge_into_the_full_report() {
         .output()
         .expect("runs");
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(results(&merged, "t"), results(&full, "t"));
+    same(&results(&merged, "t"), &results(&full, "t"));
     assert!(merged.join("t").join("report.md").is_file() && merged.join("index.md").is_file());
     let bad = bin()
         .args(["run", "--shard", "4/3"])

@@ -199,6 +199,24 @@ fn grazing_inside_missing_and_scaled_rays_are_finite_and_right() {
     assert!(res.chord.is_none() && res.transmittance == 1.0);
     assert_eq!(res.total, 0.25);
 
+    // Radii near the overflow threshold: R = 1e160, kappa = 1e-160 has optical
+    // depth 2 along a diameter (the products in the root formula once overflowed).
+    let huge = sphere_scene(1e160, 1e-160, 1.0, 0.0);
+    let res = evaluate(
+        &huge,
+        &gl(),
+        8,
+        DepthScheme::Cumulative,
+        ShadowMethod::Quadrature,
+        &mut rng(0),
+    )
+    .expect("finite");
+    assert!(
+        rel(res.optical_depth.value, 2.0) < 1e-14,
+        "{}",
+        res.optical_depth.value
+    );
+
     // Scaling lengths by s and density by 1/s keeps tau; I_E scales with s.
     let base = {
         let mut s = sphere_scene(1.0, 2.0, 1.0, 0.4);
@@ -396,7 +414,8 @@ fn a_scene_evaluates_only_the_terms_it_has() {
     .expect("finite");
     assert!(res.emission.is_none() && res.light.is_none() && res.background.is_none());
     assert_eq!(res.evaluated, vec!["V-tau", "V-I"]);
-    assert_eq!(res.optical_depth.evaluations, 50 + 49);
+    // Gauss–Legendre spends m + (m-1) + (m-2) with its error estimate.
+    assert_eq!(res.optical_depth.evaluations, 50 + 49 + 48);
 }
 
 #[test]
@@ -519,4 +538,60 @@ fn regression_cumulative_depth_is_right_for_rules_that_visit_nodes_out_of_order(
         l.value,
         l.error
     );
+}
+
+#[test]
+fn proportional_emission_obeys_the_identity_i_e_equals_k_over_lambda_times_one_minus_tau() {
+    // With c(v) = k v, I_E = int tau sigma (k / lambda) dt = (k / lambda)(1 - tau)
+    // for any medium: an independent check of the nested integral against the
+    // erf closed form of tau, by every deterministic rule and both schemes.
+    let blobs = GaussianBlobs::new(vec![
+        GaussianBlob {
+            centre: Vec3::new(0.0, 0.1, 0.0),
+            amplitude: 1.2,
+            width: 0.4,
+        },
+        GaussianBlob {
+            centre: Vec3::new(0.6, -0.2, 0.1),
+            amplitude: 0.8,
+            width: 0.25,
+        },
+    ])
+    .expect("valid");
+    use lightquad::volume::Medium;
+    let ray = Ray::new(Vec3::new(-5.0, 0.05, 0.0), Vec3::new(1.0, 0.02, 0.01)).expect("ray");
+    let (lambda, k) = (1.7, 0.6);
+    let tau = (-lambda
+        * blobs
+            .density_integral(&ray, 0.0, f64::INFINITY)
+            .expect("erf"))
+    .exp();
+    let want = k / lambda * (1.0 - tau);
+    let mut scene = VolumeScene::new(ray);
+    scene.medium = Some(Arc::new(blobs));
+    scene.lambda = lambda;
+    scene.emission = Some(EmissionMap::Proportional(k));
+    for (name, n, tol) in [
+        ("gauss-legendre", 60, 1e-12),
+        ("gauss-kronrod", 600, 1e-12),
+        ("trapezoid", 4001, 1e-6),
+    ] {
+        let rule = AnyRule::by_name(name).expect("known");
+        for scheme in [DepthScheme::Nested, DepthScheme::Cumulative] {
+            if scheme == DepthScheme::Nested && name == "trapezoid" {
+                continue; // n^2 = 1.6e7 evaluations: too slow for a unit test
+            }
+            let res = evaluate(
+                &scene,
+                &rule,
+                n,
+                scheme,
+                ShadowMethod::Quadrature,
+                &mut rng(0),
+            )
+            .expect("finite");
+            let got = res.emission.expect("emits").value;
+            assert!(rel(got, want) < tol, "{name} {scheme:?}: {got} vs {want}");
+        }
+    }
 }

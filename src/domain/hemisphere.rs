@@ -1,4 +1,5 @@
-//! The hemisphere of directions around a normal, measured in solid angle.
+//! The hemisphere of directions around a normal, measured in solid angle (or,
+//! with [`HemisphereMap::Projected`], in projected solid angle `cos theta d omega`).
 
 use super::{Domain, Frame, Vec3};
 use std::f64::consts::PI;
@@ -10,8 +11,15 @@ pub enum HemisphereMap {
     Uniform,
     /// Malley's map: `sin theta = sqrt(u_1)`, `phi = 2 pi u_2`; density
     /// `cos theta / pi`, so `|J| = pi / cos theta`. A cosine-weighted integrand
-    /// `g(w) cos theta` becomes `pi g(w)` in `u`.
+    /// `g(w) cos theta` becomes `pi g(w)` in `u`. The Jacobian is infinite on
+    /// the rim (`u_1 = 1`): rules with a node there (the trapezoid rule) get an
+    /// infinite integrand unless `g` carries the `cos theta`; use `Projected`.
     Cosine,
+    /// Malley's map measured in projected solid angle `cos theta d omega`:
+    /// `|J| = pi`, constant, so `int g(w) cos theta d omega` is integrated as
+    /// `int g(w) d omega_perp` with `g` free of the cosine, and rules with
+    /// nodes on the rim are safe. `measure()` is `pi`.
+    Projected,
 }
 
 /// The hemisphere `{w : w . n >= 0}` of unit directions.
@@ -29,6 +37,15 @@ impl Hemisphere {
         Hemisphere {
             frame: Frame::identity(),
             map: HemisphereMap::Uniform,
+        }
+    }
+
+    /// The upper hemisphere about `+z` in projected solid angle (Malley's map,
+    /// constant Jacobian `pi`).
+    pub fn projected() -> Self {
+        Hemisphere {
+            frame: Frame::identity(),
+            map: HemisphereMap::Projected,
         }
     }
 
@@ -59,6 +76,10 @@ impl Domain<2> for Hemisphere {
                 let z = (1.0 - u[0]).max(0.0).sqrt();
                 (u[0].sqrt(), z, PI / z)
             }
+            HemisphereMap::Projected => {
+                let z = (1.0 - u[0]).max(0.0).sqrt();
+                (u[0].sqrt(), z, PI)
+            }
         };
         let local = Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
         (self.frame.to_world(local), jacobian)
@@ -75,13 +96,16 @@ impl Domain<2> for Hemisphere {
         // Rounding can put `cos theta` or `sin^2 theta` a few ulps above 1.
         let u1 = match self.map {
             HemisphereMap::Uniform => l.z,
-            HemisphereMap::Cosine => l.x * l.x + l.y * l.y,
+            HemisphereMap::Cosine | HemisphereMap::Projected => l.x * l.x + l.y * l.y,
         }
         .min(1.0);
         Some([u1, super::azimuth_fraction(l.y, l.x)])
     }
 
     fn measure(&self) -> f64 {
-        2.0 * PI
+        match self.map {
+            HemisphereMap::Projected => PI,
+            _ => 2.0 * PI,
+        }
     }
 }

@@ -118,8 +118,10 @@ impl Domain<1> for Segment {
     type Point = f64;
 
     /// `t = a + (b - a) u`, `|J| = b - a`. Written as `a + L u` near `a` and
-    /// `b - L (1 - u)` near `b`, so nodes keep their relative distance to
-    /// whichever end is closer.
+    /// `b - L (1 - u)` near `b`, so the map adds no cancellation at either end.
+    /// (Unit-interval nodes near 1 are themselves stored as f64 values near 1,
+    /// with absolute precision 1e-16; only nodes near 0 keep full relative
+    /// precision, see `gauss_legendre::unit_nodes`.)
     fn map(&self, u: [f64; 1]) -> (f64, f64) {
         let len = self.b - self.a;
         let t = if u[0] <= 0.5 {

@@ -11,7 +11,8 @@
 //! common paired estimate `(f_a - f_b)^2 / 2` several times too large for smooth
 //! integrands (a gradient `g` across cells of width `h` adds `(g h)^2`, while
 //! `sigma^2` itself is only `(g h)^2 / 12`). Then
-//! `Var(Q) = (1/N^2) sum_i sigma_i^2 ~ (1/N^2) (N / T) sum_triples (...)^2 / 6 * 3`.
+//! `Var(Q) = (1/N^2) sum_i sigma_i^2 ~ (1/N^2) (N / T) sum_triples (...)^2 / 6`
+//! over the `T` triples.
 
 use super::{Rule, per_axis};
 use crate::error::QuadError;

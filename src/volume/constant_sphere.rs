@@ -34,7 +34,7 @@ impl Medium for ConstantSphere {
     }
 
     fn density(&self, p: Vec3) -> f64 {
-        if (p - self.sphere.centre).norm() <= self.sphere.radius {
+        if crate::geometry::norm(p - self.sphere.centre) <= self.sphere.radius {
             self.kappa
         } else {
             0.0

@@ -21,6 +21,8 @@
 //! scene does not have are not evaluated at all.
 
 use std::cell::Cell;
+use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use super::medium::Medium;
 use super::scene::VolumeScene;
@@ -28,7 +30,9 @@ use crate::domain::Segment;
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::geometry::Ray;
-use crate::quadrature::{GaussLegendre, Rule};
+use crate::quadrature::Rule;
+use crate::quadrature::gauss_legendre::unit_nodes;
+use crate::quadrature::nodes::UnitNodes;
 
 /// How the optical depth `tau(t_n, t)` inside V-E and V-L is computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,14 +145,54 @@ struct DepthAlong<'a, R: Rule> {
     scheme: DepthScheme,
     rule: &'a R,
     n: usize,
-    /// Visited `(t, depth from the piece start)`, sorted by t (cumulative scheme).
-    checkpoints: Vec<(f64, f64)>,
+    /// The gap rule's nodes on [0, 1], fetched once per evaluation.
+    gap: Arc<UnitNodes>,
+    /// Visited `t -> depth from the piece start` (cumulative scheme).
+    checkpoints: BTreeMap<Key, f64>,
+}
+
+/// A parameter `t` ordered totally, as a map key.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Key(f64);
+impl Eq for Key {}
+impl PartialOrd for Key {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Key {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
 }
 
 impl<R: Rule> DepthAlong<'_, R> {
     fn start_piece(&mut self, piece: &Segment) {
         self.checkpoints.clear();
-        self.checkpoints.push((piece.start(), 0.0));
+        self.checkpoints.insert(Key(piece.start()), 0.0);
+    }
+
+    /// `lambda int_lo^hi v_r` with the gap rule on panels no longer than
+    /// `longest`, split at the piece's break points; no allocation.
+    fn gap_depth(&self, piece: &Segment, lo: f64, hi: f64, longest: f64) -> f64 {
+        let mut total = 0.0;
+        let mut a = lo;
+        let inner = piece.breaks().iter().copied().filter(|&b| lo < b && b < hi);
+        for b in inner.chain(std::iter::once(hi)) {
+            let panels = ((b - a) / longest).ceil().max(1.0) as usize;
+            let width = (b - a) / panels as f64;
+            for j in 0..panels {
+                let p0 = a + width * j as f64;
+                let len = if j + 1 == panels { b - p0 } else { width };
+                let mut sum = 0.0;
+                for (u, w) in self.gap.u.iter().zip(&self.gap.w) {
+                    sum += w * self.medium.density(&self.ray, p0 + len * u);
+                }
+                total += self.lambda * len * sum;
+            }
+            a = b;
+        }
+        total
     }
 
     /// Depth from the start of `piece` to `t` (inside `piece`).
@@ -168,36 +212,50 @@ impl<R: Rule> DepthAlong<'_, R> {
                     .value)
             }
             DepthScheme::Cumulative => {
-                let i = self.checkpoints.partition_point(|c| c.0 <= t);
-                let (t0, d0) = self.checkpoints[i.saturating_sub(1)];
-                // The gap to the nearest visited node below t is covered by
-                // 6-point Gauss–Legendre panels no longer than piece / n, the
-                // spacing of an ascending rule: rules that visit nodes out of
-                // order (adaptive, Monte Carlo) get the same accuracy, at a
-                // cost of O(n log n) instead of O(n) panels.
-                let rule = GaussLegendre {
-                    error_estimate: false,
-                };
+                // Continue from the nearest visited node below t. The gap is
+                // covered by 6-point Gauss–Legendre panels no longer than
+                // piece / n, the spacing of an ascending rule, so rules that
+                // visit nodes out of order (adaptive, Monte Carlo) get the same
+                // accuracy, at O(n log n) instead of O(n) panels.
+                let (t0, d0) = self
+                    .checkpoints
+                    .range(..=Key(t))
+                    .next_back()
+                    .map_or((piece.start(), 0.0), |(k, d)| (k.0, *d));
                 let longest = (piece.end() - piece.start()) / self.n as f64;
-                let panels = ((t - t0) / longest).ceil().max(1.0) as usize;
-                let mut d = d0;
-                for j in 0..panels {
-                    let lo = t0 + (t - t0) * j as f64 / panels as f64;
-                    let hi = if j + 1 == panels {
-                        t
-                    } else {
-                        t0 + (t - t0) * (j + 1) as f64 / panels as f64
-                    };
-                    d += piece
-                        .restrict(lo, hi)?
-                        .integrate(&rule, GAP_NODES, rng, |s| lambda * medium.density(&ray, s))?
-                        .value;
-                }
-                self.checkpoints.insert(i, (t, d));
+                let d = d0 + self.gap_depth(piece, t0, t, longest);
+                self.checkpoints.insert(Key(t), d);
                 Ok(d)
             }
         }
     }
+}
+
+/// The outer integration pieces of V-E and V-L: each support piece is cut at
+/// optical depths 1, 2, 4, 8, ... from its start (measured with the majorant),
+/// so the boundary layer `tau(t_n, t) = e^{-sigma (t - t_n)}` of a thick medium
+/// is resolved by every rule: a piece of optical depth D costs
+/// `1 + log2 D` times the budget instead of being missed.
+fn graded(medium: &dyn Medium, lambda: f64, ray: &Ray, piece: &Segment) -> Vec<Segment> {
+    let (a, b) = (piece.start(), piece.end());
+    let bar = lambda * medium.max_density(ray, a, b);
+    let depth = bar * (b - a);
+    if !(depth.is_finite() && depth > 2.0) {
+        return vec![piece.clone()];
+    }
+    let mut cuts = vec![a];
+    let mut d = 1.0;
+    while d < depth {
+        let t = a + d / bar;
+        if t > *cuts.last().unwrap_or(&a) && t < b {
+            cuts.push(t);
+        }
+        d *= 2.0;
+    }
+    cuts.push(b);
+    cuts.windows(2)
+        .filter_map(|w| piece.restrict(w[0], w[1]).ok())
+        .collect()
 }
 
 /// Evaluates every term the scene has with `rule` at budget `n` per smooth piece.
@@ -294,38 +352,42 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
             scheme,
             rule,
             n,
-            checkpoints: Vec::new(),
+            gap: unit_nodes(GAP_NODES)?,
+            checkpoints: BTreeMap::new(),
         };
         let mut total = Estimate {
             value: 0.0,
             error: 0.0,
             evaluations: 0,
         };
+        // Optical depth from t_n to the start of the current sub-piece.
         let mut before = 0.0;
-        for (piece, piece_depth) in pieces.iter().zip(&piece_depths) {
-            along.start_piece(piece);
-            let mut failure = None;
-            // The outer rule's own rng stream is derived so the inner calls
-            // can use the caller's.
-            let mut outer_rng =
-                <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(rng.next_u64());
-            let est = piece.integrate(rule, n, &mut outer_rng, |t| {
-                if failure.is_some() {
-                    return 0.0;
+        for piece in &pieces {
+            for sub in graded(medium, scene.lambda, &ray, piece) {
+                along.start_piece(&sub);
+                let mut failure = None;
+                // The outer rule's own rng stream is derived so the inner calls
+                // can use the caller's.
+                let mut outer_rng =
+                    <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(rng.next_u64());
+                let est = sub.integrate(rule, n, &mut outer_rng, |t| {
+                    if failure.is_some() {
+                        return 0.0;
+                    }
+                    let value = along
+                        .depth_to(&sub, t, rng)
+                        .and_then(|d| Ok((-(before + d)).exp() * h(t, rng)?));
+                    value.unwrap_or_else(|e| {
+                        failure = Some(e);
+                        0.0
+                    })
+                });
+                if let Some(e) = failure {
+                    return Err(e);
                 }
-                let value = along
-                    .depth_to(piece, t, rng)
-                    .and_then(|d| Ok((-(before + d)).exp() * h(t, rng)?));
-                value.unwrap_or_else(|e| {
-                    failure = Some(e);
-                    0.0
-                })
-            });
-            if let Some(e) = failure {
-                return Err(e);
+                total = total.combine(est?);
+                before += along.depth_to(&sub, sub.end(), rng)?;
             }
-            total = total.combine(est?);
-            before += piece_depth;
         }
         Ok(total)
     };

@@ -47,7 +47,7 @@ pub enum Tracker {
     Delta,
     /// Ratio tracking.
     Ratio,
-    /// Residual ratio tracking with control `sigma_bar / 2`.
+    /// Residual ratio tracking with a control extinction per span (its mean).
     ResidualRatio,
 }
 
