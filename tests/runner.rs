@@ -365,3 +365,41 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
     assert!(schema["properties"]["scene"].is_object());
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn cancellation_in_the_total_is_flagged() {
+    use lightquad::exact::volume::emission;
+    use lightquad::experiment::report::rows;
+    use lightquad::experiment::run::run_job;
+    use lightquad::experiment::spec::Quantity;
+    use lightquad::experiment::validate::{parse, validate};
+    // Negative emission c = -1 on a chord of 2 at sigma = 1 and a background
+    // I_b = -I_E / tau: the total V-I is zero up to rounding.
+    let (sigma, chord) = (1.0f64, 2.0f64);
+    let i_e = emission(sigma, chord, -1.0);
+    let i_b = -i_e / (-sigma * chord).exp();
+    let text = VALID
+        .replace("\"kappa\": 2.0", "\"kappa\": 1.0")
+        .replace("[-3.0, 0.3, 0.0]", "[-3.0, 0.0, 0.0]")
+        .replace(
+            "\"c\": 1.0 }",
+            &format!("\"c\": -1.0 }}, \"background\": {i_b:e}"),
+        )
+        .replace("[\"tau\", \"I_E\"]", "[\"I\"]")
+        .replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"value\", \"values\": { \"I\": 0.0 } }",
+        );
+    let exp = validate(parse(&text).expect("parses")).expect("valid");
+    let jobs: Vec<_> = [4usize, 16]
+        .iter()
+        .map(|&n| run_job(&exp, "h", 0, n, 0))
+        .collect();
+    let table = rows(&exp, &jobs, Quantity::Total, 0.0);
+    assert!(
+        table
+            .iter()
+            .all(|r| r.flags.iter().any(|f| f.starts_with("cancellation"))),
+        "{table:?}"
+    );
+}

@@ -83,6 +83,17 @@ pub fn rows(exp: &Experiment, results: &[JobResult], q: Quantity, reference: f64
         if vals.iter().any(|v| !v.0.is_finite() || !v.1.is_finite()) {
             flags.push("non-finite value".into());
         }
+        // A sum much smaller than the magnitudes of its parts has lost digits
+        // to cancellation.
+        if jobs
+            .iter()
+            .any(|j| match (j.values.get(&q), j.magnitudes.get(&q)) {
+                (Some(v), Some(m)) => *m > 0.0 && v.abs() < 1e-6 * m,
+                _ => false,
+            })
+        {
+            flags.push("cancellation: |sum| < 1e-6 of its parts".into());
+        }
         if jobs.iter().any(|j| j.underflow) && q == Quantity::Tau {
             flags.push("tau underflows: log space".into());
         }
@@ -355,8 +366,9 @@ pub fn write_experiment(
         md,
         "Flags: `non-finite value`; `outside 4 standard errors` (a random estimate whose standard \
          error misses the true error); `estimate off by more than 10x` (a deterministic error \
-         estimate, above the rounding floor); `error grew with the budget`; `tau underflows: log \
-         space` (the optical depth is exact, tau itself is below the smallest f64)."
+         estimate, above the rounding floor); `error grew with the budget`; `cancellation` (V-I \
+         is below 1e-6 of the summed magnitudes of its terms); `tau underflows: log space` (the \
+         optical depth is exact, tau itself is below the smallest f64)."
     );
     write_atomic(&dir.join("report.md"), md.as_bytes()).map_err(|e| e.to_string())?;
     // CSV of every job.

@@ -45,6 +45,10 @@ pub struct JobResult {
     pub estimated_errors: BTreeMap<Quantity, f64>,
     /// Density evaluations per quantity.
     pub evaluations: BTreeMap<Quantity, u64>,
+    /// The summed magnitude of the parts of a quantity (for V-I: |I_E| + |I_B|
+    /// + |I_L|), when it is a sum; the report flags cancellation against it.
+    #[serde(default)]
+    pub magnitudes: BTreeMap<Quantity, f64>,
     /// Wall time of the evaluation, seconds (the clock is read outside it).
     pub seconds: f64,
     /// Why the job failed, if it did.
@@ -73,6 +77,7 @@ impl JobResult {
             values: BTreeMap::new(),
             estimated_errors: BTreeMap::new(),
             evaluations: BTreeMap::new(),
+            magnitudes: BTreeMap::new(),
             seconds: 0.0,
             failure: None,
             underflow: false,
@@ -189,6 +194,8 @@ pub fn collect_into(res: &VolumeResult, quantities: &[Quantity], out: &mut JobRe
                 let e = terms.iter().flatten().map(|t| t.error).sum();
                 let k = res.optical_depth.evaluations
                     + terms.iter().flatten().map(|t| t.evaluations).sum::<u64>();
+                let magnitude = terms.iter().flatten().map(|t| t.value.abs()).sum::<f64>();
+                out.magnitudes.insert(*q, magnitude);
                 (res.total, e, k)
             }
         };
@@ -220,6 +227,7 @@ pub fn run_job(
         values: BTreeMap::new(),
         estimated_errors: BTreeMap::new(),
         evaluations: BTreeMap::new(),
+        magnitudes: BTreeMap::new(),
         seconds: 0.0,
         failure: None,
         underflow: false,
