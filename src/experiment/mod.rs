@@ -65,8 +65,15 @@ pub fn load(path: &Path) -> Result<(Experiment, String), RunError> {
         file: path.display().to_string(),
         source,
     };
-    let exp = validate(parse(&text).map_err(spec_error)?).map_err(spec_error)?;
-    Ok((exp, file_hash(&bytes)))
+    let mut exp = validate(parse(&text).map_err(spec_error)?).map_err(spec_error)?;
+    let hash = file_hash(&bytes);
+    if let spec::ReferenceSpec::Mitsuba { file } = &exp.spec.reference {
+        let (values, uncertainty, _) =
+            validate::mitsuba_reference(file, &hash, &exp.spec.quantities).map_err(spec_error)?;
+        exp.reference = values;
+        exp.uncertainty = uncertainty;
+    }
+    Ok((exp, hash))
 }
 
 /// The experiment files of a folder, sorted.
@@ -88,6 +95,10 @@ pub fn reference(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String) {
         spec::ReferenceSpec::ClosedForm {} => (
             exp.reference.clone(),
             "closed forms (`lightquad::exact`).".into(),
+        ),
+        spec::ReferenceSpec::Mitsuba { file } => (
+            exp.reference.clone(),
+            format!("Mitsuba 3 values from `{file}`, largest standard error {:.1e} (float32 renderer: ~1e-6 relative floor).", exp.uncertainty),
         ),
         spec::ReferenceSpec::Value { uncertainty, .. } => (
             exp.reference.clone(),

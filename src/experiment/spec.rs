@@ -346,6 +346,13 @@ pub enum ReferenceSpec {
         #[serde(default)]
         uncertainty: f64,
     },
+    /// Values written by the Mitsuba 3 harness (`reference/`), e.g.
+    /// `reference/values/<name>.json`; stale files (another experiment hash)
+    /// are rejected.
+    Mitsuba {
+        /// Path of the values file, relative to the working folder.
+        file: String,
+    },
     /// A high-order Gauss–Legendre run at `n` nodes per piece, checked against `2n`.
     Converged {
         /// Nodes per smooth piece (default 400).

@@ -464,6 +464,7 @@ pub fn validate(spec: ExperimentSpec) -> Result<Experiment, SpecError> {
             }
             (values.clone(), *uncertainty)
         }
+        ReferenceSpec::Mitsuba { .. } => (BTreeMap::new(), 0.0),
         ReferenceSpec::Converged { n } => {
             if !(2..=100_000).contains(n) {
                 return Err(SpecError::at(
@@ -481,4 +482,48 @@ pub fn validate(spec: ExperimentSpec) -> Result<Experiment, SpecError> {
         reference,
         uncertainty,
     })
+}
+
+/// Reads a Mitsuba values file for an experiment whose file hashes to `hash`:
+/// the value and standard error per quantity, and a note for the report.
+pub fn mitsuba_reference(
+    path: &str,
+    hash: &str,
+    quantities: &[Quantity],
+) -> Result<(BTreeMap<Quantity, f64>, f64, String), SpecError> {
+    let at = "reference.file";
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SpecError::at(at, format!("{path}: {e} (run scripts/reference.sh to generate it)")))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| SpecError::at(at, format!("{path}: {e}")))?;
+    let file_hash = json["experiment_hash"].as_str().unwrap_or("");
+    if file_hash != hash {
+        return Err(SpecError::at(
+            at,
+            format!(
+                "{path} is stale: it was made from an experiment file with hash {file_hash:?}, this one \
+                 hashes to {hash:?}; regenerate it (scripts/reference.sh)"
+            ),
+        ));
+    }
+    let mut values = BTreeMap::new();
+    let mut worst = 0.0f64;
+    for q in quantities {
+        let entry = &json["quantities"][q.name()];
+        let (Some(v), Some(se)) = (entry["value"].as_f64(), entry["std_error"].as_f64()) else {
+            return Err(SpecError::at(
+                at,
+                format!("{path} has no value for quantity {} (Mitsuba cannot compute it here?)", q.name()),
+            ));
+        };
+        values.insert(*q, v);
+        worst = worst.max(se);
+    }
+    let note = format!(
+        "Mitsuba 3 ({} {}), largest standard error {worst:.1e}: errors below a few standard errors \
+         (and the float32 floor of ~1e-6 relative) are not resolved.",
+        json["mitsuba_variant"].as_str().unwrap_or("?"),
+        json["mitsuba_version"].as_str().unwrap_or("?")
+    );
+    Ok((values, worst, note))
 }

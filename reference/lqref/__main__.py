@@ -1,0 +1,63 @@
+"""Command line: ``python -m lqref <experiment files...> [--quick] [--out DIR]``,
+or ``python -m lqref --check [experiment files...]``."""
+
+import argparse
+import sys
+import time
+
+from .runner import DEFAULT_OUT, check, compute
+from .spec import SpecError
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(
+        prog="python -m lqref",
+        description="Mitsuba 3 reference values for lightquad experiment files: writes "
+                    "<out>/<experiment name>.json per file.")
+    ap.add_argument("files", nargs="*", help="experiment files (JSON)")
+    ap.add_argument("--quick", action="store_true",
+                    help="few samples: a smoke run in seconds, not reference accuracy")
+    ap.add_argument("--out", default=str(DEFAULT_OUT),
+                    help="directory of the values files (default: reference/values)")
+    ap.add_argument("--check", action="store_true",
+                    help="only report stale (hash mismatch) or missing values files; "
+                         "without files, check every values file in --out")
+    args = ap.parse_args(argv)
+
+    if args.check:
+        bad = 0
+        for status, name, message in check(args.files, args.out):
+            print(f"{status.upper():8s}{name}: {message}")
+            bad += status != "ok"
+        return 1 if bad else 0
+
+    if not args.files:
+        ap.error("give one or more experiment files (or --check)")
+
+    from .mitsuba_scene import MitsubaMissing, require_mitsuba
+    from .quantities import Settings
+    try:
+        require_mitsuba()
+    except MitsubaMissing as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 3
+
+    settings = Settings(quick=args.quick)
+    failed = 0
+    t0 = time.perf_counter()
+    for path in args.files:
+        print(f"{path}:")
+        try:
+            rec = compute(path, settings, args.out)
+        except SpecError as e:
+            print(f"error: {path}: {e}", file=sys.stderr)
+            failed += 1
+            continue
+        print(f"  -> {args.out}/{rec['experiment']}.json ({rec['run_seconds']:.1f} s)")
+    print(f"{len(args.files) - failed} of {len(args.files)} experiments in "
+          f"{time.perf_counter() - t0:.1f} s")
+    return 2 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
