@@ -3,7 +3,7 @@
 //! line per job; and reports of error against run time.
 //!
 //! Data flow: file -> [`spec`] (serde, unknown fields rejected, JSON paths in
-//! errors) -> [`validate`] (every number checked, the scene built) -> [`run`]
+//! errors) -> [`validate`](mod@validate) (every number checked, the scene built) -> [`run`](mod@run)
 //! (jobs in parallel, results appended as they finish) -> [`report`] (Markdown,
 //! SVG, CSV, index). The built-in studies ([`core_study`], [`volume_study`])
 //! are the `lightquad study` command.

@@ -229,7 +229,7 @@ fn tail_estimate(q: f64, q1: f64, q2: f64) -> f64 {
 /// Gauss–Legendre product rule on `[0, 1]^D`.
 ///
 /// A budget of n evaluations gives `m = floor(n^(1/D))` nodes per axis. The
-/// error estimate compares `Q_m` with `Q_{m-1}` and `Q_{m-2}` ([`tail_estimate`]);
+/// error estimate compares `Q_m` with `Q_{m-1}` and `Q_{m-2}` (a geometric tail);
 /// it costs `(m-1)^D + (m-2)^D` extra evaluations and can be switched off with
 /// `error_estimate: false`, in which case the error is reported as infinite.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

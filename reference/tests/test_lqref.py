@@ -1,0 +1,308 @@
+"""Tests of the Mitsuba 3 reference harness, each against an independent value:
+hand-computed hashes, lightquad's voxel-grid formula in float64 NumPy, and the
+closed forms of lightquad::exact::volume (restated here)."""
+
+import json
+import math
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lqref import fnv1a64, file_hash
+from lqref import mitsuba_scene as ms
+from lqref import quantities as qt
+from lqref import runner, spec
+from lqref.__main__ import main
+
+REPO = Path(__file__).resolve().parents[2]
+LIGHTQUAD = REPO / "target" / "release" / "lightquad"
+
+
+def write_experiment(tmp_path, name, scene, quantities, reference=None):
+    doc = {
+        "name": name,
+        "description": "test",
+        "equations": ["V-tau"],
+        "scene": scene,
+        "quantities": quantities,
+        "rules": [{"rule": "gauss-legendre"}],
+        "budgets": [4],
+        "reference": reference or {"type": "closed-form"},
+    }
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps(doc, indent=2))
+    return path
+
+
+def settings(passes=None, walks=None):
+    s = qt.Settings(quick=True)
+    if passes is not None:
+        s.passes = passes
+    if walks is not None:
+        s.walks = walks
+    return s
+
+
+# ---------------------------------------------------------------- hash
+
+
+def test_fnv1a64_known_values():
+    assert fnv1a64(b"") == "cbf29ce484222325"  # the offset basis itself
+    # b"a" by hand: one xor, one multiply, modulo 2^64.
+    by_hand = ((0xCBF29CE484222325 ^ 0x61) * 0x100000001B3) % 2 ** 64
+    assert fnv1a64(b"a") == f"{by_hand:016x}" == "af63dc4c8601ec8c"
+    assert fnv1a64(b"foobar") == "85944171f73967e8"  # published FNV-1a test vector
+
+
+@pytest.mark.skipif(not LIGHTQUAD.exists(), reason="lightquad not built (cargo build --release)")
+def test_file_hash_matches_lightquad():
+    path = REPO / "experiments" / "v-l-single-scattering.json"
+    out = subprocess.run([str(LIGHTQUAD), "check", str(path)], capture_output=True,
+                         text=True, check=True).stdout
+    assert f"hash {file_hash(path)}" in out
+
+
+# ---------------------------------------------------------------- voxel grid
+
+
+def lightquad_voxel_density(medium, p):
+    """src/volume/voxel_grid.rs in float64: values at voxel centres, [z][y][x],
+    trilinear, indices clamped, 0 outside the box."""
+    lo, hi = np.asarray(medium["min"], float), np.asarray(medium["max"], float)
+    n = np.asarray(medium["resolution"])
+    data = np.asarray(medium["data"], float).reshape(n[2], n[1], n[0])
+    u = (p - lo) / ((hi - lo) / n) - 0.5
+    f = np.floor(u)
+    w = u - f
+    lower = np.clip(f, 0, n - 1).astype(int)
+    upper = np.clip(f + 1, 0, n - 1).astype(int)
+    out = np.zeros(len(p))
+    for a in (0, 1):
+        for b in (0, 1):
+            for c in (0, 1):
+                ix = upper[:, 0] if a else lower[:, 0]
+                iy = upper[:, 1] if b else lower[:, 1]
+                iz = upper[:, 2] if c else lower[:, 2]
+                weight = ((w[:, 0] if a else 1 - w[:, 0]) * (w[:, 1] if b else 1 - w[:, 1])
+                          * (w[:, 2] if c else 1 - w[:, 2]))
+                out += weight * data[iz, iy, ix]
+    inside = np.all((p >= lo) & (p <= hi), axis=1)
+    return np.where(inside, out, 0.0)
+
+
+def box_chord(o, d, lo, hi):
+    """The slab method (no axis parallel to the ray here)."""
+    ta, tb = (np.asarray(lo) - o) / d, (np.asarray(hi) - o) / d
+    return max(np.minimum(ta, tb).max(), 0.0), np.maximum(ta, tb).min()
+
+
+def distinct_grid():
+    nx, ny, nz = 3, 4, 5
+    data = [1.0 + x + 10.0 * y + 100.0 * z + 0.25 * ((x * 7 + y * 3 + z) % 5)
+            for z in range(nz) for y in range(ny) for x in range(nx)]
+    return {"type": "voxel-grid", "min": [-1.0, 0.5, -2.0], "max": [2.0, 1.5, 0.5],
+            "resolution": [nx, ny, nz], "data": data}
+
+
+def test_grid_export_round_trip_at_voxel_centres():
+    mi, dr = ms.require_mitsuba()
+    grid = distinct_grid()
+    assert len(set(grid["data"])) == len(grid["data"])
+    vol = ms.gridvolume(grid)
+    nx, ny, nz = grid["resolution"]
+    lo, hi = np.array(grid["min"]), np.array(grid["max"])
+    it = dr.zeros(mi.Interaction3f)
+    for z in range(nz):
+        for y in range(ny):
+            for x in range(nx):
+                centre = lo + (np.array([x, y, z]) + 0.5) / np.array([nx, ny, nz]) * (hi - lo)
+                it.p = ms.point(centre)
+                expected = grid["data"][(z * ny + y) * nx + x]
+                assert vol.eval_1(it) == pytest.approx(expected, rel=2e-6), (x, y, z)
+
+
+def test_grid_export_matches_lightquad_trilinear_everywhere(tmp_path):
+    grid = distinct_grid()
+    path = write_experiment(tmp_path, "grid", {
+        "ray": {"origin": [-3.0, 1.0, 0.0], "direction": [1.0, 0.0, 0.0]},
+        "medium": grid, "lambda": 1.7}, ["tau"])
+    exp = spec.load(path)
+    _, medium = ms.build_scene(exp)
+    rng = np.random.default_rng(5)
+    lo, hi = np.array(grid["min"]), np.array(grid["max"])
+    pts = lo + rng.random((2000, 3)) * (hi - lo)  # includes the clamped half-voxel margins
+    pts = pts.astype(np.float32).astype(np.float64)  # the points Mitsuba sees
+    expected = 1.7 * lightquad_voxel_density(grid, pts)
+    assert np.allclose(ms.sigma_t_at(medium, pts), expected, rtol=2e-6, atol=0)
+
+
+def test_voxel_tau_ratio_tracking_and_ray_march(tmp_path):
+    grid = distinct_grid()
+    grid["data"] = [v / 1000.0 for v in grid["data"]]  # optical depth about 1
+    path = write_experiment(tmp_path, "voxel-tau", {
+        "ray": {"origin": [-2.0, 0.7, -1.9], "direction": [1.0, 0.1, 0.7]},
+        "medium": grid, "lambda": 1.5}, ["tau"], {"type": "converged", "n": 50})
+    exp = spec.load(path)
+    res = qt.tau_voxel_grid(exp, settings(walks=2 ** 13))
+    # Independent: lightquad's field in float64, fine midpoint rule on the chord.
+    o, d = np.array(exp.origin), np.array(exp.direction)
+    t_n, t_f = box_chord(o, d, grid["min"], grid["max"])
+    assert res["chord"] == pytest.approx([t_n, t_f], abs=1e-6)
+    n = 2 ** 20
+    ts = t_n + (np.arange(n) + 0.5) * (t_f - t_n) / n
+    depth = 1.5 * lightquad_voxel_density(grid, o + ts[:, None] * d).sum() * (t_f - t_n) / n
+    tau = math.exp(-depth)
+    assert 0.05 < tau < 0.9
+    assert abs(res["value"] - tau) <= 4 * res["std_error"]
+    assert abs(res["ray_march"]["value"] - tau) <= res["ray_march"]["error_estimate"] + 1e-6 * tau
+
+
+# ---------------------------------------------------------------- tau, constant sphere
+
+
+def sphere_chord(o, d, c, r):
+    """The closed-form chord of the unit-direction line o + t d through the sphere."""
+    o, d, c = (np.asarray(v, float) for v in (o, d, c))
+    d = d / np.linalg.norm(d)
+    tc = np.dot(c - o, d)
+    h2 = np.sum((o + tc * d - c) ** 2)
+    half = math.sqrt(max(r * r - h2, 0.0))
+    return max(tc - half, 0.0), tc + half
+
+
+@pytest.mark.parametrize("origin,direction,centre,radius,kappa,lam", [
+    ([-3.0, 0.4, 0.1], [1.0, 0.02, 0.0], [0.1, -0.05, 0.0], 1.2, 0.8, 1.25),
+    ([-3.0, 0.3, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0], 1.0, 2.620712, 1.0),
+    ([0.2, -0.1, 0.3], [0.3, 1.0, -0.2], [0.0, 0.0, 0.0], 1.0, 3.0, 0.5),  # origin inside
+    ([5.0, 5.0, 5.0], [-1.0, -1.0, -0.9], [0.0, 0.0, 0.0], 2.0, 0.01, 1.0),  # thin, long
+])
+def test_tau_constant_sphere_closed_form(tmp_path, origin, direction, centre, radius, kappa, lam):
+    path = write_experiment(tmp_path, "sphere", {
+        "ray": {"origin": origin, "direction": direction},
+        "medium": {"type": "constant-sphere", "centre": centre, "radius": radius,
+                   "kappa": kappa}, "lambda": lam}, ["tau"])
+    res = qt.tau_constant_sphere(spec.load(path))
+    t_n, t_f = sphere_chord(origin, direction, centre, radius)
+    depth = lam * kappa * (t_f - t_n)
+    exact = math.exp(-depth)
+    assert res["value"] == pytest.approx(exact, rel=2e-6 * (1 + depth))
+    assert abs(res["value"] - exact) <= res["float32_error"]
+
+
+def test_tau_stiff_sphere_log_value():
+    res = qt.tau_constant_sphere(spec.load(REPO / "experiments" / "v-tau-stiff-sphere.json"))
+    assert res["value"] == 0.0
+    assert res["log_value"] == pytest.approx(-1e5, rel=1e-6)
+
+
+def test_tau_ray_missing_the_sphere(tmp_path):
+    path = write_experiment(tmp_path, "miss", {
+        "ray": {"origin": [-3.0, 2.0, 0.0], "direction": [1.0, 0.0, 0.0]},
+        "medium": {"type": "constant-sphere", "centre": [0, 0, 0], "radius": 1.0,
+                   "kappa": 1.0}}, ["tau"])
+    assert qt.tau_constant_sphere(spec.load(path))["value"] == 1.0
+
+
+# ---------------------------------------------------------------- I_L, single scattering
+
+
+def light_behind(sigma, chord, intensity, albedo):
+    """lightquad::exact::volume::light_behind with an albedo."""
+    return intensity * albedo * sigma / (4 * math.pi) * (-math.expm1(-2 * sigma * chord)) / (2 * sigma)
+
+
+@pytest.mark.parametrize("kappa,passes", [(1.5, 192), (200.0, 192)])
+def test_single_scattering_light_behind_closed_form(tmp_path, kappa, passes):
+    """The light straight behind the eye. kappa = 200 would be ~1.8 % low (many
+    standard errors) if the camera ray were re-spawned at the boundary or the
+    radiancemeter's ray-epsilon offset were left in."""
+    origin, direction = [-3.0, 0.2, 0.0], [1.0, 0.0, 0.0]
+    path = write_experiment(tmp_path, "ss", {
+        "ray": {"origin": origin, "direction": direction},
+        "medium": {"type": "constant-sphere", "centre": [0, 0, 0], "radius": 1.0,
+                   "kappa": kappa},
+        "light": {"toward_light": [-1.0, 0.0, 0.0], "intensity": 2.0, "albedo": 0.8}},
+        ["I_L"])
+    res = qt.light_single_scattering(spec.load(path), settings(passes=passes))
+    t_n, t_f = sphere_chord(origin, direction, [0, 0, 0], 1.0)
+    exact = light_behind(kappa, t_f - t_n, 2.0, 0.8)
+    float32_floor = 1e-5 * exact
+    assert abs(res["value"] - exact) <= 4 * res["std_error"] + float32_floor, \
+        (res["value"], exact, res["std_error"])
+    assert res["std_error"] < 0.01 * exact
+
+
+# ---------------------------------------------------------------- files, errors
+
+
+def test_stale_hash_detection(tmp_path):
+    src = REPO / "reference" / "experiments" / "mitsuba-tau-constant-sphere.json"
+    path = tmp_path / "exp.json"
+    shutil.copy(src, path)
+    out = tmp_path / "values"
+    rec = runner.compute(path, settings(), out, log=lambda *a: None)
+    assert rec["experiment_hash"] == file_hash(path)
+    assert [s for s, *_ in runner.check([path], out)] == ["ok"]
+    assert main(["--check", str(path), "--out", str(out)]) == 0
+
+    path.write_bytes(path.read_bytes().replace(b'"kappa": 0.8', b'"kappa": 0.81'))
+    assert [s for s, *_ in runner.check([path], out)] == ["stale"]
+    assert main(["--check", str(path), "--out", str(out)]) == 1
+
+    (out / "mitsuba-tau-constant-sphere.json").unlink()
+    assert [s for s, *_ in runner.check([path], out)] == ["missing"]
+
+
+def test_values_file_layout_and_unsupported(tmp_path):
+    path = write_experiment(tmp_path, "mixed", {
+        "ray": {"origin": [-3.0, 0.3, 0.0], "direction": [1.0, 0.0, 0.0]},
+        "medium": {"type": "constant-sphere", "centre": [0, 0, 0], "radius": 1.0,
+                   "kappa": 2.0},
+        "emission": {"type": "constant", "c": 1.0}, "background": 0.5},
+        ["tau", "I_E", "I_B", "I"])
+    rec = runner.compute(path, settings(), tmp_path / "v", log=lambda *a: None)
+    on_disk = json.loads((tmp_path / "v" / "mixed.json").read_text())
+    assert on_disk == rec
+    for key in ("mitsuba_variant", "mitsuba_version", "run_seconds", "experiment_hash"):
+        assert key in rec
+    assert rec["mitsuba_variant"] == "scalar_rgb"
+    assert set(rec["quantities"]) == {"tau"}
+    assert {"value", "std_error", "samples", "method"} <= set(rec["quantities"]["tau"])
+    assert set(rec["unsupported"]) == {"I_E", "I_B", "I"}
+    assert "emission" in rec["unsupported"]["I_E"]
+
+
+def test_inexpressible_scene_elements_are_named(tmp_path):
+    blobs = write_experiment(tmp_path, "blobs", {
+        "ray": {"origin": [-3.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0]},
+        "medium": {"type": "gaussian-blobs",
+                   "blobs": [{"centre": [0, 0, 0], "amplitude": 1.0, "width": 0.5}]}},
+        ["tau"])
+    with pytest.raises(spec.SpecError, match="scene.medium.type"):
+        runner.compute(blobs, settings(), tmp_path / "v", log=lambda *a: None)
+    reduced = write_experiment(tmp_path, "reduced", {
+        "ray": {"origin": [-3.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0]},
+        "medium": {"type": "constant-sphere", "centre": [0, 0, 0], "radius": 1.0,
+                   "kappa": 1.0},
+        "light": {"toward_light": [-1.0, 0.0, 0.0], "intensity": 1.0}}, ["I_L"])
+    with pytest.raises(spec.SpecError, match="scene.light.albedo"):
+        runner.compute(reduced, settings(), tmp_path / "v", log=lambda *a: None)
+    assert main([str(blobs), "--out", str(tmp_path / "v")]) == 2
+
+
+def test_missing_mitsuba_message(monkeypatch):
+    import builtins
+    real_import = builtins.__import__
+
+    def no_mitsuba(name, *args, **kwargs):
+        if name in ("mitsuba", "drjit"):
+            raise ImportError(f"No module named '{name}'")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(ms, "_MI", None)
+    monkeypatch.setattr(builtins, "__import__", no_mitsuba)
+    with pytest.raises(ms.MitsubaMissing, match=r"pip install -r reference/requirements.txt"):
+        ms.require_mitsuba()
