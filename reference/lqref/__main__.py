@@ -34,8 +34,13 @@ def main(argv=None):
     if not args.files:
         ap.error("give one or more experiment files (or --check)")
 
-    from .mitsuba_scene import MitsubaMissing, require_mitsuba
-    from .quantities import Settings
+    try:
+        from .mitsuba_scene import MitsubaMissing, require_mitsuba
+        from .quantities import Settings
+    except ImportError as e:  # numpy, before Mitsuba is even tried
+        print(f"error: {e} (Python {sys.executable}).\nInstall the pinned versions with:\n"
+              "    pip install -r reference/requirements.txt", file=sys.stderr)
+        return 3
     try:
         require_mitsuba()
     except MitsubaMissing as e:
@@ -46,11 +51,11 @@ def main(argv=None):
     failed = 0
     t0 = time.perf_counter()
     for path in args.files:
-        print(f"{path}:")
+        print(f"{path}:", flush=True)
         try:
             rec = compute(path, settings, args.out)
         except SpecError as e:
-            print(f"error: {path}: {e}", file=sys.stderr)
+            print(f"error: {path}: {e}", file=sys.stderr, flush=True)
             failed += 1
             continue
         print(f"  -> {args.out}/{rec['experiment']}.json ({rec['run_seconds']:.1f} s)")

@@ -36,7 +36,11 @@ def unsupported_reason(exp, quantity):
     return None
 
 
-def compute(path, settings, out_dir=DEFAULT_OUT, log=print):
+def _log(message):
+    print(message, flush=True)
+
+
+def compute(path, settings, out_dir=DEFAULT_OUT, log=_log):
     """Computes the supported quantities of the experiment at ``path`` and
     writes ``out_dir/<name>.json``; returns the record. Raises SpecError for a
     scene element Mitsuba cannot express."""

@@ -80,9 +80,8 @@ def load(path) -> Experiment:
     origin = _vec3(scene["ray"].get("origin"), "scene.ray.origin")
     direction = _unit(_vec3(scene["ray"].get("direction"), "scene.ray.direction"),
                       "scene.ray.direction")
-    t_min = float(scene.get("t_min", 0.0) if scene.get("t_min") is not None else 0.0)
-    t_max = scene.get("t_max")
-    t_max = math.inf if t_max is None else float(t_max)
+    t_min = 0.0 if scene.get("t_min") is None else float(scene["t_min"])
+    t_max = math.inf if scene.get("t_max") is None else float(scene["t_max"])
 
     medium = scene.get("medium")
     if medium is not None and medium.get("type") not in MEDIUM_TYPES:
