@@ -1,0 +1,107 @@
+//! lightquad against Mitsuba 3: the values the harness in reference/ wrote
+//! (reference/values/*.json, or the folder named by LIGHTQUAD_REFERENCE_VALUES,
+//! which CI points at a quick regeneration) must match lightquad's converged
+//! values within 4 standard errors plus a float32 floor, and must have been made
+//! from the experiment file as it is now (a stale hash fails the test).
+
+use std::path::{Path, PathBuf};
+
+use lightquad::experiment::load;
+use lightquad::experiment::spec::Quantity;
+use lightquad::quadrature::GaussLegendre;
+use lightquad::volume::{DepthScheme, ShadowMethod, evaluate};
+use rand::SeedableRng;
+use serde_json::Value;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn values_dir() -> PathBuf {
+    std::env::var_os("LIGHTQUAD_REFERENCE_VALUES")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("reference/values"))
+}
+
+/// lightquad's converged value (Gauss–Legendre, 400 nodes per graded piece)
+/// and `ln tau` for V-tau, which stays exact where tau underflows.
+fn lightquad_value(file: &Path, q: Quantity) -> (f64, f64) {
+    let (exp, _) = load(file).unwrap_or_else(|e| panic!("{e}"));
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+    let rule = GaussLegendre { error_estimate: false };
+    let res = evaluate(
+        &exp.scene,
+        &rule,
+        400,
+        DepthScheme::Cumulative,
+        ShadowMethod::ClosedFormWhereAvailable,
+        &mut rng,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    match q {
+        Quantity::Tau => (res.transmittance, res.log_transmittance),
+        Quantity::Light => (res.light.map_or(0.0, |t| t.value), f64::NAN),
+        Quantity::Emission => (res.emission.map_or(0.0, |t| t.value), f64::NAN),
+        Quantity::Background => (res.background.map_or(0.0, |t| t.value), f64::NAN),
+        Quantity::Total => (res.total, f64::NAN),
+    }
+}
+
+fn quantity(name: &str) -> Quantity {
+    match name {
+        "tau" => Quantity::Tau,
+        "I_E" => Quantity::Emission,
+        "I_B" => Quantity::Background,
+        "I_L" => Quantity::Light,
+        _ => Quantity::Total,
+    }
+}
+
+#[test]
+fn lightquad_agrees_with_mitsuba_within_four_standard_errors() {
+    let dir = values_dir();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    files.sort();
+    let mut compared = 0;
+    let mut kinds = std::collections::BTreeSet::new();
+    for path in files {
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).expect("read"))
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let experiment = root().join(v["experiment_file"].as_str().expect("experiment_file"));
+        let (_, hash) = load(&experiment).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            v["experiment_hash"].as_str(),
+            Some(hash.as_str()),
+            "{} is stale: regenerate it with scripts/reference.sh",
+            path.display()
+        );
+        for (name, entry) in v["quantities"].as_object().expect("quantities") {
+            let q = quantity(name);
+            let (lq, lq_log) = lightquad_value(&experiment, q);
+            let mi = entry["value"].as_f64().expect("value");
+            let se = entry["std_error"].as_f64().expect("std_error");
+            // float32 renderer: at least 1e-6 relative, or the harness's own bound.
+            let floor = entry["float32_error"].as_f64().unwrap_or(0.0).max(1e-6 * mi.abs());
+            let diff = (lq - mi).abs();
+            eprintln!(
+                "{} {name}: lightquad {lq:.10e}, Mitsuba {mi:.10e} +- {se:.1e} ({:.2} SE)",
+                v["experiment"].as_str().unwrap_or("?"),
+                if se > 0.0 { (lq - mi) / se } else { 0.0 }
+            );
+            assert!(diff <= 4.0 * se + floor, "{}: {name} differs by {diff:e}", path.display());
+            // Where tau underflows, compare the logarithms.
+            if let Some(log) = entry["log_value"].as_f64() {
+                assert!((lq_log - log).abs() <= 1e-6 * log.abs().max(1.0), "ln tau {lq_log} vs {log}");
+            }
+            compared += 1;
+            kinds.insert(name.clone());
+        }
+    }
+    assert!(compared >= 2, "only {compared} values compared");
+    assert!(kinds.contains("tau") && kinds.contains("I_L"), "{kinds:?}");
+}
