@@ -239,7 +239,7 @@ def test_single_scattering_light_behind_closed_form(tmp_path, kappa, passes):
 
 
 def test_stale_hash_detection(tmp_path):
-    src = REPO / "reference" / "experiments" / "mitsuba-tau-constant-sphere.json"
+    src = REPO / "experiments" / "mitsuba-tau-constant-sphere.json"
     path = tmp_path / "exp.json"
     shutil.copy(src, path)
     out = tmp_path / "values"
