@@ -28,7 +28,9 @@ fn values_dir() -> PathBuf {
 fn lightquad_value(file: &Path, q: Quantity) -> (f64, f64) {
     let (exp, _) = load(file).unwrap_or_else(|e| panic!("{e}"));
     let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
-    let rule = GaussLegendre { error_estimate: false };
+    let rule = GaussLegendre {
+        error_estimate: false,
+    };
     let res = evaluate(
         &exp.scene,
         &rule,
@@ -86,17 +88,27 @@ fn lightquad_agrees_with_mitsuba_within_four_standard_errors() {
             let mi = entry["value"].as_f64().expect("value");
             let se = entry["std_error"].as_f64().expect("std_error");
             // float32 renderer: at least 1e-6 relative, or the harness's own bound.
-            let floor = entry["float32_error"].as_f64().unwrap_or(0.0).max(1e-6 * mi.abs());
+            let floor = entry["float32_error"]
+                .as_f64()
+                .unwrap_or(0.0)
+                .max(1e-6 * mi.abs());
             let diff = (lq - mi).abs();
             eprintln!(
                 "{} {name}: lightquad {lq:.10e}, Mitsuba {mi:.10e} +- {se:.1e} ({:.2} SE)",
                 v["experiment"].as_str().unwrap_or("?"),
                 if se > 0.0 { (lq - mi) / se } else { 0.0 }
             );
-            assert!(diff <= 4.0 * se + floor, "{}: {name} differs by {diff:e}", path.display());
+            assert!(
+                diff <= 4.0 * se + floor,
+                "{}: {name} differs by {diff:e}",
+                path.display()
+            );
             // Where tau underflows, compare the logarithms.
             if let Some(log) = entry["log_value"].as_f64() {
-                assert!((lq_log - log).abs() <= 1e-6 * log.abs().max(1.0), "ln tau {lq_log} vs {log}");
+                assert!(
+                    (lq_log - log).abs() <= 1e-6 * log.abs().max(1.0),
+                    "ln tau {lq_log} vs {log}"
+                );
             }
             compared += 1;
             kinds.insert(name.clone());

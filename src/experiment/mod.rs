@@ -98,7 +98,10 @@ pub fn reference(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String) {
         ),
         spec::ReferenceSpec::Mitsuba { file } => (
             exp.reference.clone(),
-            format!("Mitsuba 3 values from `{file}`, largest standard error {:.1e} (float32 renderer: ~1e-6 relative floor).", exp.uncertainty),
+            format!(
+                "Mitsuba 3 values from `{file}`, largest standard error {:.1e} (float32 renderer: ~1e-6 relative floor).",
+                exp.uncertainty
+            ),
         ),
         spec::ReferenceSpec::Value { uncertainty, .. } => (
             exp.reference.clone(),
@@ -153,6 +156,112 @@ pub fn reference(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String) {
     }
 }
 
+/// One row of the "lightquad vs Mitsuba vs closed form" comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Crosscheck {
+    /// Experiment name.
+    pub experiment: String,
+    /// The quantity.
+    pub quantity: Quantity,
+    /// lightquad's converged value (Gauss–Legendre, 400 nodes per graded piece).
+    pub lightquad: f64,
+    /// Mitsuba's value and standard error, when it has one.
+    pub mitsuba: Option<(f64, f64)>,
+    /// The closed form, where `exact` has one.
+    pub closed_form: Option<f64>,
+    /// Why Mitsuba has no value, or that its file is stale.
+    pub note: String,
+}
+
+/// The comparison rows of an experiment that has a Mitsuba values file in
+/// `reference/values/<name>.json` (relative to the working folder); none otherwise.
+pub fn crosscheck(exp: &Experiment, hash: &str) -> Vec<Crosscheck> {
+    let path = Path::new("reference/values").join(format!("{}.json", exp.spec.name));
+    let Ok(text) = fs::read_to_string(&path) else {
+        return Vec::new();
+    };
+    let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Vec::new();
+    };
+    let stale = json["experiment_hash"].as_str() != Some(hash);
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+    let rule = GaussLegendre {
+        error_estimate: false,
+    };
+    let mut job = JobResult::empty();
+    if let Ok(res) = evaluate(
+        &exp.scene,
+        &rule,
+        400,
+        crate::volume::DepthScheme::Cumulative,
+        crate::volume::ShadowMethod::ClosedFormWhereAvailable,
+        &mut rng,
+    ) {
+        run::collect_into(&res, &exp.spec.quantities, &mut job);
+    }
+    exp.spec
+        .quantities
+        .iter()
+        .map(|q| {
+            let entry = &json["quantities"][q.name()];
+            let mitsuba = match (entry["value"].as_f64(), entry["std_error"].as_f64()) {
+                (Some(v), Some(se)) if !stale => Some((v, se)),
+                _ => None,
+            };
+            let note = if stale {
+                "values file is stale (experiment changed): regenerate with scripts/reference.sh"
+                    .into()
+            } else {
+                json["unsupported"][q.name()]
+                    .as_str()
+                    .unwrap_or("")
+                    .to_string()
+            };
+            Crosscheck {
+                experiment: exp.spec.name.clone(),
+                quantity: *q,
+                lightquad: job.values.get(q).copied().unwrap_or(f64::NAN),
+                mitsuba,
+                closed_form: validate::closed_form(&exp.spec, &exp.scene, *q),
+                note,
+            }
+        })
+        .collect()
+}
+
+/// The comparison as a Markdown table.
+pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
+    let mut md = String::from(
+        "| experiment | quantity | lightquad (GL, 400 nodes per piece) | Mitsuba 3 +- std. error | closed form | lightquad - Mitsuba |\n\
+         |---|---|---:|---:|---:|---|\n",
+    );
+    for r in rows {
+        let mitsuba = r.mitsuba.map_or(format!("— {}", r.note), |(v, se)| {
+            format!("{v:.10e} +- {se:.1e}")
+        });
+        let closed = r.closed_form.map_or("—".into(), |c| format!("{c:.10e}"));
+        let agreement = match r.mitsuba {
+            Some((v, se)) if se > 0.0 => format!("{:+.2} SE", (r.lightquad - v) / se),
+            Some((v, _)) => format!(
+                "{:+.1e} relative (deterministic, float32)",
+                if v != 0.0 {
+                    (r.lightquad - v) / v
+                } else {
+                    r.lightquad - v
+                }
+            ),
+            None => "—".into(),
+        };
+        md.push_str(&format!(
+            "| {} | {} | {:.10e} | {mitsuba} | {closed} | {agreement} |\n",
+            r.experiment,
+            r.quantity.name(),
+            r.lightquad
+        ));
+    }
+    md
+}
+
 /// Runs experiment files and writes their reports under `opts.out`.
 /// Every file is validated and the output folder checked before any job runs,
 /// so a bad input leaves nothing behind.
@@ -191,6 +300,7 @@ pub fn run_files(files: &[PathBuf], opts: &RunOptions) -> Result<PathBuf, RunErr
         indicatif::ProgressBar::hidden()
     };
     let mut entries = Vec::new();
+    let mut checks = Vec::new();
     for (exp, hash, file) in &loaded {
         let dir = opts.out.join(&exp.spec.name);
         fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
@@ -200,14 +310,27 @@ pub fn run_files(files: &[PathBuf], opts: &RunOptions) -> Result<PathBuf, RunErr
         let results = run_experiment(exp, hash, opts, &bar).map_err(|e| io(&dir, e))?;
         if opts.shard.is_none() {
             let (values, note) = reference(exp);
-            let summary = report::write_experiment(&dir, exp, &results, &values, &note)
+            let rows = crosscheck(exp, hash);
+            let extra = if rows.is_empty() {
+                String::new()
+            } else {
+                crosscheck_markdown(&rows)
+            };
+            let summary = report::write_experiment(&dir, exp, &results, &values, &note, &extra)
                 .map_err(|e| io(&dir, e))?;
             entries.push((exp.spec.name.clone(), exp.spec.description.clone(), summary));
+            checks.extend(rows);
         }
     }
     bar.finish_and_clear();
     if opts.shard.is_none() {
-        report::write_index(&opts.out, &entries).map_err(|e| io(&opts.out, e))?;
+        report::write_index(
+            &opts.out,
+            &entries,
+            &crosscheck_markdown(&checks),
+            checks.is_empty(),
+        )
+        .map_err(|e| io(&opts.out, e))?;
     }
     Ok(opts.out.join("index.md"))
 }
@@ -249,7 +372,8 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
     }
     fs::create_dir_all(out).map_err(|e| io(out, e))?;
     let mut entries = Vec::new();
-    for (name, (exp, _, mut results)) in by_experiment {
+    let mut checks = Vec::new();
+    for (name, (exp, hash, mut results)) in by_experiment {
         results.sort_by_key(JobResult::key);
         results.dedup_by_key(|r| r.key());
         let dir = out.join(&name);
@@ -261,11 +385,24 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
         }
         write_atomic(&dir.join("results.jsonl"), text.as_bytes()).map_err(|e| io(&dir, e))?;
         let (values, note) = reference(&exp);
-        let summary = report::write_experiment(&dir, &exp, &results, &values, &note)
+        let rows = crosscheck(&exp, &hash);
+        let extra = if rows.is_empty() {
+            String::new()
+        } else {
+            crosscheck_markdown(&rows)
+        };
+        let summary = report::write_experiment(&dir, &exp, &results, &values, &note, &extra)
             .map_err(|e| io(&dir, e))?;
         entries.push((name, exp.spec.description.clone(), summary));
+        checks.extend(rows);
     }
-    report::write_index(out, &entries).map_err(|e| io(out, e))?;
+    report::write_index(
+        out,
+        &entries,
+        &crosscheck_markdown(&checks),
+        checks.is_empty(),
+    )
+    .map_err(|e| io(out, e))?;
     Ok(out.join("index.md"))
 }
 

@@ -247,6 +247,7 @@ pub fn write_experiment(
     results: &[JobResult],
     reference: &BTreeMap<Quantity, f64>,
     reference_note: &str,
+    crosscheck: &str,
 ) -> Result<Summary, String> {
     let spec = &exp.spec;
     let mut md = String::new();
@@ -362,6 +363,12 @@ pub fn write_experiment(
             "\n![error against time]({base}-time.svg)\n![error against evaluations]({base}-n.svg)\n"
         );
     }
+    if !crosscheck.is_empty() {
+        let _ = writeln!(
+            md,
+            "## lightquad vs Mitsuba 3 vs closed form\n\n{crosscheck}"
+        );
+    }
     let _ = writeln!(
         md,
         "Flags: `non-finite value`; `outside 4 standard errors` (a random estimate whose standard \
@@ -401,7 +408,12 @@ pub fn write_experiment(
 
 /// Writes the index page: every experiment, and the rules ranked by time to
 /// the middle target error per quantity.
-pub fn write_index(out: &Path, entries: &[(String, String, Summary)]) -> Result<(), String> {
+pub fn write_index(
+    out: &Path,
+    entries: &[(String, String, Summary)],
+    crosscheck: &str,
+    no_crosscheck: bool,
+) -> Result<(), String> {
     let mut md = String::from(
         "# lightquad report\n\nEvery experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (1e-6 unless the experiment says otherwise); `not reached` means no budget got there.\n\n",
     );
@@ -425,6 +437,15 @@ pub fn write_index(out: &Path, entries: &[(String, String, Summary)]) -> Result<
             let _ = writeln!(md, "- {}: {}", q.name(), list.join(", "));
         }
         md.push('\n');
+    }
+    if !no_crosscheck {
+        let _ = writeln!(
+            md,
+            "## lightquad vs Mitsuba 3 vs closed form\n\nEvery case the Mitsuba harness (reference/) covers: \
+             lightquad's converged value, Mitsuba's value with its standard error (float32 renderer: \
+             expect ~1e-6 relative at best), the closed form where one exists. Mitsuba media have no \
+             volumetric emission, so V-E (and V-I with emission) has no Mitsuba counterpart.\n\n{crosscheck}"
+        );
     }
     write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())
 }

@@ -492,8 +492,12 @@ pub fn mitsuba_reference(
     quantities: &[Quantity],
 ) -> Result<(BTreeMap<Quantity, f64>, f64, String), SpecError> {
     let at = "reference.file";
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SpecError::at(at, format!("{path}: {e} (run scripts/reference.sh to generate it)")))?;
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        SpecError::at(
+            at,
+            format!("{path}: {e} (run scripts/reference.sh to generate it)"),
+        )
+    })?;
     let json: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| SpecError::at(at, format!("{path}: {e}")))?;
     let file_hash = json["experiment_hash"].as_str().unwrap_or("");
@@ -513,7 +517,10 @@ pub fn mitsuba_reference(
         let (Some(v), Some(se)) = (entry["value"].as_f64(), entry["std_error"].as_f64()) else {
             return Err(SpecError::at(
                 at,
-                format!("{path} has no value for quantity {} (Mitsuba cannot compute it here?)", q.name()),
+                format!(
+                    "{path} has no value for quantity {} (Mitsuba cannot compute it here?)",
+                    q.name()
+                ),
             ));
         };
         values.insert(*q, v);
