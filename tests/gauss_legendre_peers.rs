@@ -17,6 +17,19 @@ fn max_diff(x: &[f64], w: &[f64], xr: &[f64], wr: &[f64]) -> (f64, f64) {
         })
 }
 
+/// bilby's n-point rule, ascending.
+fn bilby_rule(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let bil = bilby::GaussLegendre::new(n).expect("n > 0");
+    let rule = bil.rule();
+    ascending(
+        rule.nodes
+            .iter()
+            .copied()
+            .zip(rule.weights.iter().copied())
+            .collect(),
+    )
+}
+
 /// A peer's rule sorted ascending (gauss-quad lists nodes descending).
 fn ascending(mut pairs: Vec<(f64, f64)>) -> (Vec<f64>, Vec<f64>) {
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -29,15 +42,7 @@ fn the_two_term_regime_agrees_with_bilby() {
     // so every node of n = 5000 and 20000 is held against bilby's.
     for n in [5000usize, 20_000] {
         let ours = table(n).expect("valid n");
-        let bil = bilby::GaussLegendre::new(n).expect("n > 0");
-        let (bx, bw) = ascending(
-            bil.rule()
-                .nodes
-                .iter()
-                .copied()
-                .zip(bil.rule().weights.iter().copied())
-                .collect(),
-        );
+        let (bx, bw) = bilby_rule(n);
         let (dx, dw) = max_diff(&ours.x, &ours.w, &bx, &bw);
         assert!(dx <= 4.0 && dw <= 6.0, "n={n}: {dx} eps, {dw} eps");
     }
@@ -53,15 +58,7 @@ fn agrees_with_bilby_and_gauss_quad_and_is_at_least_as_accurate() {
             continue;
         }
         let ours = table(n).expect("valid n");
-        let bil = bilby::GaussLegendre::new(n).expect("n > 0");
-        let (bx, bw) = ascending(
-            bil.rule()
-                .nodes
-                .iter()
-                .copied()
-                .zip(bil.rule().weights.iter().copied())
-                .collect(),
-        );
+        let (bx, bw) = bilby_rule(n);
         let gq = gauss_quad::GaussLegendre::new(std::num::NonZeroUsize::new(n).expect("n > 0"));
         let (gx, gw) = ascending(gq.iter().map(|(x, w)| (*x, *w)).collect());
 

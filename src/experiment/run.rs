@@ -224,16 +224,9 @@ pub fn run_job(
         budget,
         repeat,
         seed,
-        values: BTreeMap::new(),
-        estimated_errors: BTreeMap::new(),
-        evaluations: BTreeMap::new(),
-        magnitudes: BTreeMap::new(),
-        seconds: 0.0,
-        failure: None,
-        underflow: false,
-        version: env!("CARGO_PKG_VERSION").to_string(),
         git_commit: Some(env!("LIGHTQUAD_GIT_COMMIT").to_string()).filter(|c| !c.is_empty()),
         machine: machine(),
+        ..JobResult::empty()
     };
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let scheme = match spec.depth_scheme {
