@@ -124,7 +124,7 @@ pub fn markdown(rows: &[Row]) -> String {
                 r.seconds
             ));
         }
-        out.push_str("\n| rule | fitted order (error vs evaluations) |\n|---|---:|\n");
+        out.push_str("\n| rule | fitted slope of log error vs log evaluations (order p shows as -p) |\n|---|---:|\n");
         for (name, _) in RULES {
             let pts: Vec<(f64, f64)> = rows
                 .iter()

@@ -300,7 +300,7 @@ pub fn write_experiment(
         }
         let _ = writeln!(
             md,
-            "\n| rule | fitted order (error vs evaluations) | {} |",
+            "\n| rule | fitted slope of log error vs log evaluations (order p shows as -p) | {} |",
             spec.targets
                 .iter()
                 .map(|t| format!("time to {t:.0e} (s)"))
