@@ -75,13 +75,11 @@ impl Segment {
         &self.breaks
     }
 
-    /// The smooth pieces `[t_i, t_{i+1}]` between break points.
+    /// The smooth pieces `[t_i, t_{i+1}]` between break points (no allocation).
     pub fn pieces(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
-        let knots: Vec<f64> = std::iter::once(self.a)
-            .chain(self.breaks.iter().copied())
-            .chain(std::iter::once(self.b))
-            .collect();
-        (0..knots.len() - 1).map(move |i| (knots[i], knots[i + 1]))
+        let starts = std::iter::once(self.a).chain(self.breaks.iter().copied());
+        let ends = self.breaks.iter().copied().chain(std::iter::once(self.b));
+        starts.zip(ends)
     }
 
     /// `int_a^b g(t) dt` as the sum over the smooth pieces, `n` evaluations

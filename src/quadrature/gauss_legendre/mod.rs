@@ -181,6 +181,40 @@ pub fn table(n: usize) -> Result<Table, QuadError> {
 /// four digits); near-singular integrands at a segment's start need that.
 pub fn unit_nodes(n: usize) -> Result<Arc<UnitNodes>, QuadError> {
     check_order(n)?;
+    // A few recent rules per thread in front of the shared cache, so inner
+    // loops (nested optical depths, error estimates) do not contend for its lock.
+    thread_local! {
+        static RECENT: std::cell::RefCell<Vec<(usize, Arc<UnitNodes>)>> =
+            const { std::cell::RefCell::new(Vec::new()) };
+    }
+    const RECENT_RULES: usize = 8;
+    /// Only small rules are kept per thread (large ones stay in the shared
+    /// cache alone, whose size is bounded).
+    const RECENT_MAX_ORDER: usize = 4096;
+    if n > RECENT_MAX_ORDER {
+        return shared_unit_nodes(n);
+    }
+    if let Some(hit) = RECENT.with(|r| {
+        r.borrow()
+            .iter()
+            .find(|(m, _)| *m == n)
+            .map(|(_, nodes)| nodes.clone())
+    }) {
+        return Ok(hit);
+    }
+    let nodes = shared_unit_nodes(n)?;
+    RECENT.with(|r| {
+        let mut r = r.borrow_mut();
+        if r.len() == RECENT_RULES {
+            r.remove(0);
+        }
+        r.push((n, nodes.clone()));
+    });
+    Ok(nodes)
+}
+
+/// The process-wide cache behind [`unit_nodes`].
+fn shared_unit_nodes(n: usize) -> Result<Arc<UnitNodes>, QuadError> {
     static CACHE: OnceLock<Mutex<HashMap<usize, Arc<UnitNodes>>>> = OnceLock::new();
     /// Total nodes kept in the cache before it is emptied (~0.5 GB).
     const CACHE_NODES: usize = 1 << 25;
