@@ -65,7 +65,10 @@ pub struct Term {
     pub id: &'static str,
     /// The value.
     pub value: f64,
-    /// The rule's error estimate.
+    /// The outer rule's error estimate. For V-E and V-L it does not include
+    /// the error of the inner optical depths (exact to quadrature accuracy in
+    /// the cumulative scheme; for a Monte Carlo rule in the nested scheme the
+    /// noisy inner depth also biases `exp(-depth)` slightly, by Jensen).
     pub error: f64,
     /// Density evaluations spent on this term.
     pub evaluations: u64,
