@@ -403,3 +403,138 @@ fn cancellation_in_the_total_is_flagged() {
         "{table:?}"
     );
 }
+
+/// Runs the binary, killing it after `secs` (a regression must not hang CI).
+fn run_with_timeout(args: &[&str], secs: u64) -> Output {
+    let mut child = bin()
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawns");
+    let start = Instant::now();
+    loop {
+        if child.try_wait().expect("waits").is_some() {
+            break;
+        }
+        if start.elapsed() > Duration::from_secs(secs) {
+            let _ = child.kill();
+            panic!("lightquad {args:?} ran past {secs} s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("output")
+}
+
+#[test]
+fn regressions_from_the_runner_review() {
+    let dir = scratch("review");
+    let path = |name: &str, text: &str| {
+        let p = dir.join(name);
+        fs::write(&p, text).expect("write");
+        p.display().to_string()
+    };
+    // A value near f64::MAX once hung the plot's axis code forever.
+    let huge = path(
+        "huge.json",
+        &VALID
+            .replace("\"c\": 1.0", "\"c\": 1e308")
+            .replace("[4, 16, 64]", "[4]"),
+    );
+    let out = dir.join("huge-out").display().to_string();
+    let o = run_with_timeout(&["run", &huge, "--out", &out], 60);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // A budget factor near 1 once looped without end in validation.
+    let slow = path(
+        "factor.json",
+        &VALID.replace(
+            "[4, 16, 64]",
+            "{ \"from\": 1, \"to\": 100000000, \"factor\": 1.0000000001 }",
+        ),
+    );
+    let o = run_with_timeout(&["check", &slow], 20);
+    assert!(
+        !o.status.success() && stderr(&o).contains("at `budgets.factor`"),
+        "{}",
+        stderr(&o)
+    );
+
+    // Jobs that fail are reported and make the run fail (they once vanished):
+    // lambda kappa = 1e600 overflows the extinction, so every job fails.
+    let failing = path(
+        "failing.json",
+        &VALID
+            .replace("\"kappa\": 2.0", "\"kappa\": 1e300")
+            .replace("\"ray\": {", "\"lambda\": 1e300, \"ray\": {")
+            .replace(
+                "{ \"type\": \"closed-form\" }",
+                "{ \"type\": \"value\", \"values\": { \"tau\": 0.0, \"I_E\": 0.0 } }",
+            ),
+    );
+    let out = dir.join("failing-out");
+    let o = run_with_timeout(&["run", &failing, "--out", &out.display().to_string()], 60);
+    assert!(
+        !o.status.success() && stderr(&o).contains("jobs failed"),
+        "{}",
+        stderr(&o)
+    );
+    let report = fs::read_to_string(out.join("t").join("report.md")).expect("report written");
+    assert!(
+        report.contains("failed:"),
+        "the failure reasons are in the report"
+    );
+
+    // Shards sharing one output folder, run at the same time, all succeed and
+    // merge into the whole.
+    let base = path("base.json", VALID);
+    let shared = dir.join("shared").display().to_string();
+    let children: Vec<_> = (1..=4)
+        .map(|k| {
+            bin()
+                .args([
+                    "run",
+                    "--threads",
+                    "1",
+                    "--shard",
+                    &format!("{k}/4"),
+                    "--out",
+                    &shared,
+                    &base,
+                ])
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .expect("spawns")
+        })
+        .collect();
+    for c in children {
+        let o = c.wait_with_output().expect("waits");
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let merged = dir.join("merged").display().to_string();
+    let o = run_with_timeout(&["merge", "--out", &merged, &shared], 60);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // One shard alone is an incomplete merge, and says so.
+    let lone = dir.join("lone").display().to_string();
+    assert!(
+        run_with_timeout(&["run", "--shard", "1/3", "--out", &lone, &base], 60)
+            .status
+            .success()
+    );
+    let o = run_with_timeout(
+        &[
+            "merge",
+            "--out",
+            &dir.join("m2").display().to_string(),
+            &lone,
+        ],
+        60,
+    );
+    assert!(
+        !o.status.success() && stderr(&o).contains("incomplete"),
+        "{}",
+        stderr(&o)
+    );
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -40,6 +40,16 @@ pub enum RunError {
         /// The fault.
         source: SpecError,
     },
+    /// Jobs failed (their reasons are in the report); the report was written.
+    #[error("{failed} of {total} jobs failed (reasons in the report: {index})")]
+    Failed {
+        /// Failed jobs.
+        failed: usize,
+        /// All jobs.
+        total: usize,
+        /// The report's index page.
+        index: String,
+    },
     /// A file or folder that cannot be read or written.
     #[error("{path}: {message}")]
     Io {
@@ -266,12 +276,15 @@ pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
 /// Every file is validated and the output folder checked before any job runs,
 /// so a bad input leaves nothing behind.
 pub fn run_files(files: &[PathBuf], opts: &RunOptions) -> Result<PathBuf, RunError> {
-    let loaded: Vec<(Experiment, String, PathBuf)> = files
+    let loaded: Vec<(Experiment, String, PathBuf, Vec<u8>)> = files
         .iter()
-        .map(|f| load(f).map(|(e, h)| (e, h, f.clone())))
+        .map(|f| {
+            let bytes = fs::read(f).map_err(|e| io(f, e))?;
+            load(f).map(|(e, h)| (e, h, f.clone(), bytes))
+        })
         .collect::<Result<_, _>>()?;
     let mut names = std::collections::BTreeSet::new();
-    for (e, _, f) in &loaded {
+    for (e, _, f, _) in &loaded {
         if !names.insert(e.spec.name.clone()) {
             return Err(RunError::Spec {
                 file: f.display().to_string(),
@@ -286,13 +299,15 @@ pub fn run_files(files: &[PathBuf], opts: &RunOptions) -> Result<PathBuf, RunErr
         }
     }
     fs::create_dir_all(&opts.out).map_err(|e| io(&opts.out, e))?;
-    let probe = opts.out.join(".lightquad-write-probe");
+    let probe = opts
+        .out
+        .join(format!(".lightquad-write-probe-{}", std::process::id()));
     write_atomic(&probe, b"").map_err(|e| io(&opts.out, format!("not writable: {e}")))?;
     let _ = fs::remove_file(&probe);
 
     let total: usize = loaded
         .iter()
-        .map(|(e, _, _)| run::jobs(e, opts.shard).len())
+        .map(|(e, _, _, _)| run::jobs(e, opts.shard).len())
         .sum();
     let bar = if opts.progress {
         indicatif::ProgressBar::new(total as u64)
@@ -301,13 +316,20 @@ pub fn run_files(files: &[PathBuf], opts: &RunOptions) -> Result<PathBuf, RunErr
     };
     let mut entries = Vec::new();
     let mut checks = Vec::new();
-    for (exp, hash, file) in &loaded {
+    let (mut failed, mut ran) = (0usize, 0usize);
+    for (exp, hash, _, bytes) in &loaded {
         let dir = opts.out.join(&exp.spec.name);
         fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
-        let text = fs::read(file).map_err(|e| io(file, e))?;
-        write_atomic(&dir.join("experiment.json"), &text).map_err(|e| io(&dir, e))?;
+        // The bytes that were validated (not a re-read), written only when they
+        // differ, so shards sharing the folder do not race on it.
+        let spec_path = dir.join("experiment.json");
+        if fs::read(&spec_path).ok().as_deref() != Some(bytes.as_slice()) {
+            write_atomic(&spec_path, bytes).map_err(|e| io(&dir, e))?;
+        }
         bar.set_message(exp.spec.name.clone());
         let results = run_experiment(exp, hash, opts, &bar).map_err(|e| io(&dir, e))?;
+        ran += results.len();
+        failed += results.iter().filter(|r| r.failure.is_some()).count();
         if opts.shard.is_none() {
             let (values, note) = reference(exp);
             let rows = crosscheck(exp, hash);
@@ -331,6 +353,13 @@ pub fn run_files(files: &[PathBuf], opts: &RunOptions) -> Result<PathBuf, RunErr
             checks.is_empty(),
         )
         .map_err(|e| io(&opts.out, e))?;
+    }
+    if failed > 0 {
+        return Err(RunError::Failed {
+            failed,
+            total: ran,
+            index: opts.out.join("index.md").display().to_string(),
+        });
     }
     Ok(opts.out.join("index.md"))
 }
@@ -370,12 +399,27 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
             }
         }
     }
+    if by_experiment.is_empty() {
+        return Err(RunError::Io {
+            path: inputs
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            message: "no experiment folders (with an experiment.json) found: give the --out folders of the shards".into(),
+        });
+    }
     fs::create_dir_all(out).map_err(|e| io(out, e))?;
+    let mut missing_jobs = Vec::new();
     let mut entries = Vec::new();
     let mut checks = Vec::new();
     for (name, (exp, hash, mut results)) in by_experiment {
         results.sort_by_key(JobResult::key);
         results.dedup_by_key(|r| r.key());
+        let expected = run::jobs(&exp, None).len();
+        if results.len() < expected {
+            missing_jobs.push(format!("{name}: {} of {expected} jobs", results.len()));
+        }
         let dir = out.join(&name);
         fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
         let mut text = String::new();
@@ -403,6 +447,15 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
         checks.is_empty(),
     )
     .map_err(|e| io(out, e))?;
+    if !missing_jobs.is_empty() {
+        return Err(RunError::Io {
+            path: out.display().to_string(),
+            message: format!(
+                "merged an incomplete set (is a shard missing, or from another version of the file?): {}",
+                missing_jobs.join("; ")
+            ),
+        });
+    }
     Ok(out.join("index.md"))
 }
 

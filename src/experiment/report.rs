@@ -74,13 +74,26 @@ pub fn rows(exp: &Experiment, results: &[JobResult], q: Quantity, reference: f64
                 ))
             })
             .collect();
+        let rule_spec = &exp.spec.rules[rule_index.min(exp.spec.rules.len() - 1)];
         if let Some(f) = jobs.iter().find_map(|j| j.failure.clone()) {
             flags.push(format!("failed: {f}"));
         }
         if vals.is_empty() {
+            // Every job of this row failed: keep the row, so the failure shows.
+            out.push(Row {
+                rule_index,
+                rule: rule_spec.name().to_string(),
+                budget,
+                value: f64::NAN,
+                rel_error: f64::NAN,
+                rel_estimate: f64::NAN,
+                evaluations: 0.0,
+                seconds: median(jobs.iter().map(|j| j.seconds).collect()),
+                flags,
+            });
             continue;
         }
-        if vals.iter().any(|v| !v.0.is_finite() || !v.1.is_finite()) {
+        if vals.iter().any(|v| !v.0.is_finite()) {
             flags.push("non-finite value".into());
         }
         // A sum much smaller than the magnitudes of its parts has lost digits
@@ -103,7 +116,6 @@ pub fn rows(exp: &Experiment, results: &[JobResult], q: Quantity, reference: f64
             (vals.iter().map(|v| (v.0 - reference).powi(2)).sum::<f64>() / m).sqrt() / scale;
         let rel_estimate = vals.iter().map(|v| v.1).sum::<f64>() / m / scale;
         let evaluations = vals.iter().map(|v| v.2).sum::<f64>() / m;
-        let rule_spec = &exp.spec.rules[rule_index.min(exp.spec.rules.len() - 1)];
         // The rule's own error estimate against the truth.
         if rule_spec.is_random() {
             if vals
@@ -191,8 +203,15 @@ fn plot(
         y0 = y0.min(*y);
         y1 = y1.max(*y);
     }
-    let (x0, x1) = (x0 / 1.5, x1 * 1.5);
-    let (y0, y1) = (y0 / 3.0, y1 * 3.0);
+    // Whole decades, at least one wide on each axis: plotters' log axis
+    // misbehaves on ranges that are very narrow or start off a decade.
+    let decades = |lo: f64, hi: f64| {
+        let a = lo.log10().floor().clamp(-300.0, 300.0);
+        let b = hi.log10().ceil().clamp(-300.0, 300.0).max(a + 1.0);
+        (10f64.powf(a), 10f64.powf(b))
+    };
+    let (x0, x1) = decades(x0, x1);
+    let (y0, y1) = decades(y0, y1);
     let root = SVGBackend::new(path, (900, 520)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     // The legend gets a panel of its own on the right, so it never hides a curve.
@@ -281,7 +300,7 @@ pub fn write_experiment(
         let _ = writeln!(md, "## {} (reference {reference:.16e})\n", q.name());
         let _ = writeln!(
             md,
-            "| rule | n | value | true rel. error | estimated rel. error | evaluations | median time (s) | flags |\n\
+            "| rule | n | value | true error (relative; absolute where the reference is 0) | estimated error (same) | evaluations | median time (s) | flags |\n\
              |---|---:|---:|---:|---:|---:|---:|---|"
         );
         for r in &rows {
@@ -330,7 +349,14 @@ pub fn write_experiment(
                 .copied()
                 .unwrap_or(1e-6);
             ranking.push((label.clone(), time_to(&mine, middle)));
-            let floor = |r: &&Row| r.rel_error.max(1e-17);
+            // Errors at exactly 0 are drawn at 1e-17; NaN (failed) rows are dropped.
+            let floor = |r: &&Row| {
+                if r.rel_error.is_nan() {
+                    f64::NAN
+                } else {
+                    r.rel_error.max(1e-17)
+                }
+            };
             by_time.push((
                 label.clone(),
                 mine.iter()
@@ -383,6 +409,20 @@ pub fn write_experiment(
         "experiment,rule_index,rule,budget,repeat,seed,quantity,value,estimated_error,evaluations,seconds,failure\n",
     );
     for r in results {
+        if r.values.is_empty() {
+            let _ = writeln!(
+                csv,
+                "{},{},{},{},{},{},,,,,{:e},{}",
+                r.experiment,
+                r.rule_index,
+                r.rule,
+                r.budget,
+                r.repeat,
+                r.seed,
+                r.seconds,
+                r.failure.as_deref().unwrap_or("no value").replace(',', ";")
+            );
+        }
         for (q, v) in &r.values {
             let _ = writeln!(
                 csv,

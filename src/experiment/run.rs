@@ -286,8 +286,8 @@ pub fn run_job(
 /// Every job of an experiment in a fixed order, restricted to a shard.
 pub fn jobs(exp: &Experiment, shard: Option<(usize, usize)>) -> Vec<(usize, usize, usize)> {
     let mut all = Vec::new();
-    for r in 0..exp.spec.rules.len() {
-        for &b in &exp.budgets {
+    for (r, rule) in exp.spec.rules.iter().enumerate() {
+        for &b in exp.budgets.iter().filter(|&&b| b >= rule.min_budget()) {
             for k in 0..exp.spec.repeats {
                 all.push((r, b, k));
             }
@@ -320,7 +320,14 @@ pub fn read_results(path: &Path, hash: Option<&str>) -> Vec<JobResult> {
 /// Writes `text` to `path` atomically (a temporary file, then a rename), so a
 /// reader never sees a half-written file.
 pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension("tmp");
+    // A name no other process or thread writing beside us can pick (shards of
+    // one run may share an output folder).
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let unique = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map_or("out".into(), |n| n.to_string_lossy().to_string());
+    let tmp = path.with_file_name(format!(".{name}.{}.{unique}.tmp", std::process::id()));
     {
         let mut f = File::create(&tmp)?;
         f.write_all(text)?;
@@ -346,7 +353,15 @@ pub fn run_experiment(
     // Keep finished jobs on --resume (rewriting the file without a torn last
     // line); start afresh otherwise.
     let kept = if opts.resume {
-        read_results(&path, Some(hash))
+        // Lines of this experiment file and this lightquad version only, one per
+        // job (the last wins).
+        let mut by_key = BTreeMap::new();
+        for r in read_results(&path, Some(hash)) {
+            if r.version == env!("CARGO_PKG_VERSION") {
+                by_key.insert(r.key(), r);
+            }
+        }
+        by_key.into_values().collect()
     } else {
         Vec::new()
     };

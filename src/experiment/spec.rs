@@ -274,6 +274,17 @@ impl RuleSpec {
         }
     }
 
+    /// The smallest budget the rule accepts (smaller budgets are skipped for it).
+    pub fn min_budget(&self) -> usize {
+        match self {
+            RuleSpec::Trapezoid {} => 3,
+            RuleSpec::GaussKronrod { .. } => 15,
+            RuleSpec::Sobol { replicates } => *replicates,
+            RuleSpec::GaussLegendre { .. } => 1,
+            _ => 2,
+        }
+    }
+
     /// True for the randomised rules and estimators.
     pub fn is_random(&self) -> bool {
         matches!(

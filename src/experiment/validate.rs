@@ -236,14 +236,26 @@ fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
                     format!("{} is not a finite number > 1", r.factor),
                 ));
             }
-            let mut v = Vec::new();
-            let mut x = from as f64;
-            while x.round() as usize <= to && v.len() < 200 {
-                let n = x.round() as usize;
-                if v.last() != Some(&n) {
-                    v.push(n);
+            // Each budget at least one above the last, so factors near 1
+            // still advance; at most MAX_BUDGETS of them.
+            const MAX_BUDGETS: usize = 200;
+            let mut v = vec![from];
+            loop {
+                let last = v[v.len() - 1];
+                let next = ((last as f64 * r.factor).round() as usize).max(last + 1);
+                if next > to {
+                    break;
                 }
-                x *= r.factor;
+                if v.len() == MAX_BUDGETS {
+                    return Err(SpecError::at(
+                        "budgets.factor",
+                        format!(
+                            "{} gives more than {MAX_BUDGETS} budgets from {from} to {to}: use a larger factor",
+                            r.factor
+                        ),
+                    ));
+                }
+                v.push(next);
             }
             v
         }
@@ -416,6 +428,21 @@ pub fn validate(spec: ExperimentSpec) -> Result<Experiment, SpecError> {
     }
     let scene = scene(&spec)?;
     let budgets = budgets(&spec.budgets)?;
+    // Budgets below a rule's minimum are skipped for that rule; a rule left
+    // with none is an error, so no rule silently disappears.
+    let largest = budgets.last().copied().unwrap_or(0);
+    for (i, r) in spec.rules.iter().enumerate() {
+        if largest < r.min_budget() {
+            return Err(SpecError::at(
+                "budgets",
+                format!(
+                    "no budget reaches what rules[{i}] ({}) needs: at least {}",
+                    r.name(),
+                    r.min_budget()
+                ),
+            ));
+        }
+    }
     let (reference, uncertainty) = match &spec.reference {
         ReferenceSpec::ClosedForm {} => {
             let mut values = BTreeMap::new();
