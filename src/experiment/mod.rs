@@ -100,7 +100,38 @@ pub fn experiment_files(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
 /// The reference values of an experiment and a sentence on where they come
 /// from; a converged reference is computed here, and its own convergence
 /// (n against 2n nodes) is reported.
-pub fn reference(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String) {
+/// The reference values of an experiment, a sentence on where they come from,
+/// and their relative accuracy (errors below it are not resolved).
+pub fn reference(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String, f64) {
+    let (values, note) = reference_values(exp);
+    // Relative accuracy: the stated uncertainty against the smallest reference
+    // magnitude; for a converged reference, its change from n to 2n nodes.
+    let smallest = values
+        .values()
+        .map(|v| v.abs())
+        .filter(|v| *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let mut accuracy = if smallest.is_finite() {
+        exp.uncertainty / smallest
+    } else {
+        0.0
+    };
+    if let spec::ReferenceSpec::Converged { .. } = exp.spec.reference {
+        accuracy = accuracy.max(converged_change(&note));
+    }
+    (values, note, accuracy)
+}
+
+/// The relative change recorded in a converged reference's note.
+fn converged_change(note: &str) -> f64 {
+    note.split("change is ")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0.0)
+}
+
+fn reference_values(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String) {
     match &exp.spec.reference {
         spec::ReferenceSpec::ClosedForm {} => (
             exp.reference.clone(),
@@ -331,15 +362,16 @@ pub fn run_files(files: &[PathBuf], opts: &RunOptions) -> Result<PathBuf, RunErr
         ran += results.len();
         failed += results.iter().filter(|r| r.failure.is_some()).count();
         if opts.shard.is_none() {
-            let (values, note) = reference(exp);
+            let (values, note, accuracy) = reference(exp);
             let rows = crosscheck(exp, hash);
             let extra = if rows.is_empty() {
                 String::new()
             } else {
                 crosscheck_markdown(&rows)
             };
-            let summary = report::write_experiment(&dir, exp, &results, &values, &note, &extra)
-                .map_err(|e| io(&dir, e))?;
+            let summary =
+                report::write_experiment(&dir, exp, &results, &values, &note, accuracy, &extra)
+                    .map_err(|e| io(&dir, e))?;
             entries.push((exp.spec.name.clone(), exp.spec.description.clone(), summary));
             checks.extend(rows);
         }
@@ -428,15 +460,16 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
             text.push('\n');
         }
         write_atomic(&dir.join("results.jsonl"), text.as_bytes()).map_err(|e| io(&dir, e))?;
-        let (values, note) = reference(&exp);
+        let (values, note, accuracy) = reference(&exp);
         let rows = crosscheck(&exp, &hash);
         let extra = if rows.is_empty() {
             String::new()
         } else {
             crosscheck_markdown(&rows)
         };
-        let summary = report::write_experiment(&dir, &exp, &results, &values, &note, &extra)
-            .map_err(|e| io(&dir, e))?;
+        let summary =
+            report::write_experiment(&dir, &exp, &results, &values, &note, accuracy, &extra)
+                .map_err(|e| io(&dir, e))?;
         entries.push((name, exp.spec.description.clone(), summary));
         checks.extend(rows);
     }

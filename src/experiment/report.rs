@@ -267,6 +267,7 @@ pub fn write_experiment(
     results: &[JobResult],
     reference: &BTreeMap<Quantity, f64>,
     reference_note: &str,
+    reference_accuracy: f64,
     crosscheck: &str,
 ) -> Result<Summary, String> {
     let spec = &exp.spec;
@@ -297,7 +298,15 @@ pub fn write_experiment(
         let Some(&reference) = reference.get(q) else {
             continue;
         };
-        let rows = rows(exp, results, *q, reference);
+        let mut rows = rows(exp, results, *q, reference);
+        // Errors the reference cannot resolve.
+        for r in rows.iter_mut() {
+            if reference_accuracy > 0.0 && r.rel_error <= reference_accuracy {
+                r.flags.push(format!(
+                    "at the reference's accuracy ({reference_accuracy:.1e})"
+                ));
+            }
+        }
         let _ = writeln!(md, "## {} (reference {reference:.16e})\n", q.name());
         let _ = writeln!(
             md,
@@ -341,7 +350,13 @@ pub fn write_experiment(
             let times: Vec<String> = spec
                 .targets
                 .iter()
-                .map(|t| time_to(&mine, *t).map_or("not reached".into(), |s| format!("{s:.2e}")))
+                .map(|t| {
+                    if *t < reference_accuracy {
+                        "below reference accuracy".into()
+                    } else {
+                        time_to(&mine, *t).map_or("not reached".into(), |s| format!("{s:.2e}"))
+                    }
+                })
                 .collect();
             let _ = writeln!(md, "| {label} | {order} | {} |", times.join(" | "));
             let middle = spec
@@ -349,7 +364,14 @@ pub fn write_experiment(
                 .get(spec.targets.len() / 2)
                 .copied()
                 .unwrap_or(1e-6);
-            ranking.push((label.clone(), time_to(&mine, middle)));
+            ranking.push((
+                label.clone(),
+                if middle < reference_accuracy {
+                    None
+                } else {
+                    time_to(&mine, middle)
+                },
+            ));
             // Errors at exactly 0 are drawn at 1e-17; NaN (failed) rows are dropped.
             let floor = |r: &&Row| {
                 if r.rel_error.is_nan() {
