@@ -29,6 +29,23 @@ fn sphere_scene(r: f64, kappa: f64, lambda: f64, h: f64) -> VolumeScene {
     scene
 }
 
+/// Two overlapping Gaussian blobs (the bundled experiments' medium).
+fn two_blobs() -> GaussianBlobs {
+    GaussianBlobs::new(vec![
+        GaussianBlob {
+            centre: Vec3::new(0.0, 0.1, 0.0),
+            amplitude: 1.2,
+            width: 0.4,
+        },
+        GaussianBlob {
+            centre: Vec3::new(0.6, -0.2, 0.1),
+            amplitude: 0.8,
+            width: 0.25,
+        },
+    ])
+    .expect("valid")
+}
+
 fn gl() -> GaussLegendre {
     GaussLegendre::default()
 }
@@ -470,19 +487,7 @@ fn bad_volume_input_is_a_clear_error() {
 fn regression_cumulative_depth_is_right_for_rules_that_visit_nodes_out_of_order() {
     // Adaptive Gauss–Kronrod visits the middle of a piece first; a single
     // 6-point rule over that half-piece gap once put I_L off by 0.2%.
-    let blobs = GaussianBlobs::new(vec![
-        GaussianBlob {
-            centre: Vec3::new(0.0, 0.1, 0.0),
-            amplitude: 1.2,
-            width: 0.4,
-        },
-        GaussianBlob {
-            centre: Vec3::new(0.6, -0.2, 0.1),
-            amplitude: 0.8,
-            width: 0.25,
-        },
-    ])
-    .expect("valid");
+    let blobs = two_blobs();
     let mut scene = VolumeScene::new(
         Ray::new(Vec3::new(-4.0, 0.2, 0.1), Vec3::new(1.0, 0.05, 0.0)).expect("ray"),
     );
@@ -545,19 +550,7 @@ fn proportional_emission_obeys_the_identity_i_e_equals_k_over_lambda_times_one_m
     // With c(v) = k v, I_E = int tau sigma (k / lambda) dt = (k / lambda)(1 - tau)
     // for any medium: an independent check of the nested integral against the
     // erf closed form of tau, by every deterministic rule and both schemes.
-    let blobs = GaussianBlobs::new(vec![
-        GaussianBlob {
-            centre: Vec3::new(0.0, 0.1, 0.0),
-            amplitude: 1.2,
-            width: 0.4,
-        },
-        GaussianBlob {
-            centre: Vec3::new(0.6, -0.2, 0.1),
-            amplitude: 0.8,
-            width: 0.25,
-        },
-    ])
-    .expect("valid");
+    let blobs = two_blobs();
     use lightquad::volume::Medium;
     let ray = Ray::new(Vec3::new(-5.0, 0.05, 0.0), Vec3::new(1.0, 0.02, 0.01)).expect("ray");
     let (lambda, k) = (1.7, 0.6);

@@ -131,6 +131,28 @@ fn converged_change(note: &str) -> f64 {
         .unwrap_or(0.0)
 }
 
+/// Every quantity of the experiment by Gauss–Legendre with `n` nodes per
+/// graded piece (cumulative depth, closed-form shadow rays where available):
+/// the converged reference and lightquad's column in the Mitsuba comparison.
+pub fn converged_values(exp: &Experiment, n: usize) -> BTreeMap<Quantity, f64> {
+    let rule = GaussLegendre {
+        error_estimate: false,
+    };
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+    let mut job = JobResult::empty();
+    if let Ok(res) = evaluate(
+        &exp.scene,
+        &rule,
+        n,
+        crate::volume::DepthScheme::Cumulative,
+        crate::volume::ShadowMethod::ClosedFormWhereAvailable,
+        &mut rng,
+    ) {
+        run::collect_into(&res, &exp.spec.quantities, &mut job);
+    }
+    job.values
+}
+
 fn reference_values(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String) {
     match &exp.spec.reference {
         spec::ReferenceSpec::ClosedForm {} => (
@@ -149,25 +171,7 @@ fn reference_values(exp: &Experiment) -> (BTreeMap<Quantity, f64>, String) {
             format!("literal values, uncertainty {uncertainty:e}."),
         ),
         spec::ReferenceSpec::Converged { n } => {
-            let rule = GaussLegendre {
-                error_estimate: false,
-            };
-            let run = |m: usize| {
-                let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
-                let mut job = JobResult::empty();
-                if let Ok(res) = evaluate(
-                    &exp.scene,
-                    &rule,
-                    m,
-                    crate::volume::DepthScheme::Cumulative,
-                    crate::volume::ShadowMethod::ClosedFormWhereAvailable,
-                    &mut rng,
-                ) {
-                    run::collect_into(&res, &exp.spec.quantities, &mut job);
-                }
-                job.values
-            };
-            let (a, b) = (run(*n), run(2 * n));
+            let (a, b) = (converged_values(exp, *n), converged_values(exp, 2 * n));
             let worst = exp
                 .spec
                 .quantities
@@ -225,21 +229,7 @@ pub fn crosscheck(exp: &Experiment, hash: &str) -> Vec<Crosscheck> {
         return Vec::new();
     };
     let stale = json["experiment_hash"].as_str() != Some(hash);
-    let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
-    let rule = GaussLegendre {
-        error_estimate: false,
-    };
-    let mut job = JobResult::empty();
-    if let Ok(res) = evaluate(
-        &exp.scene,
-        &rule,
-        400,
-        crate::volume::DepthScheme::Cumulative,
-        crate::volume::ShadowMethod::ClosedFormWhereAvailable,
-        &mut rng,
-    ) {
-        run::collect_into(&res, &exp.spec.quantities, &mut job);
-    }
+    let lightquad = converged_values(exp, 400);
     exp.spec
         .quantities
         .iter()
@@ -261,7 +251,7 @@ pub fn crosscheck(exp: &Experiment, hash: &str) -> Vec<Crosscheck> {
             Crosscheck {
                 experiment: exp.spec.name.clone(),
                 quantity: *q,
-                lightquad: job.values.get(q).copied().unwrap_or(f64::NAN),
+                lightquad: lightquad.get(q).copied().unwrap_or(f64::NAN),
                 mitsuba,
                 closed_form: validate::closed_form(&exp.spec, &exp.scene, *q),
                 note,

@@ -128,7 +128,13 @@ fn job_seed(seed: u64, rule_index: usize, budget: usize, repeat: usize) -> u64 {
 }
 
 /// The machine: CPU model and cores.
+/// Read once per process: every job line carries it.
 pub fn machine() -> String {
+    static MACHINE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    MACHINE.get_or_init(read_machine).clone()
+}
+
+fn read_machine() -> String {
     let model = fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
