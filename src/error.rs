@@ -77,3 +77,40 @@ pub fn require_positive(name: &str, x: f64) -> Result<f64, QuadError> {
         Err(QuadError::invalid(name, x, "a finite number > 0"))
     }
 }
+
+/// A fault in an experiment file, at a JSON path.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("at `{path}`: {message}")]
+pub struct SpecError {
+    /// JSON path of the fault (`scene.medium.kappa`, `budgets[2]`, ...).
+    pub path: String,
+    /// What is wrong and what is accepted.
+    pub message: String,
+}
+
+impl SpecError {
+    /// An error at `path`.
+    pub fn at(path: impl Into<String>, message: impl Into<String>) -> Self {
+        SpecError {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+
+    /// A library error re-anchored under `path`: an invalid parameter lands at
+    /// `path.<parameter>`, anything else at `path`.
+    pub fn from_quad(path: &str, e: QuadError) -> Self {
+        let field = match &e {
+            QuadError::InvalidParameter { name, .. } => Some(name.clone()),
+            _ => None,
+        };
+        let path = match field {
+            Some(f) if !path.ends_with(&f) => format!("{path}.{f}"),
+            _ => path.to_string(),
+        };
+        SpecError {
+            path,
+            message: e.to_string(),
+        }
+    }
+}

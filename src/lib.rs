@@ -37,6 +37,8 @@ pub mod error;
 pub mod estimate;
 pub mod exact;
 pub mod experiment;
+pub mod families;
+pub mod family;
 pub mod geometry;
 pub mod quadrature;
 pub mod sum;

@@ -8,8 +8,9 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use lightquad::experiment::run::RunOptions;
-use lightquad::experiment::{self, core_study, volume_study};
-use lightquad::quadrature::{PRODUCT_RULE, RULES, gauss_legendre};
+use lightquad::experiment;
+use lightquad::families;
+use lightquad::quadrature::gauss_legendre;
 
 /// How accurate is each numerical approximation of a light-transport integral,
 /// and what does it cost?
@@ -22,7 +23,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the quadrature rules, one line each.
+    /// List the quadrature rules and every family's estimators, one line each,
+    /// then the families with their quantities.
     Rules,
     /// Print a rule's nodes and weights on [-1, 1] as JSON
     /// `{"nodes": [...], "weights": [...]}`, every digit needed to round-trip an f64.
@@ -68,17 +70,9 @@ enum Command {
         #[arg(long, default_value = "report")]
         out: PathBuf,
     },
-    /// The built-in studies: every rule on integrals with closed forms, over a
-    /// budget sweep, and the volume equations (audit of the printed V-Lp, V-E and
-    /// V-L nested and cumulative); prints a Markdown report.
-    Study {
-        /// The largest budget is 4^max_power (1..=11).
-        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=11))]
-        max_power: u32,
-        /// Seed of the randomised rules.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-    },
+    /// Print the families' audits of the source documents' printed formulas
+    /// (Markdown; also at the end of every report's index).
+    Audit,
 }
 
 fn main() -> ExitCode {
@@ -97,8 +91,20 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
     let mut out = BufWriter::new(stdout.lock());
     match command {
         Command::Rules => {
-            for (name, about) in RULES.iter().chain([&PRODUCT_RULE]) {
-                writeln!(out, "{name:<16} {about}")?;
+            let registry = families::builtin();
+            for (name, about) in registry.methods() {
+                writeln!(out, "{name:<40} {about}")?;
+            }
+            writeln!(out)?;
+            for f in registry.entries() {
+                writeln!(
+                    out,
+                    "family {:<9} {} (equations {}; quantities {})",
+                    f.name,
+                    f.about,
+                    f.equations.join(", "),
+                    f.quantities().join(", ")
+                )?;
             }
         }
         Command::Nodes { rule, n } => {
@@ -172,7 +178,7 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 shard,
                 progress: std::io::stderr().is_terminal(),
             };
-            let index = experiment::run_files(&files, &opts)?;
+            let index = experiment::run_files(&families::builtin(), &files, &opts)?;
             if shard.is_none() {
                 writeln!(out, "report: {}", index.display())?;
             } else {
@@ -184,28 +190,35 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         Command::Check { files } => {
+            let registry = families::builtin();
             for f in files {
-                let (exp, hash) = experiment::load(&f)?;
+                let exp = experiment::load(&registry, &f)?;
+                let (rules, budgets, repeats) = exp.shape();
                 writeln!(
                     out,
-                    "{}: ok ({}, {} rule(s) x {} budget(s) x {} repeat(s), hash {hash})",
+                    "{}: ok ({}, family {}, {rules} rule(s) x {budgets} budget(s) x {repeats} repeat(s), hash {})",
                     f.display(),
-                    exp.spec.name,
-                    exp.spec.rules.len(),
-                    exp.budgets.len(),
-                    exp.spec.repeats
+                    exp.name(),
+                    exp.family(),
+                    exp.hash()
                 )?;
             }
         }
-        Command::Schema => writeln!(out, "{}", experiment::schema())?,
+        Command::Schema => writeln!(
+            out,
+            "{}",
+            serde_json::to_string_pretty(&families::builtin().schema())?
+        )?,
         Command::Merge { inputs, out: dir } => {
-            let index = experiment::merge(&inputs, &dir)?;
+            let index = experiment::merge(&families::builtin(), &inputs, &dir)?;
             writeln!(out, "report: {}", index.display())?;
         }
-        Command::Study { max_power, seed } => {
-            let rows = core_study::run(max_power, seed);
-            write!(out, "{}", core_study::markdown(&rows))?;
-            write!(out, "{}", volume_study::markdown())?;
+        Command::Audit => {
+            for f in families::builtin().entries() {
+                if let Some(audit) = f.audit() {
+                    writeln!(out, "{audit}")?;
+                }
+            }
         }
     }
     out.flush()?;

@@ -133,8 +133,27 @@ where
     V: Value,
     G: FnMut(Dom::Point) -> V,
 {
-    rule.integrate(n, rng, |u: [f64; D]| {
+    try_integrate_over(rule, domain, n, rng, |p| Ok(g(p)))
+}
+
+/// [`integrate_over`] for an integrand that may fail: its first error is
+/// returned as is.
+pub fn try_integrate_over<const D: usize, Dom, R, Rg, V, G>(
+    rule: &R,
+    domain: &Dom,
+    n: usize,
+    rng: &mut Rg,
+    mut g: G,
+) -> Result<Estimate<V>, QuadError>
+where
+    Dom: Domain<D>,
+    R: Rule,
+    Rg: rand::Rng + ?Sized,
+    V: Value,
+    G: FnMut(Dom::Point) -> Result<V, QuadError>,
+{
+    rule.try_integrate(n, rng, |u: [f64; D]| {
         let (p, jacobian) = domain.map(u);
-        g(p).map(|v| v * jacobian)
+        Ok(g(p)?.map(|v| v * jacobian))
     })
 }

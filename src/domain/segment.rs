@@ -91,6 +91,23 @@ impl Segment {
         rng: &mut Rg,
         mut g: G,
     ) -> Result<Estimate<V>, QuadError> {
+        self.try_integrate(rule, n, rng, |t| Ok(g(t)))
+    }
+
+    /// [`Segment::integrate`] for an integrand that may fail: its first error
+    /// is returned as is.
+    pub fn try_integrate<
+        R: Rule,
+        Rg: rand::Rng + ?Sized,
+        V: Value,
+        G: FnMut(f64) -> Result<V, QuadError>,
+    >(
+        &self,
+        rule: &R,
+        n: usize,
+        rng: &mut Rg,
+        mut g: G,
+    ) -> Result<Estimate<V>, QuadError> {
         let mut total: Option<Estimate<V>> = None;
         for (lo, hi) in self.pieces() {
             let piece = Segment {
@@ -98,7 +115,7 @@ impl Segment {
                 b: hi,
                 breaks: Vec::new(),
             };
-            let est = super::integrate_over(rule, &piece, n, rng, &mut g)?;
+            let est = super::try_integrate_over(rule, &piece, n, rng, &mut g)?;
             total = Some(match total {
                 None => est,
                 Some(t) => t.combine(est),

@@ -2,6 +2,10 @@
 //! quantity, fitted orders, time to reach target errors, stability flags) with
 //! SVG plots of error against time and against n, a CSV of every job, and an
 //! index page that links every experiment and ranks the rules by time to error.
+//!
+//! Nothing here knows a family: a page is described by a [`Page`], and values
+//! are channel vectors (a scalar, RGB, an image), compared by their root mean
+//! square.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -10,31 +14,111 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::fit::fitted_order;
+use super::reference::{Crosscheck, Reference, crosscheck_markdown, rms};
 use super::run::{JobResult, write_atomic};
-use super::spec::Quantity;
-use super::validate::Experiment;
+use crate::family::Flag;
+
+/// What a report page shows of an experiment, whatever its family.
+#[derive(Debug, Clone)]
+pub struct Page<'a> {
+    /// Experiment name.
+    pub name: &'a str,
+    /// What it shows.
+    pub description: &'a str,
+    /// Its family.
+    pub family: &'static str,
+    /// Its equation IDs.
+    pub equations: &'a [String],
+    /// Budgets, ascending.
+    pub budgets: &'a [usize],
+    /// Repeats per (rule, budget).
+    pub repeats: usize,
+    /// The file's seed.
+    pub seed: u64,
+    /// How the family evaluates the scene, in words (may be empty).
+    pub settings: String,
+    /// The quantities, in the file's order.
+    pub quantities: Vec<&'static str>,
+    /// The rules and estimators, in the file's order.
+    pub rules: Vec<RuleInfo>,
+    /// Target relative errors.
+    pub targets: &'a [f64],
+    /// The reference.
+    pub reference: &'a Reference,
+    /// The Mitsuba comparison rows (may be empty).
+    pub crosscheck: &'a [Crosscheck],
+}
+
+/// A rule or estimator as a report sees it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RuleInfo {
+    /// Its label (its name, with `#index` where the file names it twice).
+    pub label: String,
+    /// True for randomised rules (their estimate is a standard error).
+    pub is_random: bool,
+}
+
+/// A fact about a row of a report table.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RowFlag {
+    /// A job failed, with its reason.
+    Failed(String),
+    /// A value is NaN or infinite.
+    NonFinite,
+    /// A fact the family recorded on the value.
+    Job(Flag),
+    /// A random estimate whose standard error misses the true error.
+    OutsideStandardErrors,
+    /// A deterministic error estimate off by more than 10x, above the rounding floor.
+    EstimateOff,
+    /// The error grew with the budget, above the rounding floor.
+    ErrorGrew,
+    /// The error is at or below the reference's own relative accuracy.
+    AtReferenceAccuracy(f64),
+}
+
+impl std::fmt::Display for RowFlag {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RowFlag::Failed(why) => write!(f, "failed: {why}"),
+            RowFlag::NonFinite => write!(f, "non-finite value"),
+            RowFlag::Job(flag) => write!(f, "{flag}"),
+            RowFlag::OutsideStandardErrors => write!(f, "outside 4 standard errors"),
+            RowFlag::EstimateOff => write!(f, "estimate off by more than 10x"),
+            RowFlag::ErrorGrew => write!(f, "error grew with the budget"),
+            RowFlag::AtReferenceAccuracy(a) => write!(f, "at the reference's accuracy ({a:.1e})"),
+        }
+    }
+}
+
+/// The legend of the flags, below every page.
+const FLAG_LEGEND: &str = "Flags: `failed` (the job's reason follows); `non-finite value`; \
+`outside 4 standard errors` (a random estimate whose standard error misses the true error); \
+`estimate off by more than 10x` (a deterministic error estimate, above the rounding floor); \
+`error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
+parts); `underflows: log space` (the value is below the smallest f64, its logarithm is exact); \
+`at the reference's accuracy` (the error is not resolved by the reference).";
 
 /// One row of a report table: a rule at one budget, aggregated over repeats.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Row {
     /// Index of the rule in the file.
     pub rule_index: usize,
-    /// Rule name.
-    pub rule: String,
     /// Budget.
     pub budget: usize,
-    /// Mean value over repeats.
-    pub value: f64,
-    /// Root-mean-square true error over repeats, relative to the reference.
+    /// Mean value over repeats, per channel.
+    pub value: Vec<f64>,
+    /// Root-mean-square true error over repeats and channels, relative to the
+    /// reference's root mean square (absolute where that is 0).
     pub rel_error: f64,
-    /// Mean estimated error, relative to the reference.
+    /// Mean over repeats of the root-mean-square estimated error, same scale.
     pub rel_estimate: f64,
     /// Mean evaluations.
     pub evaluations: f64,
-    /// Median wall time, seconds.
+    /// Lower median wall time, seconds.
     pub seconds: f64,
     /// Stability flags.
-    pub flags: Vec<String>,
+    pub flags: Vec<RowFlag>,
 }
 
 /// Relative errors below this are at the f64 rounding floor: no order is
@@ -51,108 +135,126 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// Aggregates the jobs of one quantity into rows, with their flags.
-pub fn rows(exp: &Experiment, results: &[JobResult], q: Quantity, reference: f64) -> Vec<Row> {
+/// Aggregates the jobs of quantity `q` into rows, with their flags.
+pub fn rows(rules: &[RuleInfo], results: &[JobResult], q: &str, reference: &[f64]) -> Vec<Row> {
     let mut groups: BTreeMap<(usize, usize), Vec<&JobResult>> = BTreeMap::new();
     for r in results {
         groups.entry((r.rule_index, r.budget)).or_default().push(r);
     }
-    let scale = if reference != 0.0 {
-        reference.abs()
-    } else {
-        1.0
+    let scale = match rms(reference.iter().copied()) {
+        s if s > 0.0 => s,
+        _ => 1.0,
     };
-    let mut out: Vec<Row> = Vec::new();
-    for ((rule_index, budget), jobs) in groups {
-        let mut flags = Vec::new();
-        let vals: Vec<(f64, f64, f64)> = jobs
-            .iter()
-            .filter_map(|j| {
-                Some((
-                    *j.values.get(&q)?,
-                    *j.estimated_errors.get(&q)?,
-                    *j.evaluations.get(&q)? as f64,
-                ))
-            })
-            .collect();
-        let rule_spec = &exp.spec.rules[rule_index.min(exp.spec.rules.len() - 1)];
-        if let Some(f) = jobs.iter().find_map(|j| j.failure.clone()) {
-            flags.push(format!("failed: {f}"));
-        }
-        if vals.is_empty() {
-            // Every job of this row failed: keep the row, so the failure shows.
-            out.push(Row {
-                rule_index,
-                rule: rule_spec.name().to_string(),
-                budget,
-                value: f64::NAN,
-                rel_error: f64::NAN,
-                rel_estimate: f64::NAN,
-                evaluations: 0.0,
-                seconds: median(jobs.iter().map(|j| j.seconds).collect()),
-                flags,
-            });
-            continue;
-        }
-        if vals.iter().any(|v| !v.0.is_finite()) {
-            flags.push("non-finite value".into());
-        }
-        // A sum much smaller than the magnitudes of its parts has lost digits
-        // to cancellation.
-        if jobs
-            .iter()
-            .any(|j| match (j.values.get(&q), j.magnitudes.get(&q)) {
-                (Some(v), Some(m)) => *m > 0.0 && v.abs() < 1e-6 * m,
-                _ => false,
-            })
-        {
-            flags.push("cancellation: |sum| < 1e-6 of its parts".into());
-        }
-        if jobs.iter().any(|j| j.underflow) && q == Quantity::Tau {
-            flags.push("tau underflows: log space".into());
-        }
-        let m = vals.len() as f64;
-        let value = vals.iter().map(|v| v.0).sum::<f64>() / m;
-        let rel_error =
-            (vals.iter().map(|v| (v.0 - reference).powi(2)).sum::<f64>() / m).sqrt() / scale;
-        let rel_estimate = vals.iter().map(|v| v.1).sum::<f64>() / m / scale;
-        let evaluations = vals.iter().map(|v| v.2).sum::<f64>() / m;
-        // The rule's own error estimate against the truth.
-        if rule_spec.is_random() {
-            if vals
-                .iter()
-                .any(|v| (v.0 - reference).abs() > 4.0 * v.1 && v.1.is_finite())
-            {
-                flags.push("outside 4 standard errors".into());
-            }
-        } else if rel_error > 100.0 * FLOOR
-            && rel_estimate.is_finite()
-            && (rel_estimate > 10.0 * rel_error || rel_estimate < rel_error / 10.0)
-        {
-            flags.push("estimate off by more than 10x".into());
-        }
-        out.push(Row {
-            rule_index,
-            rule: rule_spec.name().to_string(),
-            budget,
-            value,
-            rel_error,
-            rel_estimate,
-            evaluations,
-            seconds: median(jobs.iter().map(|j| j.seconds).collect()),
-            flags,
-        });
-    }
+    let mut out: Vec<Row> = groups
+        .into_iter()
+        .map(|((rule_index, budget), jobs)| {
+            let random = rules.get(rule_index).is_some_and(|r| r.is_random);
+            row(rule_index, budget, &jobs, q, reference, scale, random)
+        })
+        .collect();
     // Convergence that stalls or reverses, above the rounding floor.
     for i in 1..out.len() {
         if out[i].rule_index == out[i - 1].rule_index
             && out[i - 1].rel_error > 1e3 * FLOOR
             && out[i].rel_error > 1.5 * out[i - 1].rel_error
         {
-            out[i].flags.push("error grew with the budget".into());
+            out[i].flags.push(RowFlag::ErrorGrew);
         }
     }
     out
+}
+
+/// One row from the repeats of one (rule, budget).
+fn row(
+    rule_index: usize,
+    budget: usize,
+    jobs: &[&JobResult],
+    q: &str,
+    reference: &[f64],
+    scale: f64,
+    random: bool,
+) -> Row {
+    let mut flags = Vec::new();
+    if let Some(f) = jobs.iter().find_map(|j| j.failure.clone()) {
+        flags.push(RowFlag::Failed(f));
+    }
+    let seconds = median(jobs.iter().map(|j| j.seconds).collect());
+    let measured: Vec<_> = jobs.iter().filter_map(|j| j.quantities.get(q)).collect();
+    if measured.is_empty() {
+        // Every job of this row failed: keep the row, so the failure shows.
+        return Row {
+            rule_index,
+            budget,
+            value: Vec::new(),
+            rel_error: f64::NAN,
+            rel_estimate: f64::NAN,
+            evaluations: 0.0,
+            seconds,
+            flags,
+        };
+    }
+    if measured
+        .iter()
+        .any(|m| m.value.iter().any(|v| !v.is_finite()))
+    {
+        flags.push(RowFlag::NonFinite);
+    }
+    for m in &measured {
+        for f in &m.flags {
+            let same = |g: &RowFlag| matches!(g, RowFlag::Job(h) if std::mem::discriminant(h) == std::mem::discriminant(f));
+            if !flags.iter().any(same) {
+                flags.push(RowFlag::Job(*f));
+            }
+        }
+    }
+    let count = measured.len() as f64;
+    let channels = reference.len();
+    let value = (0..channels)
+        .map(|c| measured.iter().map(|m| channel(&m.value, c)).sum::<f64>() / count)
+        .collect();
+    // True error: the root mean square over repeats and channels.
+    let diffs = measured.iter().flat_map(|m| {
+        (0..channels.max(m.value.len())).map(|c| channel(&m.value, c) - channel(reference, c))
+    });
+    let rel_error = rms(diffs.collect::<Vec<_>>().into_iter()) / scale;
+    let rel_estimate = measured
+        .iter()
+        .map(|m| rms(m.error.iter().copied()))
+        .sum::<f64>()
+        / count
+        / scale;
+    let evaluations = measured.iter().map(|m| m.evaluations as f64).sum::<f64>() / count;
+    // The rule's own error estimate against the truth.
+    if random {
+        let outside = measured.iter().any(|m| {
+            m.error.iter().enumerate().any(|(c, e)| {
+                e.is_finite() && (channel(&m.value, c) - channel(reference, c)).abs() > 4.0 * e
+            })
+        });
+        if outside {
+            flags.push(RowFlag::OutsideStandardErrors);
+        }
+    } else if rel_error > 100.0 * FLOOR
+        && rel_estimate.is_finite()
+        && (rel_estimate > 10.0 * rel_error || rel_estimate < rel_error / 10.0)
+    {
+        flags.push(RowFlag::EstimateOff);
+    }
+    Row {
+        rule_index,
+        budget,
+        value,
+        rel_error,
+        rel_estimate,
+        evaluations,
+        seconds,
+        flags,
+    }
+}
+
+/// Channel `c` of `v`, NaN when it has none (a value of the wrong shape).
+fn channel(v: &[f64], c: usize) -> f64 {
+    v.get(c).copied().unwrap_or(f64::NAN)
 }
 
 /// The fitted order (error against evaluations) of one rule's rows.
@@ -171,18 +273,20 @@ pub fn order(rows: &[&Row]) -> Option<f64> {
 /// The least median time among rows whose error meets `target`.
 pub fn time_to(rows: &[&Row], target: f64) -> Option<f64> {
     rows.iter()
-        .filter(|r| r.rel_error <= target && r.flags.iter().all(|f| !f.starts_with("failed")))
+        .filter(|r| {
+            r.rel_error <= target && !r.flags.iter().any(|f| matches!(f, RowFlag::Failed(_)))
+        })
         .map(|r| r.seconds)
         .min_by(f64::total_cmp)
 }
 
-fn rule_label(exp: &Experiment, i: usize) -> String {
-    let name = exp.spec.rules[i].name();
-    let same = exp.spec.rules.iter().filter(|r| r.name() == name).count();
-    if same > 1 {
-        format!("{name}#{i}")
-    } else {
-        name.to_string()
+/// A value for a table cell: the number, or the root mean square of the
+/// channels with their count.
+fn show_value(v: &[f64]) -> String {
+    match v {
+        [] => "—".into(),
+        [x] => format!("{x:.15e}"),
+        _ => format!("rms {:.15e} ({} channels)", rms(v.iter().copied()), v.len()),
     }
 }
 
@@ -257,31 +361,65 @@ fn plot(
     root.present().map_err(|e| e.to_string())
 }
 
-/// Per-experiment summary for the index: quantity -> rule -> time to target.
-pub type Summary = BTreeMap<Quantity, Vec<(String, Option<f64>)>>;
+/// Per-experiment summary for the index: per quantity, in the file's order,
+/// each rule's time to the middle target (None: not reached).
+pub type Summary = Vec<(&'static str, Vec<(String, Option<f64>)>)>;
 
 /// Writes `report.md`, the SVG plots and `results.csv` of one experiment.
-pub fn write_experiment(
-    dir: &Path,
-    exp: &Experiment,
-    results: &[JobResult],
-    reference: &BTreeMap<Quantity, f64>,
-    reference_note: &str,
-    reference_accuracy: f64,
-    crosscheck: &str,
-) -> Result<Summary, String> {
-    let spec = &exp.spec;
+pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Result<Summary, String> {
+    let mut md = header(page, results);
+    let mut summary = Summary::new();
+    for &q in &page.quantities {
+        let Some(reference) = page.reference.values.get(q) else {
+            continue;
+        };
+        let mut rows = rows(&page.rules, results, q, reference);
+        let accuracy = page.reference.accuracy;
+        for r in rows.iter_mut() {
+            if accuracy > 0.0 && r.rel_error <= accuracy {
+                r.flags.push(RowFlag::AtReferenceAccuracy(accuracy));
+            }
+        }
+        let _ = writeln!(
+            md,
+            "## {q} (reference {})\n\n{}",
+            show_value(reference),
+            table(page, &rows)
+        );
+        summary.push((q, orders_and_plots(dir, page, q, &rows, &mut md)?));
+    }
+    if !page.crosscheck.is_empty() {
+        let _ = writeln!(
+            md,
+            "## lightquad vs Mitsuba 3 vs closed form\n\n{}",
+            crosscheck_markdown(page.crosscheck)
+        );
+    }
+    let _ = writeln!(md, "{FLAG_LEGEND}");
+    write_atomic(&dir.join("report.md"), md.as_bytes()).map_err(|e| e.to_string())?;
+    write_atomic(&dir.join("results.csv"), csv(results).as_bytes()).map_err(|e| e.to_string())?;
+    Ok(summary)
+}
+
+/// The page's title, settings, reference and provenance.
+fn header(page: &Page, results: &[JobResult]) -> String {
     let mut md = String::new();
-    let _ = writeln!(md, "# {}\n\n{}\n", spec.name, spec.description);
+    let _ = writeln!(md, "# {}\n\n{}\n", page.name, page.description);
+    let settings = if page.settings.is_empty() {
+        String::new()
+    } else {
+        format!(", {}", page.settings)
+    };
     let _ = writeln!(
         md,
-        "Equations: {}. Budgets {:?} per smooth piece, {} repeat(s), seed {}, depth scheme {:?}.\n\n\
-         Reference: {reference_note}\n",
-        spec.equations.join(", "),
-        exp.budgets,
-        spec.repeats,
-        spec.seed,
-        spec.depth_scheme
+        "Family `{}`. Equations: {}. Budgets {:?} per smooth piece, {} repeat(s), seed {}{settings}.\n\n\
+         Reference: {}\n",
+        page.family,
+        page.equations.join(", "),
+        page.budgets,
+        page.repeats,
+        page.seed,
+        page.reference.note
     );
     if let Some(r) = results.first() {
         let _ = writeln!(
@@ -293,189 +431,152 @@ pub fn write_experiment(
             r.experiment_hash
         );
     }
-    let mut summary = Summary::new();
-    for q in &spec.quantities {
-        let Some(&reference) = reference.get(q) else {
-            continue;
-        };
-        let mut rows = rows(exp, results, *q, reference);
-        // Errors the reference cannot resolve.
-        for r in rows.iter_mut() {
-            if reference_accuracy > 0.0 && r.rel_error <= reference_accuracy {
-                r.flags.push(format!(
-                    "at the reference's accuracy ({reference_accuracy:.1e})"
-                ));
-            }
-        }
-        let _ = writeln!(md, "## {} (reference {reference:.16e})\n", q.name());
+    md
+}
+
+/// The table of one quantity: a row per (rule, budget).
+fn table(page: &Page, rows: &[Row]) -> String {
+    let mut md = String::from(
+        "| rule | n | value | true error (relative; absolute where the reference is 0) | estimated error (same) | evaluations | median time (s) | flags |\n\
+         |---|---:|---:|---:|---:|---:|---:|---|\n",
+    );
+    for r in rows {
+        let flags: Vec<String> = r.flags.iter().map(ToString::to_string).collect();
         let _ = writeln!(
             md,
-            "| rule | n | value | true error (relative; absolute where the reference is 0) | estimated error (same) | evaluations | median time (s) | flags |\n\
-             |---|---:|---:|---:|---:|---:|---:|---|"
-        );
-        for r in &rows {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {:.15e} | {:.2e} | {:.2e} | {:.0} | {:.2e} | {} |",
-                rule_label(exp, r.rule_index),
-                r.budget,
-                r.value,
-                r.rel_error,
-                r.rel_estimate,
-                r.evaluations,
-                r.seconds,
-                r.flags.join("; ")
-            );
-        }
-        let _ = writeln!(
-            md,
-            "\n| rule | fitted slope of log error vs log evaluations (order p shows as -p) | {} |",
-            spec.targets
-                .iter()
-                .map(|t| format!("time to {t:.0e} (s)"))
-                .collect::<Vec<_>>()
-                .join(" | ")
-        );
-        let _ = writeln!(md, "|---|---:|{}", "---:|".repeat(spec.targets.len()));
-        let mut ranking = Vec::new();
-        let mut by_time = Vec::new();
-        let mut by_n = Vec::new();
-        for i in 0..spec.rules.len() {
-            let mine: Vec<&Row> = rows.iter().filter(|r| r.rule_index == i).collect();
-            if mine.is_empty() {
-                continue;
-            }
-            let label = rule_label(exp, i);
-            let order = order(&mine).map_or("—".into(), |o| format!("{o:.2}"));
-            let times: Vec<String> = spec
-                .targets
-                .iter()
-                .map(|t| {
-                    if *t < reference_accuracy {
-                        "below reference accuracy".into()
-                    } else {
-                        time_to(&mine, *t).map_or("not reached".into(), |s| format!("{s:.2e}"))
-                    }
-                })
-                .collect();
-            let _ = writeln!(md, "| {label} | {order} | {} |", times.join(" | "));
-            let middle = spec
-                .targets
-                .get(spec.targets.len() / 2)
-                .copied()
-                .unwrap_or(1e-6);
-            ranking.push((
-                label.clone(),
-                if middle < reference_accuracy {
-                    None
-                } else {
-                    time_to(&mine, middle)
-                },
-            ));
-            // Errors at exactly 0 are drawn at 1e-17; NaN (failed) rows are dropped.
-            let floor = |r: &&Row| {
-                if r.rel_error.is_nan() {
-                    f64::NAN
-                } else {
-                    r.rel_error.max(1e-17)
-                }
-            };
-            by_time.push((
-                label.clone(),
-                mine.iter()
-                    .map(|r| (r.seconds.max(1e-9), floor(r)))
-                    .collect(),
-            ));
-            by_n.push((
-                label,
-                mine.iter()
-                    .map(|r| (r.evaluations.max(1.0), floor(r)))
-                    .collect(),
-            ));
-        }
-        summary.insert(*q, ranking);
-        let base = format!("{}-{}", spec.name, q.name());
-        plot(
-            &dir.join(format!("{base}-time.svg")),
-            &format!("{}: {} error against time", spec.name, q.name()),
-            "median run time (s)",
-            &by_time,
-        )?;
-        plot(
-            &dir.join(format!("{base}-n.svg")),
-            &format!("{}: {} error against evaluations", spec.name, q.name()),
-            "density evaluations",
-            &by_n,
-        )?;
-        let _ = writeln!(
-            md,
-            "\n![error against time]({base}-time.svg)\n![error against evaluations]({base}-n.svg)\n"
+            "| {} | {} | {} | {:.2e} | {:.2e} | {:.0} | {:.2e} | {} |",
+            label(page, r.rule_index),
+            r.budget,
+            show_value(&r.value),
+            r.rel_error,
+            r.rel_estimate,
+            r.evaluations,
+            r.seconds,
+            flags.join("; ")
         );
     }
-    if !crosscheck.is_empty() {
-        let _ = writeln!(
-            md,
-            "## lightquad vs Mitsuba 3 vs closed form\n\n{crosscheck}"
-        );
-    }
+    md
+}
+
+fn label(page: &Page, i: usize) -> String {
+    page.rules
+        .get(i)
+        .map_or_else(|| format!("rule #{i}"), |r| r.label.clone())
+}
+
+/// Fitted orders, times to the targets and the two plots of one quantity;
+/// returns each rule's time to the middle target.
+fn orders_and_plots(
+    dir: &Path,
+    page: &Page,
+    q: &str,
+    rows: &[Row],
+    md: &mut String,
+) -> Result<Vec<(String, Option<f64>)>, String> {
+    let accuracy = page.reference.accuracy;
     let _ = writeln!(
         md,
-        "Flags: `non-finite value`; `outside 4 standard errors` (a random estimate whose standard \
-         error misses the true error); `estimate off by more than 10x` (a deterministic error \
-         estimate, above the rounding floor); `error grew with the budget`; `cancellation` (V-I \
-         is below 1e-6 of the summed magnitudes of its terms); `tau underflows: log space` (the \
-         optical depth is exact, tau itself is below the smallest f64)."
+        "\n| rule | fitted slope of log error vs log evaluations (order p shows as -p) | {} |\n|---|---:|{}",
+        page.targets
+            .iter()
+            .map(|t| format!("time to {t:.0e} (s)"))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        "---:|".repeat(page.targets.len())
     );
-    write_atomic(&dir.join("report.md"), md.as_bytes()).map_err(|e| e.to_string())?;
-    // CSV of every job.
+    let middle = page
+        .targets
+        .get(page.targets.len() / 2)
+        .copied()
+        .unwrap_or(1e-6);
+    let (mut ranking, mut by_time, mut by_n) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..page.rules.len() {
+        let mine: Vec<&Row> = rows.iter().filter(|r| r.rule_index == i).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let label = label(page, i);
+        let reach = |t: f64| (t >= accuracy).then(|| time_to(&mine, t)).flatten();
+        let times: Vec<String> = page
+            .targets
+            .iter()
+            .map(|&t| match (t < accuracy, reach(t)) {
+                (true, _) => "below reference accuracy".into(),
+                (false, None) => "not reached".into(),
+                (false, Some(s)) => format!("{s:.2e}"),
+            })
+            .collect();
+        let order = order(&mine).map_or("—".into(), |o| format!("{o:.2}"));
+        let _ = writeln!(md, "| {label} | {order} | {} |", times.join(" | "));
+        ranking.push((label.clone(), reach(middle)));
+        // Errors at exactly 0 are drawn at 1e-17; NaN (failed) rows are dropped.
+        let err = |r: &&Row| if r.rel_error.is_nan() { f64::NAN } else { r.rel_error.max(1e-17) };
+        by_time.push((label.clone(), mine.iter().map(|r| (r.seconds.max(1e-9), err(r))).collect()));
+        by_n.push((label, mine.iter().map(|r| (r.evaluations.max(1.0), err(r))).collect()));
+    }
+    let base = format!("{}-{q}", page.name);
+    plot(
+        &dir.join(format!("{base}-time.svg")),
+        &format!("{}: {q} error against time", page.name),
+        "median run time (s)",
+        &by_time,
+    )?;
+    plot(
+        &dir.join(format!("{base}-n.svg")),
+        &format!("{}: {q} error against evaluations", page.name),
+        "evaluations",
+        &by_n,
+    )?;
+    let _ = writeln!(
+        md,
+        "\n![error against time]({base}-time.svg)\n![error against evaluations]({base}-n.svg)\n"
+    );
+    Ok(ranking)
+}
+
+/// A CSV line per job and quantity (a channel vector as `;`-separated numbers).
+fn csv(results: &[JobResult]) -> String {
     let mut csv = String::from(
         "experiment,rule_index,rule,budget,repeat,seed,quantity,value,estimated_error,evaluations,seconds,failure\n",
     );
+    let join = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:e}"))
+            .collect::<Vec<_>>()
+            .join(";")
+    };
     for r in results {
-        if r.values.is_empty() {
-            let _ = writeln!(
-                csv,
-                "{},{},{},{},{},{},,,,,{:e},{}",
-                r.experiment,
-                r.rule_index,
-                r.rule,
-                r.budget,
-                r.repeat,
-                r.seed,
-                r.seconds,
-                r.failure.as_deref().unwrap_or("no value").replace(',', ";")
-            );
+        let lead = format!(
+            "{},{},{},{},{},{}",
+            r.experiment, r.rule_index, r.rule, r.budget, r.repeat, r.seed
+        );
+        let failure = r.failure.as_deref().unwrap_or("").replace([',', '\n'], ";");
+        if r.quantities.is_empty() {
+            let why = if failure.is_empty() { "no value" } else { &failure };
+            let _ = writeln!(csv, "{lead},,,,,{:e},{why}", r.seconds);
         }
-        for (q, v) in &r.values {
+        for (q, m) in &r.quantities {
             let _ = writeln!(
                 csv,
-                "{},{},{},{},{},{},{},{:e},{:e},{},{:e},{}",
-                r.experiment,
-                r.rule_index,
-                r.rule,
-                r.budget,
-                r.repeat,
-                r.seed,
-                q.name(),
-                v,
-                r.estimated_errors.get(q).copied().unwrap_or(f64::NAN),
-                r.evaluations.get(q).copied().unwrap_or(0),
-                r.seconds,
-                r.failure.as_deref().unwrap_or("").replace(',', ";")
+                "{lead},{q},{},{},{},{:e},{failure}",
+                join(&m.value),
+                join(&m.error),
+                m.evaluations,
+                r.seconds
             );
         }
     }
-    write_atomic(&dir.join("results.csv"), csv.as_bytes()).map_err(|e| e.to_string())?;
-    Ok(summary)
+    csv
 }
 
-/// Writes the index page: every experiment, and the rules ranked by time to
-/// the middle target error per quantity.
+/// Writes the index page: every experiment, per quantity the rules ranked by
+/// time to the middle target error, the Mitsuba comparison, and the
+/// families' audits of printed formulas.
 pub fn write_index(
     out: &Path,
     entries: &[(String, String, Summary)],
-    crosscheck: &str,
-    no_crosscheck: bool,
+    crosscheck: &[Crosscheck],
+    audits: &[String],
 ) -> Result<(), String> {
     let mut md = String::from(
         "# lightquad report\n\nEvery experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (1e-6 unless the experiment says otherwise); `not reached` means no budget got there.\n\n",
@@ -497,18 +598,22 @@ pub fn write_index(
                     None => format!("{r} (not reached)"),
                 })
                 .collect();
-            let _ = writeln!(md, "- {}: {}", q.name(), list.join(", "));
+            let _ = writeln!(md, "- {q}: {}", list.join(", "));
         }
         md.push('\n');
     }
-    if !no_crosscheck {
+    if !crosscheck.is_empty() {
         let _ = writeln!(
             md,
             "## lightquad vs Mitsuba 3 vs closed form\n\nEvery case the Mitsuba harness (reference/) covers: \
              lightquad's converged value, Mitsuba's value with its standard error (float32 renderer: \
              expect ~1e-6 relative at best), the closed form where one exists. Mitsuba media have no \
-             volumetric emission, so V-E (and V-I with emission) has no Mitsuba counterpart.\n\n{crosscheck}"
+             volumetric emission, so V-E (and V-I with emission) has no Mitsuba counterpart.\n\n{}",
+            crosscheck_markdown(crosscheck)
         );
+    }
+    for audit in audits {
+        let _ = writeln!(md, "{audit}");
     }
     write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())
 }

@@ -14,13 +14,12 @@ use rand::SeedableRng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::spec::{DepthSchemeSpec, Quantity, RuleSpec, ShadowSpec};
-use super::validate::Experiment;
-use crate::quadrature::{
-    AnyRule, BaseRule, GaussKronrod, GaussLegendre, MonteCarlo, Sobol, Stratified, Trapezoid,
-};
-use crate::volume::tracking::{Extinction, Tracker, transmittance};
-use crate::volume::{DepthScheme, ShadowMethod, VolumeResult, evaluate};
+use super::Loaded;
+use super::validate::{Experiment, min_budget};
+use crate::family::{Family, Measured, Quantity};
+
+/// A job's identity within its experiment: (rule index, budget, repeat).
+pub type JobKey = (usize, usize, usize);
 
 /// One finished job, as written to `results.jsonl`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -29,9 +28,11 @@ pub struct JobResult {
     pub experiment: String,
     /// FNV-1a hash of the experiment file.
     pub experiment_hash: String,
+    /// The equation family.
+    pub family: String,
     /// Index of the rule in the file's `rules`.
     pub rule_index: usize,
-    /// Rule name.
+    /// Rule or estimator name.
     pub rule: String,
     /// Budget (evaluations per smooth piece; walks for tracking).
     pub budget: usize,
@@ -39,22 +40,12 @@ pub struct JobResult {
     pub repeat: usize,
     /// The job's own seed, derived from the file's seed and the job.
     pub seed: u64,
-    /// Value per quantity.
-    pub values: BTreeMap<Quantity, f64>,
-    /// The rule's error estimate per quantity.
-    pub estimated_errors: BTreeMap<Quantity, f64>,
-    /// Density evaluations per quantity.
-    pub evaluations: BTreeMap<Quantity, u64>,
-    /// The summed magnitude of the parts of a quantity (for V-I: |I_E| + |I_B|
-    /// + |I_L|), when it is a sum; the report flags cancellation against it.
-    #[serde(default)]
-    pub magnitudes: BTreeMap<Quantity, f64>,
+    /// Each quantity: its channels, error estimates, cost and flags.
+    pub quantities: BTreeMap<String, Measured>,
     /// Wall time of the evaluation, seconds (the clock is read outside it).
     pub seconds: f64,
     /// Why the job failed, if it did.
     pub failure: Option<String>,
-    /// True when tau underflowed and only its logarithm is meaningful.
-    pub underflow: bool,
     /// lightquad version.
     pub version: String,
     /// Git commit of the build, when known.
@@ -64,31 +55,8 @@ pub struct JobResult {
 }
 
 impl JobResult {
-    /// A result with no values (a scratch record).
-    pub fn empty() -> Self {
-        JobResult {
-            experiment: String::new(),
-            experiment_hash: String::new(),
-            rule_index: 0,
-            rule: String::new(),
-            budget: 0,
-            repeat: 0,
-            seed: 0,
-            values: BTreeMap::new(),
-            estimated_errors: BTreeMap::new(),
-            evaluations: BTreeMap::new(),
-            magnitudes: BTreeMap::new(),
-            seconds: 0.0,
-            failure: None,
-            underflow: false,
-            version: env!("CARGO_PKG_VERSION").to_string(),
-            git_commit: None,
-            machine: String::new(),
-        }
-    }
-
     /// The identity of the job within its experiment.
-    pub fn key(&self) -> (usize, usize, usize) {
+    pub fn key(&self) -> JobKey {
         (self.rule_index, self.budget, self.repeat)
     }
 }
@@ -148,152 +116,50 @@ fn read_machine() -> String {
     format!("{model}, {cores} cores")
 }
 
-/// The quadrature rule a spec names (tracking estimators are not rules).
-pub fn quadrature_rule(spec: &RuleSpec) -> Option<AnyRule> {
-    Some(AnyRule::Base(match spec {
-        RuleSpec::Trapezoid {} => BaseRule::Trapezoid(Trapezoid),
-        RuleSpec::GaussLegendre { error_estimate } => BaseRule::GaussLegendre(GaussLegendre {
-            error_estimate: *error_estimate,
-        }),
-        RuleSpec::GaussKronrod { abs_tol, rel_tol } => BaseRule::GaussKronrod(GaussKronrod {
-            abs_tol: *abs_tol,
-            rel_tol: *rel_tol,
-        }),
-        RuleSpec::MonteCarlo {} => BaseRule::MonteCarlo(MonteCarlo),
-        RuleSpec::Stratified {} => BaseRule::Stratified(Stratified),
-        RuleSpec::Sobol { replicates } => BaseRule::Sobol(Sobol {
-            replicates: *replicates,
-        }),
-        _ => return None,
-    }))
-}
-
-fn tracker(spec: &RuleSpec) -> Option<Tracker> {
-    match spec {
-        RuleSpec::DeltaTracking {} => Some(Tracker::Delta),
-        RuleSpec::RatioTracking {} => Some(Tracker::Ratio),
-        RuleSpec::ResidualRatioTracking {} => Some(Tracker::ResidualRatio),
-        _ => None,
-    }
-}
-
-/// The quantities of a volume result.
-pub fn collect_into(res: &VolumeResult, quantities: &[Quantity], out: &mut JobResult) {
-    for q in quantities {
-        let (v, e, k) = match q {
-            Quantity::Tau => (
-                res.transmittance,
-                res.transmittance * res.optical_depth.error,
-                res.optical_depth.evaluations,
-            ),
-            Quantity::Emission => res
-                .emission
-                .map_or((0.0, 0.0, 0), |t| (t.value, t.error, t.evaluations)),
-            Quantity::Background => res
-                .background
-                .map_or((0.0, 0.0, 0), |t| (t.value, t.error, t.evaluations)),
-            Quantity::Light => res
-                .light
-                .map_or((0.0, 0.0, 0), |t| (t.value, t.error, t.evaluations)),
-            Quantity::Total => {
-                let terms = [res.emission, res.background, res.light];
-                let e = terms.iter().flatten().map(|t| t.error).sum();
-                let k = res.optical_depth.evaluations
-                    + terms.iter().flatten().map(|t| t.evaluations).sum::<u64>();
-                let magnitude = terms.iter().flatten().map(|t| t.value.abs()).sum::<f64>();
-                out.magnitudes.insert(*q, magnitude);
-                (res.total, e, k)
-            }
-        };
-        out.values.insert(*q, v);
-        out.estimated_errors.insert(*q, e);
-        out.evaluations.insert(*q, k);
-    }
-}
-
-/// Runs one job.
-pub fn run_job(
-    exp: &Experiment,
-    hash: &str,
-    rule_index: usize,
-    budget: usize,
-    repeat: usize,
-) -> JobResult {
+/// Runs one job of an experiment.
+pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): JobKey) -> JobResult {
     let spec = &exp.spec;
     let seed = job_seed(spec.seed, rule_index, budget, repeat);
-    let rule_spec = &spec.rules[rule_index.min(spec.rules.len() - 1)];
+    let method = &spec.rules[rule_index.min(spec.rules.len() - 1)];
     let mut out = JobResult {
         experiment: spec.name.clone(),
-        experiment_hash: hash.to_string(),
+        experiment_hash: exp.hash.clone(),
+        family: F::NAME.to_string(),
         rule_index,
-        rule: rule_spec.name().to_string(),
+        rule: method.name().to_string(),
         budget,
         repeat,
         seed,
+        quantities: BTreeMap::new(),
+        seconds: 0.0,
+        failure: None,
+        version: env!("CARGO_PKG_VERSION").to_string(),
         git_commit: Some(env!("LIGHTQUAD_GIT_COMMIT").to_string()).filter(|c| !c.is_empty()),
         machine: machine(),
-        ..JobResult::empty()
     };
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-    let scheme = match spec.depth_scheme {
-        DepthSchemeSpec::Cumulative => DepthScheme::Cumulative,
-        DepthSchemeSpec::Nested => DepthScheme::Nested,
-    };
-    let shadow = match spec.shadow {
-        ShadowSpec::ClosedForm => ShadowMethod::ClosedFormWhereAvailable,
-        ShadowSpec::Quadrature => ShadowMethod::Quadrature,
-    };
-    if let Some(rule) = quadrature_rule(rule_spec) {
-        let start = Instant::now();
-        let res = evaluate(&exp.scene, &rule, budget, scheme, shadow, &mut rng);
-        out.seconds = start.elapsed().as_secs_f64();
-        match res {
-            Ok(res) => {
-                out.underflow = res.underflow;
-                collect_into(&res, &spec.quantities, &mut out);
-            }
-            Err(e) => out.failure = Some(e.to_string()),
+    let start = Instant::now();
+    let outcome = F::evaluate(&exp.scene, method, budget, &mut rng, &spec.quantities);
+    out.seconds = start.elapsed().as_secs_f64();
+    match outcome {
+        Ok(values) => {
+            out.quantities = values
+                .into_iter()
+                .map(|(q, m)| (q.name().to_string(), m))
+                .collect();
         }
-    } else if let Some(tracker) = tracker(rule_spec) {
-        // Tracking estimators compute tau only.
-        if let Some(medium) = exp.scene.medium.as_deref() {
-            let sigma = Extinction {
-                medium,
-                lambda: exp.scene.lambda,
-            };
-            let start = Instant::now();
-            let res = transmittance(
-                tracker,
-                sigma,
-                &exp.scene.ray,
-                exp.scene.t_min,
-                exp.scene.t_max,
-                budget.max(2),
-                &mut rng,
-            );
-            out.seconds = start.elapsed().as_secs_f64();
-            match res {
-                Ok(est) => {
-                    out.values.insert(Quantity::Tau, est.value);
-                    out.estimated_errors.insert(Quantity::Tau, est.error);
-                    out.evaluations.insert(Quantity::Tau, est.evaluations);
-                }
-                Err(e) => out.failure = Some(e.to_string()),
-            }
-        } else {
-            out.values.insert(Quantity::Tau, 1.0);
-            out.estimated_errors.insert(Quantity::Tau, 0.0);
-            out.evaluations.insert(Quantity::Tau, 0);
-        }
+        Err(e) => out.failure = Some(e.to_string()),
     }
     out
 }
 
-/// Every job of an experiment in a fixed order, restricted to a shard.
-pub fn jobs(exp: &Experiment, shard: Option<(usize, usize)>) -> Vec<(usize, usize, usize)> {
+/// Every job of an experiment in a fixed order, restricted to a shard; a
+/// rule's budgets below its minimum are left out.
+pub fn jobs<F: Family>(exp: &Experiment<F>, shard: Option<(usize, usize)>) -> Vec<JobKey> {
     let mut all = Vec::new();
-    for (r, rule) in exp.spec.rules.iter().enumerate() {
-        for &b in exp.budgets.iter().filter(|&&b| b >= rule.min_budget()) {
+    for (r, method) in exp.spec.rules.iter().enumerate() {
+        let least = min_budget::<F>(method, &exp.spec.quantities);
+        for &b in exp.budgets.iter().filter(|&&b| b >= least) {
             for k in 0..exp.spec.repeats {
                 all.push((r, b, k));
             }
@@ -345,12 +211,11 @@ pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
 /// Runs one experiment's pending jobs, appending to `<out>/<name>/results.jsonl`;
 /// returns every result of the experiment (old and new), sorted by job.
 pub fn run_experiment(
-    exp: &Experiment,
-    hash: &str,
+    exp: &dyn Loaded,
     opts: &RunOptions,
     progress: &indicatif::ProgressBar,
 ) -> std::io::Result<Vec<JobResult>> {
-    let dir = opts.out.join(&exp.spec.name);
+    let dir = opts.out.join(exp.name());
     fs::create_dir_all(&dir)?;
     let path = dir.join(match opts.shard {
         None => "results.jsonl".to_string(),
@@ -362,7 +227,7 @@ pub fn run_experiment(
         // Lines of this experiment file and this lightquad version only, one per
         // job (the last wins).
         let mut by_key = BTreeMap::new();
-        for r in read_results(&path, Some(hash)) {
+        for r in read_results(&path, Some(exp.hash())) {
             if r.version == env!("CARGO_PKG_VERSION") {
                 by_key.insert(r.key(), r);
             }
@@ -378,16 +243,16 @@ pub fn run_experiment(
     }
     write_atomic(&path, text.as_bytes())?;
     let done: BTreeSet<_> = kept.iter().map(JobResult::key).collect();
-    let pending: Vec<_> = jobs(exp, opts.shard)
+    let pending: Vec<_> = exp.jobs(opts.shard)
         .into_iter()
         .filter(|j| !done.contains(j))
         .collect();
-    progress.inc((jobs(exp, opts.shard).len() - pending.len()) as u64);
+    progress.inc((exp.jobs(opts.shard).len() - pending.len()) as u64);
     let file = Mutex::new(OpenOptions::new().append(true).open(&path)?);
     let fresh: Vec<std::io::Result<JobResult>> = pending
         .par_iter()
-        .map(|&(r, b, k)| {
-            let result = run_job(exp, hash, r, b, k);
+        .map(|&key| {
+            let result = exp.run_job(key);
             let line = serde_json::to_string(&result).map_err(std::io::Error::other)? + "\n";
             // One write per line, flushed, so a killed run leaves whole lines.
             let mut f = file

@@ -12,7 +12,10 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use super::Rule;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::{Dimensions, Rule};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::quadrature::nodes::non_finite;
@@ -20,11 +23,15 @@ use crate::sum::Compensated;
 use crate::value::Value;
 
 /// Adaptive G7–K15 on `[0, 1]` (1-D only).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GaussKronrod {
-    /// Stop when the estimated error is below this absolute tolerance.
+    /// Stop when the estimated error is below this absolute tolerance
+    /// (default 0: use the whole budget).
+    #[serde(default)]
     pub abs_tol: f64,
-    /// Stop when the estimated error is below this fraction of `|Q|`.
+    /// Stop when the estimated error is below this fraction of `|Q|` (default 0).
+    #[serde(default)]
     pub rel_tol: f64,
 }
 
@@ -91,7 +98,7 @@ impl<V: Value> Ord for Piece<V> {
 }
 
 /// Applies the G7–K15 pair on `[a, b]`.
-fn kronrod_piece<V: Value, F: FnMut([f64; 1]) -> V>(
+fn kronrod_piece<V: Value, F: FnMut([f64; 1]) -> Result<V, QuadError>>(
     a: f64,
     b: f64,
     f: &mut F,
@@ -99,7 +106,7 @@ fn kronrod_piece<V: Value, F: FnMut([f64; 1]) -> V>(
     let centre = 0.5 * (a + b);
     let half = 0.5 * (b - a);
     let mut eval = |u: f64| -> Result<V, QuadError> {
-        let y = f([u]);
+        let y = f([u])?;
         if y.all_finite() {
             Ok(y)
         } else {
@@ -159,7 +166,34 @@ impl Rule for GaussKronrod {
         "gauss-kronrod"
     }
 
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn about(&self) -> &'static str {
+        "adaptive Gauss–Kronrod G7-K15 on [0,1] (1-D); embedded error estimate"
+    }
+
+    /// One G7-K15 panel.
+    fn min_budget(&self, _dim: usize) -> usize {
+        15
+    }
+
+    fn dimensions(&self) -> Dimensions {
+        Dimensions { min: 1, max: 1 }
+    }
+
+    fn check(&self) -> Result<(), QuadError> {
+        for (name, tol) in [("abs_tol", self.abs_tol), ("rel_tol", self.rel_tol)] {
+            if !(tol.is_finite() && tol >= 0.0) {
+                return Err(QuadError::invalid(name, tol, "a finite number >= 0"));
+            }
+        }
+        Ok(())
+    }
+
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         _rng: &mut R,
@@ -172,11 +206,7 @@ impl Rule for GaussKronrod {
                 supported: "1",
             });
         }
-        for (name, tol) in [("abs_tol", self.abs_tol), ("rel_tol", self.rel_tol)] {
-            if !(tol.is_finite() && tol >= 0.0) {
-                return Err(QuadError::invalid(name, tol, "a finite number >= 0"));
-            }
-        }
+        self.check()?;
         if n < 15 {
             return Err(QuadError::invalid(
                 "n",

@@ -5,6 +5,14 @@
 //! [`domain`](crate::domain)'s job) nor which equation it serves. Every rule
 //! implements [`Rule`]; [`AnyRule`] selects one by name at run time.
 //!
+//! **The registry** is the one [`registry!`] line per rule below: it declares
+//! the rule's module and its name in experiment files, and generates
+//! [`BaseRule`] (the serde rule spec, tagged by `"rule"`, every parameter a
+//! field of the rule's own struct) with dispatch of every [`Rule`] method.
+//! Facts about a rule (its minimum budget, whether it is random, the
+//! dimensions it integrates, the check of its parameters) are methods of the
+//! rule itself. Adding a rule is its file plus one registry line.
+//!
 //! | name | rule | error estimate |
 //! |---|---|---|
 //! | `trapezoid` | composite trapezoid, product in D > 1 | Richardson, half step |
@@ -13,44 +21,108 @@
 //! | `monte-carlo` | plain Monte Carlo | standard error |
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
 //! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles |
-//! | `product(A,B)` | iterated 2-D rule from any two 1-D rules | outer estimate + integrated inner estimates |
+//! | `product` | iterated 2-D rule from any two 1-D rules (`product(A,B)` on the command line) | outer estimate + integrated inner estimates |
 
-pub mod gauss_kronrod;
-pub mod gauss_legendre;
-pub mod monte_carlo;
 pub mod nodes;
 pub mod product;
-pub mod sobol;
-pub mod stratified;
-pub mod trapezoid;
 
-pub use gauss_kronrod::GaussKronrod;
-pub use gauss_legendre::GaussLegendre;
-pub use monte_carlo::MonteCarlo;
 pub use product::Product;
-pub use sobol::Sobol;
-pub use stratified::Stratified;
-pub use trapezoid::Trapezoid;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
+
+/// The dimensions `min..=max` of the unit cube a rule integrates over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Dimensions {
+    /// Smallest dimension.
+    pub min: usize,
+    /// Largest dimension.
+    pub max: usize,
+}
+
+impl Dimensions {
+    /// Every dimension from 1.
+    pub const ANY: Dimensions = Dimensions {
+        min: 1,
+        max: usize::MAX,
+    };
+
+    /// True when `dim` is in range.
+    pub fn contains(&self, dim: usize) -> bool {
+        (self.min..=self.max).contains(&dim)
+    }
+}
+
+impl std::fmt::Display for Dimensions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (self.min, self.max) {
+            (a, usize::MAX) => write!(f, "{a} and up"),
+            (a, b) if a == b => write!(f, "{a} only"),
+            (a, b) => write!(f, "{a} to {b}"),
+        }
+    }
+}
 
 /// A quadrature rule on the unit cube `[0, 1]^D`.
 pub trait Rule {
     /// The registry name (`gauss-legendre`, ...).
     fn name(&self) -> &'static str;
 
-    /// Estimates `int_{[0,1]^D} f(u) du` with a budget of about `n` evaluations.
+    /// One line on what the rule is and how it estimates its error.
+    fn about(&self) -> &'static str;
+
+    /// The smallest budget the rule accepts in `dim` dimensions (an experiment
+    /// skips smaller budgets for it).
+    fn min_budget(&self, _dim: usize) -> usize {
+        1
+    }
+
+    /// True for randomised rules (their error estimate is a standard error).
+    fn is_random(&self) -> bool {
+        false
+    }
+
+    /// The dimensions the rule integrates over.
+    fn dimensions(&self) -> Dimensions {
+        Dimensions::ANY
+    }
+
+    /// Checks the rule's parameters; the error names the parameter.
+    fn check(&self) -> Result<(), QuadError> {
+        Ok(())
+    }
+
+    /// Estimates `int_{[0,1]^D} f(u) du` with a budget of about `n` evaluations,
+    /// for an integrand that may fail: its first error stops the rule and is
+    /// returned as is.
     ///
     /// `rng` drives the randomised rules and is ignored by deterministic ones;
     /// with the same `rng` state the result is bit-for-bit reproducible.
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError>;
+
+    /// [`Rule::try_integrate`] for an integrand that cannot fail.
+    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+        &self,
+        n: usize,
+        rng: &mut R,
+        mut f: F,
+    ) -> Result<Estimate<V>, QuadError> {
+        self.try_integrate(n, rng, |u| Ok(f(u)))
+    }
 }
 
 /// Nodes per axis for a product rule with a budget of `n` evaluations in `D`
@@ -76,56 +148,118 @@ pub fn per_axis<const D: usize>(n: usize, min: usize, name: &str) -> Result<usiz
     Ok(m.max(min))
 }
 
-/// One line of `lightquad rules` per single rule: name and description.
-pub const RULES: &[(&str, &str)] = &[
-    (
-        "trapezoid",
-        "composite trapezoid (product rule in 2-D); Richardson error estimate from the half-step rule",
-    ),
-    (
-        "gauss-legendre",
-        "Gauss–Legendre of any order 1..=1e8 (product rule in 2-D); error estimate from Q_m, Q_(m-1), Q_(m-2)",
-    ),
-    (
-        "gauss-kronrod",
-        "adaptive Gauss–Kronrod G7-K15 on [0,1] (1-D); embedded error estimate",
-    ),
-    ("monte-carlo", "plain Monte Carlo, seeded; standard error"),
-    (
-        "stratified",
-        "stratified (jittered) Monte Carlo, one sample per cell; second-difference standard error",
-    ),
-    (
-        "sobol",
-        "Owen-scrambled Sobol' points (1-D and 2-D), 8 independent scrambles; standard error",
-    ),
-];
+/// Declares the rule modules and generates [`BaseRule`], its dispatch and the
+/// serde form of [`AnyRule`] from one line per rule:
+/// `module::Type = "name in experiment files"`.
+macro_rules! registry {
+    ($($module:ident :: $rule:ident = $name:literal),+ $(,)?) => {
+        $(
+            pub mod $module;
+            pub use $module::$rule;
+        )+
 
-/// The `lightquad rules` line for products, which take two rule names.
-pub const PRODUCT_RULE: (&str, &str) = (
-    "product(A,B)",
-    "2-D iterated rule from any two rules above: A over the first coordinate, B over the second",
-);
+        /// A single rule selected at run time (every rule but the product); its
+        /// serde form is the rule spec of experiment files,
+        /// `{"rule": "<name>", <the rule's parameters>}`.
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+        #[serde(tag = "rule")]
+        pub enum BaseRule {
+            $(
+                #[doc = concat!("`", $name, "`: [`", stringify!($rule), "`].")]
+                #[serde(rename = $name)]
+                $rule($rule),
+            )+
+        }
 
-/// A single rule selected at run time (every rule but the product).
-#[derive(Debug, Clone, PartialEq)]
-pub enum BaseRule {
-    /// [`Trapezoid`].
-    Trapezoid(Trapezoid),
-    /// [`GaussLegendre`].
-    GaussLegendre(GaussLegendre),
-    /// [`GaussKronrod`].
-    GaussKronrod(GaussKronrod),
-    /// [`MonteCarlo`].
-    MonteCarlo(MonteCarlo),
-    /// [`Stratified`].
-    Stratified(Stratified),
-    /// [`Sobol`].
-    Sobol(Sobol),
+        /// The serde form of [`AnyRule`]: every single rule, and `product`.
+        #[derive(Serialize, Deserialize, JsonSchema)]
+        #[serde(tag = "rule")]
+        #[schemars(rename = "Rule")]
+        enum AnyRuleSpec {
+            $(
+                #[doc = concat!("`", $name, "`: [`", stringify!($rule), "`].")]
+                #[serde(rename = $name)]
+                $rule($rule),
+            )+
+            /// `product`: the iterated 2-D rule of two single rules.
+            #[serde(rename = "product")]
+            Product(Product<BaseRule, BaseRule>),
+        }
+
+        impl From<AnyRuleSpec> for AnyRule {
+            fn from(spec: AnyRuleSpec) -> Self {
+                match spec {
+                    $(AnyRuleSpec::$rule(r) => AnyRule::Base(BaseRule::$rule(r)),)+
+                    AnyRuleSpec::Product(p) => AnyRule::Product(Box::new(p)),
+                }
+            }
+        }
+
+        impl From<AnyRule> for AnyRuleSpec {
+            fn from(rule: AnyRule) -> Self {
+                match rule {
+                    $(AnyRule::Base(BaseRule::$rule(r)) => AnyRuleSpec::$rule(r),)+
+                    AnyRule::Product(p) => AnyRuleSpec::Product(*p),
+                }
+            }
+        }
+
+        impl BaseRule {
+            /// Every single rule with its default parameters, in registry order.
+            pub fn defaults() -> Vec<BaseRule> {
+                vec![$(BaseRule::$rule(<$rule>::default())),+]
+            }
+        }
+
+        impl Rule for BaseRule {
+            fn name(&self) -> &'static str {
+                match self { $(BaseRule::$rule(r) => r.name(),)+ }
+            }
+            fn about(&self) -> &'static str {
+                match self { $(BaseRule::$rule(r) => r.about(),)+ }
+            }
+            fn min_budget(&self, dim: usize) -> usize {
+                match self { $(BaseRule::$rule(r) => r.min_budget(dim),)+ }
+            }
+            fn is_random(&self) -> bool {
+                match self { $(BaseRule::$rule(r) => r.is_random(),)+ }
+            }
+            fn dimensions(&self) -> Dimensions {
+                match self { $(BaseRule::$rule(r) => r.dimensions(),)+ }
+            }
+            fn check(&self) -> Result<(), QuadError> {
+                match self { $(BaseRule::$rule(r) => r.check(),)+ }
+            }
+            fn try_integrate<
+                const D: usize,
+                V: Value,
+                R: rand::Rng + ?Sized,
+                F: FnMut([f64; D]) -> Result<V, QuadError>,
+            >(
+                &self,
+                n: usize,
+                rng: &mut R,
+                f: F,
+            ) -> Result<Estimate<V>, QuadError> {
+                match self { $(BaseRule::$rule(r) => r.try_integrate(n, rng, f),)+ }
+            }
+        }
+    };
 }
 
-/// Any rule selected at run time, products included.
-#[derive(Debug, Clone, PartialEq)]
+registry! {
+    trapezoid::Trapezoid = "trapezoid",
+    gauss_legendre::GaussLegendre = "gauss-legendre",
+    gauss_kronrod::GaussKronrod = "gauss-kronrod",
+    monte_carlo::MonteCarlo = "monte-carlo",
+    stratified::Stratified = "stratified",
+    sobol::Sobol = "sobol",
+}
+
+/// Any rule selected at run time, products included. Its serde form is a
+/// single rule's, or `{"rule": "product", "outer": {..}, "inner": {..}}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "AnyRuleSpec", into = "AnyRuleSpec")]
 pub enum AnyRule {
     /// One rule.
     Base(BaseRule),
@@ -134,21 +268,26 @@ pub enum AnyRule {
     Product(Box<Product<BaseRule, BaseRule>>),
 }
 
+impl JsonSchema for AnyRule {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        AnyRuleSpec::schema_name()
+    }
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        AnyRuleSpec::json_schema(generator)
+    }
+}
+
 impl BaseRule {
     /// The rule named `name` with its default parameters.
     pub fn by_name(name: &str) -> Result<BaseRule, QuadError> {
-        Ok(match name.trim() {
-            "trapezoid" => BaseRule::Trapezoid(Trapezoid),
-            "gauss-legendre" => BaseRule::GaussLegendre(GaussLegendre::default()),
-            "gauss-kronrod" => BaseRule::GaussKronrod(GaussKronrod::default()),
-            "monte-carlo" => BaseRule::MonteCarlo(MonteCarlo),
-            "stratified" => BaseRule::Stratified(Stratified),
-            "sobol" => BaseRule::Sobol(Sobol::default()),
-            other => {
-                return Err(QuadError::UnknownRule {
-                    name: other.to_string(),
-                    known: RULES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
-                });
+        serde_json::from_value(serde_json::json!({ "rule": name.trim() })).map_err(|_| {
+            QuadError::UnknownRule {
+                name: name.trim().to_string(),
+                known: BaseRule::defaults()
+                    .iter()
+                    .map(Rule::name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
             }
         })
     }
@@ -177,40 +316,24 @@ impl AnyRule {
         }
         BaseRule::by_name(name).map(AnyRule::Base)
     }
+
+    /// Every rule's name and one line about it, products last (for `lightquad rules`).
+    pub fn listing() -> Vec<(&'static str, &'static str)> {
+        let mut lines: Vec<(&'static str, &'static str)> = BaseRule::defaults()
+            .iter()
+            .map(|r| (r.name(), r.about()))
+            .collect();
+        lines.push((
+            "product",
+            "2-D iterated rule of two single rules: {\"rule\": \"product\", \"outer\": {..}, \"inner\": {..}} (CLI: product(A,B))",
+        ));
+        lines
+    }
 }
 
 impl From<BaseRule> for AnyRule {
     fn from(rule: BaseRule) -> Self {
         AnyRule::Base(rule)
-    }
-}
-
-impl Rule for BaseRule {
-    fn name(&self) -> &'static str {
-        match self {
-            BaseRule::Trapezoid(r) => r.name(),
-            BaseRule::GaussLegendre(r) => r.name(),
-            BaseRule::GaussKronrod(r) => r.name(),
-            BaseRule::MonteCarlo(r) => r.name(),
-            BaseRule::Stratified(r) => r.name(),
-            BaseRule::Sobol(r) => r.name(),
-        }
-    }
-
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
-        &self,
-        n: usize,
-        rng: &mut R,
-        f: F,
-    ) -> Result<Estimate<V>, QuadError> {
-        match self {
-            BaseRule::Trapezoid(r) => r.integrate(n, rng, f),
-            BaseRule::GaussLegendre(r) => r.integrate(n, rng, f),
-            BaseRule::GaussKronrod(r) => r.integrate(n, rng, f),
-            BaseRule::MonteCarlo(r) => r.integrate(n, rng, f),
-            BaseRule::Stratified(r) => r.integrate(n, rng, f),
-            BaseRule::Sobol(r) => r.integrate(n, rng, f),
-        }
     }
 }
 
@@ -221,16 +344,50 @@ impl Rule for AnyRule {
             AnyRule::Product(r) => r.name(),
         }
     }
-
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn about(&self) -> &'static str {
+        match self {
+            AnyRule::Base(r) => r.about(),
+            AnyRule::Product(r) => r.about(),
+        }
+    }
+    fn min_budget(&self, dim: usize) -> usize {
+        match self {
+            AnyRule::Base(r) => r.min_budget(dim),
+            AnyRule::Product(r) => r.min_budget(dim),
+        }
+    }
+    fn is_random(&self) -> bool {
+        match self {
+            AnyRule::Base(r) => r.is_random(),
+            AnyRule::Product(r) => r.is_random(),
+        }
+    }
+    fn dimensions(&self) -> Dimensions {
+        match self {
+            AnyRule::Base(r) => r.dimensions(),
+            AnyRule::Product(r) => r.dimensions(),
+        }
+    }
+    fn check(&self) -> Result<(), QuadError> {
+        match self {
+            AnyRule::Base(r) => r.check(),
+            AnyRule::Product(r) => r.check(),
+        }
+    }
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
         match self {
-            AnyRule::Base(r) => r.integrate(n, rng, f),
-            AnyRule::Product(r) => r.integrate(n, rng, f),
+            AnyRule::Base(r) => r.try_integrate(n, rng, f),
+            AnyRule::Product(r) => r.try_integrate(n, rng, f),
         }
     }
 }
@@ -247,4 +404,19 @@ fn split_top_level_comma(s: &str) -> Option<(&str, &str)> {
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The registry's name for a rule (its serde tag) is the rule's own name.
+    #[test]
+    fn registry_names_match_rule_names() {
+        for rule in BaseRule::defaults() {
+            let json = serde_json::to_value(&rule).expect("serialises");
+            assert_eq!(json["rule"], rule.name());
+            assert_eq!(BaseRule::by_name(rule.name()), Ok(rule));
+        }
+    }
 }

@@ -2,6 +2,9 @@
 //! on `[0, 1)^D`; standard error `s / sqrt(N)` with the sample standard deviation
 //! `s` accumulated by Welford's update (no cancellation when the mean is large).
 
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
 use super::Rule;
 use crate::error::QuadError;
 use crate::estimate::Estimate;
@@ -10,7 +13,8 @@ use crate::value::Value;
 use rand::RngExt;
 
 /// Plain Monte Carlo with independent uniform samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct MonteCarlo;
 
 /// Welford's running mean and sum of squared deviations, per channel.
@@ -70,7 +74,25 @@ impl Rule for MonteCarlo {
         "monte-carlo"
     }
 
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn about(&self) -> &'static str {
+        "plain Monte Carlo, seeded; standard error"
+    }
+
+    /// Two samples: a standard error needs them.
+    fn min_budget(&self, _dim: usize) -> usize {
+        2
+    }
+
+    fn is_random(&self) -> bool {
+        true
+    }
+
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         rng: &mut R,
@@ -89,7 +111,7 @@ impl Rule for MonteCarlo {
             for c in p.iter_mut() {
                 *c = rng.random::<f64>();
             }
-            let y = f(p);
+            let y = f(p)?;
             if !y.all_finite() {
                 return Err(non_finite(&p, &y));
             }

@@ -46,7 +46,7 @@ pub struct ProductSum<V: Value> {
 ///
 /// This is the only place where a deterministic rule meets the integrand.
 /// A non-finite integrand value stops the sum with an error naming the point.
-pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> V>(
+pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
     axes: [&UnitNodes; D],
     mut f: F,
 ) -> Result<ProductSum<V>, QuadError> {
@@ -71,7 +71,7 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> V>(
             None => {
                 for (&u, &w) in a.u.iter().zip(&a.w) {
                     p[0] = u;
-                    let y = f(p);
+                    let y = f(p)?;
                     if !y.all_finite() {
                         return Err(non_finite(&p, &y));
                     }
@@ -81,7 +81,7 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> V>(
             Some(companion) => {
                 for ((&u, &w), &c) in a.u.iter().zip(&a.w).zip(companion) {
                     p[0] = u;
-                    let y = f(p);
+                    let y = f(p)?;
                     if !y.all_finite() {
                         return Err(non_finite(&p, &y));
                     }
@@ -105,7 +105,7 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> V>(
                     wc *= axes[d].companion.as_ref().map_or(0.0, |c| c[idx[d]]);
                 }
             }
-            let y = f(p);
+            let y = f(p)?;
             evaluations += 1;
             if !y.all_finite() {
                 return Err(non_finite(&p, &y));

@@ -13,14 +13,18 @@
 
 use rand::SeedableRng;
 
-use super::{Rule, per_axis};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::{Dimensions, Rule, per_axis};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
 
 /// The iterated product of an `outer` rule (first coordinate) and an `inner`
 /// rule (second coordinate).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Product<A, B> {
     /// Rule over the first coordinate.
     pub outer: A,
@@ -82,7 +86,47 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
         "product"
     }
 
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn about(&self) -> &'static str {
+        "2-D iterated rule: outer over the first coordinate, inner over the second"
+    }
+
+    /// Both factors get `floor(sqrt(n))` nodes: each needs its own minimum.
+    fn min_budget(&self, _dim: usize) -> usize {
+        let m = self.outer.min_budget(1).max(self.inner.min_budget(1));
+        m.saturating_mul(m)
+    }
+
+    fn is_random(&self) -> bool {
+        self.outer.is_random() || self.inner.is_random()
+    }
+
+    fn dimensions(&self) -> Dimensions {
+        Dimensions { min: 2, max: 2 }
+    }
+
+    fn check(&self) -> Result<(), QuadError> {
+        for (field, rule) in [
+            ("outer", &self.outer as &dyn Facts),
+            ("inner", &self.inner as &dyn Facts),
+        ] {
+            if !rule.dims().contains(1) {
+                return Err(QuadError::invalid(
+                    field,
+                    rule.rule_name(),
+                    "a rule that integrates in one dimension",
+                ));
+            }
+            rule.check_params()?;
+        }
+        Ok(())
+    }
+
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         rng: &mut R,
@@ -100,35 +144,19 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
         // result is reproducible from the caller's rng state.
         let mut inner_rng = rand_pcg::Pcg64::seed_from_u64(rng.next_u64());
         let mut inner_evaluations = 0u64;
-        let mut failure: Option<QuadError> = None;
-        let outer = self.outer.integrate(m, rng, |u: [f64; 1]| {
-            if failure.is_some() {
-                return WithError::<V>::zero();
-            }
-            let inner = self.inner.integrate(m, &mut inner_rng, |v: [f64; 1]| {
+        let outer = self.outer.try_integrate(m, rng, |u: [f64; 1]| {
+            let inner = self.inner.try_integrate(m, &mut inner_rng, |v: [f64; 1]| {
                 let mut p = [0.0; D];
                 p[0] = u[0];
                 p[1] = v[0];
                 f(p)
-            });
-            match inner {
-                Ok(est) => {
-                    inner_evaluations += est.evaluations;
-                    WithError {
-                        value: est.value,
-                        error: est.error,
-                    }
-                }
-                Err(e) => {
-                    failure = Some(e);
-                    WithError::<V>::zero()
-                }
-            }
-        });
-        if let Some(e) = failure {
-            return Err(e);
-        }
-        let outer = outer?;
+            })?;
+            inner_evaluations += inner.evaluations;
+            Ok(WithError {
+                value: inner.value,
+                error: inner.error,
+            })
+        })?;
         // Total error: the outer rule's estimate for g plus the integrated
         // inner estimates.
         let error =
@@ -138,5 +166,25 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
             error,
             evaluations: inner_evaluations,
         })
+    }
+}
+
+/// The facts of a factor that [`Product::check`] needs, object-safe (a
+/// [`Rule`] itself is not: its integration is generic).
+trait Facts {
+    fn dims(&self) -> Dimensions;
+    fn rule_name(&self) -> &'static str;
+    fn check_params(&self) -> Result<(), QuadError>;
+}
+
+impl<T: Rule> Facts for T {
+    fn dims(&self) -> Dimensions {
+        self.dimensions()
+    }
+    fn rule_name(&self) -> &'static str {
+        self.name()
+    }
+    fn check_params(&self) -> Result<(), QuadError> {
+        self.check()
     }
 }

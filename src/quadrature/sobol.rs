@@ -15,7 +15,10 @@
 //! eight means / sqrt 8). For smooth integrands the error falls like
 //! `N^(-3/2)` up to log factors.
 
-use super::Rule;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::{Dimensions, Rule};
 use super::monte_carlo::Welford;
 use crate::error::QuadError;
 use crate::estimate::Estimate;
@@ -24,15 +27,26 @@ use crate::sum::Compensated;
 use crate::value::Value;
 
 /// Owen-scrambled Sobol' points, `replicates` independent scrambles.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Sobol {
-    /// Number of independent scrambles (>= 2) used for the standard error.
+    /// Number of independent scrambles (>= 2) used for the standard error
+    /// (default 8).
+    #[serde(default = "Sobol::default_replicates")]
     pub replicates: usize,
+}
+
+impl Sobol {
+    fn default_replicates() -> usize {
+        8
+    }
 }
 
 impl Default for Sobol {
     fn default() -> Self {
-        Sobol { replicates: 8 }
+        Sobol {
+            replicates: Sobol::default_replicates(),
+        }
     }
 }
 
@@ -98,7 +112,40 @@ impl Rule for Sobol {
         "sobol"
     }
 
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn about(&self) -> &'static str {
+        "Owen-scrambled Sobol' points (1-D and 2-D), independent scrambles (default 8); standard error"
+    }
+
+    /// One point per scramble.
+    fn min_budget(&self, _dim: usize) -> usize {
+        self.replicates
+    }
+
+    fn is_random(&self) -> bool {
+        true
+    }
+
+    fn dimensions(&self) -> Dimensions {
+        Dimensions { min: 1, max: 2 }
+    }
+
+    fn check(&self) -> Result<(), QuadError> {
+        if self.replicates < 2 {
+            return Err(QuadError::invalid(
+                "replicates",
+                self.replicates,
+                "an integer >= 2 (the standard error needs two scrambles)",
+            ));
+        }
+        Ok(())
+    }
+
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         rng: &mut R,
@@ -111,14 +158,8 @@ impl Rule for Sobol {
                 supported: "1 and 2",
             });
         }
+        self.check()?;
         let reps = self.replicates;
-        if reps < 2 {
-            return Err(QuadError::invalid(
-                "replicates",
-                reps,
-                "an integer >= 2 (the standard error needs two scrambles)",
-            ));
-        }
         if n < reps {
             return Err(QuadError::invalid(
                 "n",
@@ -141,7 +182,7 @@ impl Rule for Sobol {
                 for (d, c) in p.iter_mut().enumerate() {
                     *c = to_unit(owen_scramble(sobol_u32(i, d), seeds[d]));
                 }
-                let y = f(p);
+                let y = f(p)?;
                 if !y.all_finite() {
                     return Err(non_finite(&p, &y));
                 }

@@ -14,6 +14,9 @@
 //! `Var(Q) = (1/N^2) sum_i sigma_i^2 ~ (1/N^2) (N / T) sum_triples (...)^2 / 6`
 //! over the `T` triples.
 
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
 use super::{Rule, per_axis};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
@@ -23,7 +26,8 @@ use crate::value::Value;
 use rand::RngExt;
 
 /// Jittered sampling, one sample per cell of an `m^D` grid.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Stratified;
 
 impl Rule for Stratified {
@@ -31,7 +35,29 @@ impl Rule for Stratified {
         "stratified"
     }
 
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn about(&self) -> &'static str {
+        "stratified (jittered) Monte Carlo, one sample per cell; second-difference standard error"
+    }
+
+    /// Two cells per axis: the standard error compares neighbouring cells.
+    fn min_budget(&self, dim: usize) -> usize {
+        if dim <= 1 {
+            2
+        } else {
+            2usize.saturating_pow(dim as u32)
+        }
+    }
+
+    fn is_random(&self) -> bool {
+        true
+    }
+
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         rng: &mut R,
@@ -60,7 +86,7 @@ impl Rule for Stratified {
             for d in 0..D {
                 p[d] = (idx[d] as f64 + rng.random::<f64>()) * inv_m;
             }
-            let y = f(p);
+            let y = f(p)?;
             if !y.all_finite() {
                 return Err(non_finite(&p, &y));
             }

@@ -7,6 +7,9 @@
 //! `|T_h - T_{2h}| / 3` of the error of `T_h` costs no extra evaluation. To keep
 //! that nesting, `m` is odd: a budget `n` gives the largest odd `m <= n^(1/D)`.
 
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
 use super::nodes::{UnitNodes, product_sum};
 use super::{Rule, per_axis};
 use crate::error::QuadError;
@@ -17,7 +20,8 @@ use crate::value::Value;
 pub const MAX_POINTS: usize = 100_000_000;
 
 /// Composite trapezoid rule (tensor product in D > 1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct Trapezoid;
 
 /// The m-point trapezoid rule on `[0, 1]` (m odd, >= 3) with the `2h` companion.
@@ -47,7 +51,21 @@ impl Rule for Trapezoid {
         "trapezoid"
     }
 
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn about(&self) -> &'static str {
+        "composite trapezoid (product rule in D > 1); Richardson error estimate from the half-step rule"
+    }
+
+    /// Three nodes per axis: the half-step rule of the estimate needs them.
+    fn min_budget(&self, dim: usize) -> usize {
+        3usize.saturating_pow(dim as u32)
+    }
+
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         _rng: &mut R,

@@ -16,7 +16,12 @@
 //! - printed: `exp(-lambda kappa (-<p,d>/<d,d>) + sqrt(<p,d>^2 - <p,p><d,d>)/<d,d>) I_p`
 //!   (the factor reaches only the first summand, audit point 2).
 
+use rand::SeedableRng;
+
+use super::{ConstantSphere, Medium};
 use crate::domain::Vec3;
+use crate::geometry::Ray;
+use crate::quadrature::AnyRule;
 
 /// `s(p)` as corrected: the positive root of `|p + s d|^2 = R^2`, written
 /// exactly as the document's formula with the radius term restored.
@@ -44,4 +49,56 @@ pub fn light_printed(p: Vec3, d: Vec3, lambda_kappa: f64, intensity: f64) -> f64
     let pd = p.dot(&d);
     let dd = d.dot(&d);
     (-lambda_kappa * (-pd / dd) + (pd * pd - p.dot(&p) * dd).sqrt() / dd).exp() * intensity
+}
+
+/// The audit as a Markdown section: the printed `s(t)` and `I_p(t)` at four
+/// points against the corrected formulas and a quadrature shadow ray.
+pub fn markdown() -> String {
+    let mut out = String::new();
+    out.push_str(
+        "\n## Volume family: V-Lp audit: the printed s(t) against the corrected root and a quadrature shadow ray\n\n\
+         Sphere of radius 1.5 at the origin, lambda kappa = 0.8, I_p = 1, light direction \
+         d = (0.3, 0.8, -0.2)/|.|. `s` by quadrature is the shadow ray's optical depth \
+         (64-node Gauss–Legendre) divided by lambda kappa. The printed radicand \
+         <p,d>^2 - <p,p><d,d> is never positive (Cauchy–Schwarz): NaN off the line through \
+         the centre (docs/EQUATIONS.md audit points 1 and 2).\n\n\
+         | point p | s printed | s corrected | s by quadrature | I_p printed | I_p corrected |\n\
+         |---|---:|---:|---:|---:|---:|\n",
+    );
+    let (r, lk) = (1.5, 0.8);
+    let d = Vec3::new(0.3, 0.8, -0.2).normalize();
+    let Ok(medium) = ConstantSphere::new(Vec3::zeros(), r, 1.0) else {
+        return out;
+    };
+    for p in [
+        Vec3::new(0.1, 0.2, 0.3),
+        Vec3::new(-1.0, 0.5, 0.2),
+        Vec3::new(0.0, 0.0, 1.4),
+        d * 0.5,
+    ] {
+        let s_quad = Ray::new(p, d).ok().and_then(|ray| {
+            let rule = AnyRule::by_name("gauss-legendre").ok()?;
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+            let mut total = 0.0;
+            for piece in medium.support(&ray, 0.0, f64::INFINITY) {
+                total += piece
+                    .integrate(&rule, 64, &mut rng, |t| medium.density(ray.at(t)))
+                    .ok()?
+                    .value;
+            }
+            Some(total)
+        });
+        out.push_str(&format!(
+            "| ({:.2}, {:.2}, {:.2}) | {} | {:.15} | {} | {} | {:.15} |\n",
+            p.x,
+            p.y,
+            p.z,
+            s_printed(p, d),
+            s_corrected(p, d, r),
+            s_quad.map_or("failed".into(), |s| format!("{s:.15}")),
+            light_printed(p, d, lk, 1.0),
+            light_corrected(p, d, r, lk, 1.0),
+        ));
+    }
+    out
 }

@@ -5,6 +5,7 @@
 
 pub mod audit;
 pub mod constant_sphere;
+pub mod experiment;
 pub mod gaussian_blobs;
 pub mod linear_gradient;
 pub mod medium;

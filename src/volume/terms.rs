@@ -368,27 +368,15 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         for piece in &pieces {
             for sub in graded(medium, scene.lambda, &ray, piece) {
                 along.start_piece(&sub);
-                let mut failure = None;
                 // The outer rule's own rng stream is derived so the inner calls
                 // can use the caller's.
                 let mut outer_rng =
                     <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(rng.next_u64());
-                let est = sub.integrate(rule, n, &mut outer_rng, |t| {
-                    if failure.is_some() {
-                        return 0.0;
-                    }
-                    let value = along
-                        .depth_to(&sub, t, rng)
-                        .and_then(|d| Ok((-(before + d)).exp() * h(t, rng)?));
-                    value.unwrap_or_else(|e| {
-                        failure = Some(e);
-                        0.0
-                    })
-                });
-                if let Some(e) = failure {
-                    return Err(e);
-                }
-                total = total.combine(est?);
+                let est = sub.try_integrate(rule, n, &mut outer_rng, |t| {
+                    let d = along.depth_to(&sub, t, rng)?;
+                    Ok((-(before + d)).exp() * h(t, rng)?)
+                })?;
+                total = total.combine(est);
                 before += along.depth_to(&sub, sub.end(), rng)?;
             }
         }

@@ -17,6 +17,8 @@
 //! Every smooth piece is cut into 16 spans, each with its own majorant (and
 //! control); the per-walk scores of the spans multiply.
 
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 use rand::RngExt;
 
 use super::medium::Medium;
@@ -40,14 +42,19 @@ struct Span {
 /// (its cost grows with the majorant's optical depth).
 const MAX_COLLISIONS: u64 = 10_000_000;
 
-/// Which tracking estimator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which tracking estimator; its serde form is the estimator's spec in an
+/// experiment file (`{"rule": "ratio-tracking"}`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "rule", deny_unknown_fields)]
 pub enum Tracker {
     /// Delta (Woodcock) tracking.
+    #[serde(rename = "delta-tracking")]
     Delta,
     /// Ratio tracking.
+    #[serde(rename = "ratio-tracking")]
     Ratio,
     /// Residual ratio tracking with a control extinction per span (its mean).
+    #[serde(rename = "residual-ratio-tracking")]
     ResidualRatio,
 }
 

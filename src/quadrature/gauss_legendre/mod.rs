@@ -26,6 +26,9 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use rayon::prelude::*;
 
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
 use super::nodes::{UnitNodes, product_sum};
 use super::{Rule, per_axis};
 use crate::error::QuadError;
@@ -266,10 +269,17 @@ fn tail_estimate(q: f64, q1: f64, q2: f64) -> f64 {
 /// error estimate compares `Q_m` with `Q_{m-1}` and `Q_{m-2}` (a geometric tail);
 /// it costs `(m-1)^D + (m-2)^D` extra evaluations and can be switched off with
 /// `error_estimate: false`, in which case the error is reported as infinite.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct GaussLegendre {
-    /// Whether to spend `(m-1)^D` evaluations on the error estimate.
+    /// Whether to spend `(m-1)^D + (m-2)^D` more evaluations on the error
+    /// estimate (default true).
+    #[serde(default = "yes")]
     pub error_estimate: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl Default for GaussLegendre {
@@ -285,7 +295,16 @@ impl Rule for GaussLegendre {
         "gauss-legendre"
     }
 
-    fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
+    fn about(&self) -> &'static str {
+        "Gauss–Legendre of any order 1..=1e8 (product rule in D > 1); error estimate from Q_m, Q_(m-1), Q_(m-2)"
+    }
+
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
         &self,
         n: usize,
         _rng: &mut R,

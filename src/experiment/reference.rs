@@ -1,0 +1,323 @@
+//! The values errors are measured against, and where they come from: the
+//! family's closed forms, literal values, the Mitsuba 3 harness's values
+//! files, or the family's converged deterministic evaluation checked against
+//! twice its nodes. Also the "lightquad vs Mitsuba vs closed form" rows.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::Path;
+
+use super::spec::{ExperimentSpec, ReferenceSpec};
+use super::validate::{Experiment, literal_values};
+use crate::error::SpecError;
+use crate::family::{Family, Quantity};
+
+/// Reference values known when an experiment is loaded.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Known<Q> {
+    /// Value per quantity, per channel.
+    pub values: BTreeMap<Q, Vec<f64>>,
+    /// Their absolute uncertainty.
+    pub uncertainty: f64,
+    /// Where they come from, for the report.
+    pub note: String,
+}
+
+/// The reference of a run: values per quantity name, where they come from,
+/// and their relative accuracy (errors below it are not resolved).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reference {
+    /// Value per quantity name, per channel.
+    pub values: BTreeMap<String, Vec<f64>>,
+    /// Where they come from, in a sentence.
+    pub note: String,
+    /// Relative accuracy.
+    pub accuracy: f64,
+}
+
+/// The reference values an experiment can know before it runs (none for a
+/// converged reference); checks the reference spec.
+pub fn known_values<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    hash: &str,
+) -> Result<Option<Known<F::Quantity>>, SpecError> {
+    Ok(Some(match &spec.reference {
+        ReferenceSpec::ClosedForm {} => {
+            let mut values = BTreeMap::new();
+            for q in &spec.quantities {
+                let Some(v) = F::closed_form(scene, *q) else {
+                    return Err(SpecError::at(
+                        "reference",
+                        format!(
+                            "quantity {} has no closed form for this scene ({}): use {{\"type\": \"converged\"}}",
+                            q.name(),
+                            F::closed_forms_available()
+                        ),
+                    ));
+                };
+                values.insert(*q, v);
+            }
+            Known {
+                values,
+                uncertainty: 0.0,
+                note: format!("closed forms of the {} family.", F::NAME),
+            }
+        }
+        ReferenceSpec::Value {
+            values,
+            uncertainty,
+        } => {
+            if !(uncertainty.is_finite() && *uncertainty >= 0.0) {
+                return Err(SpecError::at(
+                    "reference.uncertainty",
+                    format!("{uncertainty} is not a finite number >= 0"),
+                ));
+            }
+            Known {
+                values: literal_values(values, &spec.quantities)?,
+                uncertainty: *uncertainty,
+                note: format!("literal values, uncertainty {uncertainty:e}."),
+            }
+        }
+        ReferenceSpec::Mitsuba { file } => mitsuba_values(file, hash, &spec.quantities)?,
+        ReferenceSpec::Converged { n } => {
+            if !(2..=100_000).contains(n) {
+                return Err(SpecError::at(
+                    "reference.n",
+                    format!("{n} is not an integer in 2..=100000"),
+                ));
+            }
+            return Ok(None);
+        }
+    }))
+}
+
+/// Reads a Mitsuba values file for an experiment whose file hashes to `hash`:
+/// the value and standard error per quantity.
+pub fn mitsuba_values<Q: Quantity>(
+    path: &str,
+    hash: &str,
+    quantities: &[Q],
+) -> Result<Known<Q>, SpecError> {
+    let at = "reference.file";
+    let text = fs::read_to_string(path).map_err(|e| {
+        SpecError::at(
+            at,
+            format!("{path}: {e} (run scripts/reference.sh to generate it)"),
+        )
+    })?;
+    let json: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| SpecError::at(at, format!("{path}: {e}")))?;
+    let file_hash = json["experiment_hash"].as_str().unwrap_or("");
+    if file_hash != hash {
+        return Err(SpecError::at(
+            at,
+            format!(
+                "{path} is stale: it was made from an experiment file with hash {file_hash:?}, this one \
+                 hashes to {hash:?}; regenerate it (scripts/reference.sh)"
+            ),
+        ));
+    }
+    let mut values = BTreeMap::new();
+    let mut worst = 0.0f64;
+    for q in quantities {
+        let entry = &json["quantities"][q.name()];
+        let (Some(v), Some(se)) = (entry["value"].as_f64(), entry["std_error"].as_f64()) else {
+            return Err(SpecError::at(
+                at,
+                format!(
+                    "{path} has no value for quantity {} (Mitsuba cannot compute it here?)",
+                    q.name()
+                ),
+            ));
+        };
+        values.insert(*q, vec![v]);
+        worst = worst.max(se);
+    }
+    Ok(Known {
+        values,
+        uncertainty: worst,
+        note: format!(
+            "Mitsuba 3 values from `{path}` ({} {}), largest standard error {worst:.1e} (float32 \
+             renderer: ~1e-6 relative floor).",
+            json["mitsuba_variant"].as_str().unwrap_or("?"),
+            json["mitsuba_version"].as_str().unwrap_or("?")
+        ),
+    })
+}
+
+/// The family's converged values of every quantity of the experiment with
+/// `n` nodes per piece; a quantity that cannot be computed is left out.
+pub fn converged<F: Family>(exp: &Experiment<F>, n: usize) -> BTreeMap<F::Quantity, Vec<f64>> {
+    F::converged(&exp.scene, n, &exp.spec.quantities)
+        .map(|out| out.into_iter().map(|(q, m)| (q, m.value)).collect())
+        .unwrap_or_default()
+}
+
+/// `sqrt(mean_c (a_c - b_c)^2) / sqrt(mean_c b_c^2)`: the relative distance of
+/// two channel vectors (absolute where `b` is 0), without overflow.
+pub fn relative_distance(a: &[f64], b: &[f64]) -> f64 {
+    let scale = rms(b.iter().copied());
+    let diff = rms(a.iter().zip(b).map(|(x, y)| x - y));
+    if a.len() != b.len() {
+        f64::NAN
+    } else if scale > 0.0 {
+        diff / scale
+    } else {
+        diff
+    }
+}
+
+/// Root mean square, scaled by the largest magnitude so that no square
+/// overflows or underflows.
+pub fn rms(xs: impl Iterator<Item = f64> + Clone) -> f64 {
+    let big = xs.clone().fold(0.0f64, |m, x| m.max(x.abs()));
+    if big == 0.0 || !big.is_finite() {
+        return big;
+    }
+    let (sum, count) = xs.fold((0.0, 0usize), |(s, c), x| (s + (x / big).powi(2), c + 1));
+    big * (sum / count as f64).sqrt()
+}
+
+/// The reference of a run.
+pub fn reference<F: Family>(exp: &Experiment<F>) -> Reference {
+    let by_name = |m: BTreeMap<F::Quantity, Vec<f64>>| -> BTreeMap<String, Vec<f64>> {
+        m.into_iter().map(|(q, v)| (q.name().to_string(), v)).collect()
+    };
+    if let Some(known) = &exp.known {
+        // Relative accuracy: the stated uncertainty against the smallest
+        // reference magnitude.
+        let smallest = known
+            .values
+            .values()
+            .map(|v| rms(v.iter().copied()))
+            .filter(|v| *v > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let accuracy = if smallest.is_finite() {
+            known.uncertainty / smallest
+        } else {
+            0.0
+        };
+        return Reference {
+            values: by_name(known.values.clone()),
+            note: known.note.clone(),
+            accuracy,
+        };
+    }
+    let n = match exp.spec.reference {
+        ReferenceSpec::Converged { n } => n,
+        _ => 400,
+    };
+    let (a, b) = (converged(exp, n), converged(exp, 2 * n));
+    let change = exp
+        .spec
+        .quantities
+        .iter()
+        .filter_map(|q| Some(relative_distance(a.get(q)?, b.get(q)?)))
+        .fold(0.0, f64::max);
+    let verdict = if change <= 1e-12 {
+        "converged"
+    } else {
+        "NOT converged: treat errors below this with suspicion"
+    };
+    Reference {
+        values: by_name(b),
+        note: format!(
+            "the {} family's converged evaluation with {} nodes per piece; against {n} nodes the \
+             largest relative change is {change:.1e} ({verdict}).",
+            F::NAME,
+            2 * n
+        ),
+        accuracy: change,
+    }
+}
+
+/// One row of the "lightquad vs Mitsuba vs closed form" comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Crosscheck {
+    /// Experiment name.
+    pub experiment: String,
+    /// The quantity's name.
+    pub quantity: &'static str,
+    /// lightquad's converged value (400 nodes per piece).
+    pub lightquad: f64,
+    /// Mitsuba's value and standard error, when it has one.
+    pub mitsuba: Option<(f64, f64)>,
+    /// The closed form, where the family has one.
+    pub closed_form: Option<f64>,
+    /// Why Mitsuba has no value, or that its file is stale.
+    pub note: String,
+}
+
+/// The comparison rows of an experiment that has a Mitsuba values file in
+/// `reference/values/<name>.json` (relative to the working folder); none
+/// otherwise. Scalar quantities only (Mitsuba's files hold scalars).
+pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
+    let path = Path::new("reference/values").join(format!("{}.json", exp.spec.name));
+    let Ok(text) = fs::read_to_string(&path) else {
+        return Vec::new();
+    };
+    let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Vec::new();
+    };
+    let stale = json["experiment_hash"].as_str() != Some(exp.hash.as_str());
+    let lightquad = converged(exp, 400);
+    let scalar = |v: Option<&Vec<f64>>| v.and_then(|v| (v.len() == 1).then(|| v[0]));
+    exp.spec
+        .quantities
+        .iter()
+        .map(|q| {
+            let entry = &json["quantities"][q.name()];
+            let mitsuba = match (entry["value"].as_f64(), entry["std_error"].as_f64()) {
+                (Some(v), Some(se)) if !stale => Some((v, se)),
+                _ => None,
+            };
+            let note = if stale {
+                "values file is stale (experiment changed): regenerate with scripts/reference.sh"
+                    .into()
+            } else {
+                json["unsupported"][q.name()]
+                    .as_str()
+                    .unwrap_or("")
+                    .to_string()
+            };
+            Crosscheck {
+                experiment: exp.spec.name.clone(),
+                quantity: q.name(),
+                lightquad: scalar(lightquad.get(q)).unwrap_or(f64::NAN),
+                mitsuba,
+                closed_form: scalar(F::closed_form(&exp.scene, *q).as_ref()),
+                note,
+            }
+        })
+        .collect()
+}
+
+/// The comparison as a Markdown table.
+pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
+    let mut md = String::from(
+        "| experiment | quantity | lightquad (converged, 400 nodes per piece) | Mitsuba 3 +- std. error | closed form | lightquad - Mitsuba |\n\
+         |---|---|---:|---:|---:|---|\n",
+    );
+    for r in rows {
+        let mitsuba = r.mitsuba.map_or(format!("— {}", r.note), |(v, se)| {
+            format!("{v:.10e} +- {se:.1e}")
+        });
+        let closed = r.closed_form.map_or("—".into(), |c| format!("{c:.10e}"));
+        let agreement = match r.mitsuba {
+            Some((v, se)) if se > 0.0 => format!("{:+.2} SE", (r.lightquad - v) / se),
+            Some((v, _)) => format!(
+                "{:+.1e} relative (deterministic, float32)",
+                relative_distance(&[r.lightquad], &[v])
+                    * if r.lightquad >= v { 1.0 } else { -1.0 }
+            ),
+            None => "—".into(),
+        };
+        md.push_str(&format!(
+            "| {} | {} | {:.10e} | {mitsuba} | {closed} | {agreement} |\n",
+            r.experiment, r.quantity, r.lightquad
+        ));
+    }
+    md
+}

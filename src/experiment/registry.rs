@@ -1,0 +1,271 @@
+//! The families an experiment file may name, and the object-safe face of a
+//! loaded experiment ([`Loaded`]) through which the runner, the reports and
+//! `merge` handle every family alike.
+//!
+//! A [`Registry`] holds one [`FamilyEntry`] per family, made by
+//! [`Registry::with`] from the family's type; [`crate::families::builtin`]
+//! is the crate's own, and a user's family plugs in with one more `with`.
+
+use std::path::Path;
+
+use super::reference::{Crosscheck, crosscheck, reference};
+use super::report::{Page, RuleInfo, Summary, write_experiment};
+use super::run::{JobKey, JobResult, jobs, run_job};
+use super::spec::ExperimentSpec;
+use super::validate::{Experiment, deserialize, validate};
+use crate::error::SpecError;
+use crate::family::{Estimator, Family, Method, Quantity};
+
+/// A loaded, validated experiment of any family.
+pub trait Loaded: Send + Sync {
+    /// Its name.
+    fn name(&self) -> &str;
+    /// What it shows.
+    fn description(&self) -> &str;
+    /// Its family's tag.
+    fn family(&self) -> &'static str;
+    /// The hash of its file.
+    fn hash(&self) -> &str;
+    /// Rules, budgets and repeats, for `check`.
+    fn shape(&self) -> (usize, usize, usize);
+    /// Its jobs, restricted to a shard.
+    fn jobs(&self, shard: Option<(usize, usize)>) -> Vec<JobKey>;
+    /// Runs one job.
+    fn run_job(&self, key: JobKey) -> JobResult;
+    /// Writes its report page from `results` into `dir`; returns the index
+    /// summary and the Mitsuba comparison rows.
+    fn write_report(
+        &self,
+        dir: &Path,
+        results: &[JobResult],
+    ) -> Result<(Summary, Vec<Crosscheck>), String>;
+}
+
+impl<F: Family> Loaded for Experiment<F> {
+    fn name(&self) -> &str {
+        &self.spec.name
+    }
+    fn description(&self) -> &str {
+        &self.spec.description
+    }
+    fn family(&self) -> &'static str {
+        F::NAME
+    }
+    fn hash(&self) -> &str {
+        &self.hash
+    }
+    fn shape(&self) -> (usize, usize, usize) {
+        (
+            self.spec.rules.len(),
+            self.budgets.len(),
+            self.spec.repeats,
+        )
+    }
+    fn jobs(&self, shard: Option<(usize, usize)>) -> Vec<JobKey> {
+        jobs(self, shard)
+    }
+    fn run_job(&self, key: JobKey) -> JobResult {
+        run_job(self, key)
+    }
+    fn write_report(
+        &self,
+        dir: &Path,
+        results: &[JobResult],
+    ) -> Result<(Summary, Vec<Crosscheck>), String> {
+        let reference = reference(self);
+        let rows = crosscheck(self);
+        let page = page(self, &reference, &rows);
+        Ok((write_experiment(dir, &page, results)?, rows))
+    }
+}
+
+/// The report's view of an experiment.
+fn page<'a, F: Family>(
+    exp: &'a Experiment<F>,
+    reference: &'a super::reference::Reference,
+    crosscheck: &'a [Crosscheck],
+) -> Page<'a> {
+    let spec = &exp.spec;
+    let rules = spec
+        .rules
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let twice = spec.rules.iter().filter(|r| r.name() == m.name()).count() > 1;
+            RuleInfo {
+                label: if twice {
+                    format!("{}#{i}", m.name())
+                } else {
+                    m.name().to_string()
+                },
+                is_random: m.is_random(),
+            }
+        })
+        .collect();
+    Page {
+        name: &spec.name,
+        description: &spec.description,
+        family: F::NAME,
+        equations: &spec.equations,
+        budgets: &exp.budgets,
+        repeats: spec.repeats,
+        seed: spec.seed,
+        settings: F::settings(&spec.scene),
+        quantities: spec.quantities.iter().map(Quantity::name).collect(),
+        rules,
+        targets: &spec.targets,
+        reference,
+        crosscheck,
+    }
+}
+
+type LoadFn = fn(serde_json::Value, &str) -> Result<Box<dyn Loaded>, SpecError>;
+
+/// What the runner and the CLI know of a family.
+#[derive(Clone)]
+pub struct FamilyEntry {
+    /// The tag in experiment files.
+    pub name: &'static str,
+    /// One line on what it covers.
+    pub about: &'static str,
+    /// Its equation IDs.
+    pub equations: &'static [&'static str],
+    load: LoadFn,
+    schema: fn() -> schemars::Schema,
+    estimators: fn() -> Vec<(&'static str, &'static str)>,
+    quantities: fn() -> Vec<&'static str>,
+    audit: fn() -> Option<String>,
+}
+
+impl FamilyEntry {
+    fn of<F: Family>() -> Self {
+        FamilyEntry {
+            name: F::NAME,
+            about: F::ABOUT,
+            equations: F::EQUATIONS,
+            load: |json, hash| Ok(Box::new(validate::<F>(deserialize::<F>(json)?, hash)?)),
+            schema: || schemars::schema_for!(ExperimentSpec<F>),
+            estimators: || {
+                F::Estimator::all()
+                    .iter()
+                    .map(|e| (e.name(), e.about()))
+                    .collect()
+            },
+            quantities: || F::Quantity::all().iter().map(Quantity::name).collect(),
+            audit: F::audit,
+        }
+    }
+
+    /// The family's estimators beside the rules: name and one line each.
+    pub fn estimators(&self) -> Vec<(&'static str, &'static str)> {
+        (self.estimators)()
+    }
+
+    /// The family's quantities.
+    pub fn quantities(&self) -> Vec<&'static str> {
+        (self.quantities)()
+    }
+
+    /// The JSON Schema of the family's experiment files.
+    pub fn schema(&self) -> schemars::Schema {
+        (self.schema)()
+    }
+
+    /// The family's audit of printed formulas, as Markdown.
+    pub fn audit(&self) -> Option<String> {
+        (self.audit)()
+    }
+}
+
+/// The families an experiment file may name.
+#[derive(Clone, Default)]
+pub struct Registry {
+    entries: Vec<FamilyEntry>,
+}
+
+impl Registry {
+    /// A registry with no family.
+    pub fn new() -> Self {
+        Registry::default()
+    }
+
+    /// This registry and family `F` (replacing one of the same name).
+    pub fn with<F: Family>(mut self) -> Self {
+        self.entries.retain(|e| e.name != F::NAME);
+        self.entries.push(FamilyEntry::of::<F>());
+        self
+    }
+
+    /// Every family, in registration order.
+    pub fn entries(&self) -> &[FamilyEntry] {
+        &self.entries
+    }
+
+    /// The family named `name`.
+    pub fn get(&self, name: &str) -> Option<&FamilyEntry> {
+        self.entries.iter().find(|e| e.name == name)
+    }
+
+    /// Reads a parsed experiment file by its `family` tag and validates it.
+    pub fn load(&self, json: serde_json::Value, hash: &str) -> Result<Box<dyn Loaded>, SpecError> {
+        let names: Vec<&str> = self.entries.iter().map(|e| e.name).collect();
+        let accepted = format!("expected one of {}", names.join(", "));
+        if !json.is_object() {
+            return Err(SpecError::at(
+                ".",
+                format!("an experiment file is a JSON object, not {json}"),
+            ));
+        }
+        let tag = match json.get("family") {
+            None => return Err(SpecError::at("family", format!("missing: {accepted}"))),
+            Some(serde_json::Value::String(s)) => s.clone(),
+            Some(other) => {
+                return Err(SpecError::at(
+                    "family",
+                    format!("{other} is not a family name: {accepted}"),
+                ));
+            }
+        };
+        let Some(entry) = self.get(&tag) else {
+            return Err(SpecError::at(
+                "family",
+                format!("unknown family {tag:?}: {accepted}"),
+            ));
+        };
+        (entry.load)(json, hash)
+    }
+
+    /// The JSON Schema of experiment files: one of the families' schemas.
+    pub fn schema(&self) -> serde_json::Value {
+        let schemas: Vec<serde_json::Value> = self
+            .entries
+            .iter()
+            .map(|e| e.schema().to_value())
+            .collect();
+        serde_json::json!({
+            "$schema": "https://json-schema.org/draft/2020-12/schema",
+            "title": "lightquad experiment",
+            "description": "An experiment file; `family` decides the format of `scene`, `quantities` and the family's estimators in `rules`.",
+            "oneOf": schemas,
+        })
+    }
+
+    /// Every rule and every family's estimators: name and one line each.
+    pub fn methods(&self) -> Vec<(String, &'static str)> {
+        let mut out: Vec<(String, &'static str)> = crate::quadrature::AnyRule::listing()
+            .into_iter()
+            .map(|(n, a)| (n.to_string(), a))
+            .collect();
+        for e in &self.entries {
+            for (n, a) in e.estimators() {
+                out.push((format!("{n} ({} family)", e.name), a));
+            }
+        }
+        out
+    }
+}
+
+/// Method names for a family, for messages.
+pub fn method_names<F: Family>() -> Vec<&'static str> {
+    Method::<F::Estimator>::names()
+}

@@ -1,0 +1,314 @@
+//! The contract of an equation family: what the experiment layer needs of the
+//! volume-rendering equations (V-*), the rendering equation (R-*) or
+//! Whitted's model (W-*), and nothing more.
+//!
+//! A family owns its scene format (serde + JSON Schema), its quantities, the
+//! estimators it has beside the quadrature rules (tracking, path tracing,
+//! recursive ray tracing), how it evaluates a quantity with a rule or an
+//! estimator, and its closed forms. [`crate::experiment`] is generic over this
+//! trait and never names a family; [`crate::families`] is the one registry
+//! that does.
+//!
+//! Adding a family: a module that implements [`Family`], and one line in
+//! [`crate::families::builtin`] (or [`crate::experiment::Registry::with`] from
+//! outside the crate).
+
+use std::collections::BTreeMap;
+use std::fmt::Debug;
+
+use schemars::JsonSchema;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+use crate::error::{QuadError, SpecError};
+use crate::quadrature::{AnyRule, Rule};
+
+/// A quantity a family computes (`tau`, `I_L`, a pixel image, ...).
+pub trait Quantity:
+    Copy
+    + Ord
+    + Debug
+    + Serialize
+    + DeserializeOwned
+    + JsonSchema
+    + Send
+    + Sync
+    + 'static
+{
+    /// The name in experiment files, results and reports.
+    fn name(&self) -> &'static str;
+    /// Every quantity of the family.
+    fn all() -> &'static [Self];
+}
+
+/// A family's estimator that is not a quadrature rule (tracking, path
+/// tracing, ...). Its serde form is tagged by `"rule"`, like the rules'.
+pub trait Estimator:
+    Clone + Debug + PartialEq + Serialize + DeserializeOwned + JsonSchema + Send + Sync + 'static
+{
+    /// The name in experiment files (`ratio-tracking`, ...).
+    fn name(&self) -> &'static str;
+    /// One line on what it estimates and how.
+    fn about(&self) -> &'static str;
+    /// The smallest budget it accepts.
+    fn min_budget(&self) -> usize;
+    /// True for randomised estimators.
+    fn is_random(&self) -> bool;
+    /// Every estimator with default parameters (for listings and names).
+    fn all() -> Vec<Self>;
+}
+
+/// The estimators of a family that has none beyond the quadrature rules.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub enum NoEstimator {}
+
+impl Estimator for NoEstimator {
+    fn name(&self) -> &'static str {
+        match *self {}
+    }
+    fn about(&self) -> &'static str {
+        match *self {}
+    }
+    fn min_budget(&self) -> usize {
+        match *self {}
+    }
+    fn is_random(&self) -> bool {
+        match *self {}
+    }
+    fn all() -> Vec<Self> {
+        Vec::new()
+    }
+}
+
+/// How a quantity is computed: a quadrature rule, or one of the family's own
+/// estimators. In experiment files both are `{"rule": "<name>", ...}`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Method<E> {
+    /// A quadrature rule (products included).
+    Rule(AnyRule),
+    /// The family's estimator.
+    Estimator(E),
+}
+
+impl<E: Estimator> Method<E> {
+    /// The name in experiment files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Rule(r) => r.name(),
+            Method::Estimator(e) => e.name(),
+        }
+    }
+
+    /// The smallest budget it accepts in `dim` dimensions.
+    pub fn min_budget(&self, dim: usize) -> usize {
+        match self {
+            Method::Rule(r) => r.min_budget(dim),
+            Method::Estimator(e) => e.min_budget(),
+        }
+    }
+
+    /// True for randomised rules and estimators.
+    pub fn is_random(&self) -> bool {
+        match self {
+            Method::Rule(r) => r.is_random(),
+            Method::Estimator(e) => e.is_random(),
+        }
+    }
+
+    /// Every name a method of this family may have: the rules, then the estimators.
+    pub fn names() -> Vec<&'static str> {
+        let mut names: Vec<&'static str> = AnyRule::listing().iter().map(|r| r.0).collect();
+        names.extend(E::all().iter().map(Estimator::name));
+        names
+    }
+}
+
+impl<E: Serialize> Serialize for Method<E> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Method::Rule(r) => r.serialize(s),
+            Method::Estimator(e) => e.serialize(s),
+        }
+    }
+}
+
+/// Reads the `"rule"` tag first, then the rule or the estimator it names, so
+/// an unknown name gets one message listing every accepted name.
+impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let value = serde_json::Value::deserialize(d)?;
+        let names = Self::names();
+        let Some(tag) = value.get("rule") else {
+            return Err(D::Error::custom(format!(
+                "missing field `rule`: expected one of {}",
+                names.join(", ")
+            )));
+        };
+        let Some(tag) = tag.as_str() else {
+            return Err(D::Error::custom(format!(
+                "`rule` is {tag}, not a name: expected one of {}",
+                names.join(", ")
+            )));
+        };
+        // Faults inside the rule keep their path below the rule (`.outer.rule`).
+        fn inner<T: DeserializeOwned, Er: Error>(value: serde_json::Value) -> Result<T, Er> {
+            serde_path_to_error::deserialize(value).map_err(|e| {
+                let path = e.path().to_string();
+                if path == "." || path.is_empty() {
+                    Er::custom(e.inner())
+                } else {
+                    Er::custom(format!("at `.{path}`: {}", e.inner()))
+                }
+            })
+        }
+        if E::all().iter().any(|e| e.name() == tag) {
+            inner(value).map(Method::Estimator)
+        } else if names.contains(&tag) {
+            inner(value).map(Method::Rule)
+        } else {
+            Err(D::Error::custom(format!(
+                "unknown rule `{tag}`: expected one of {}",
+                names.join(", ")
+            )))
+        }
+    }
+}
+
+impl<E: JsonSchema> JsonSchema for Method<E> {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "Method".into()
+    }
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let rule = generator.subschema_for::<AnyRule>();
+        let estimator = generator.subschema_for::<E>();
+        schemars::json_schema!({ "anyOf": [rule, estimator] })
+    }
+}
+
+/// A fact about one evaluated value that a report must show.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "flag", rename_all = "kebab-case")]
+pub enum Flag {
+    /// The value is below the smallest normal f64: only its logarithm (the
+    /// family computes it) is meaningful.
+    Underflow,
+    /// A sum that lost digits: its magnitude is below 1e-6 of the summed
+    /// magnitudes of its parts, `parts`.
+    Cancellation {
+        /// `sum |part|`.
+        parts: f64,
+    },
+}
+
+impl std::fmt::Display for Flag {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Flag::Underflow => write!(f, "underflows: log space"),
+            Flag::Cancellation { parts } => {
+                write!(f, "cancellation: |sum| < 1e-6 of its parts ({parts:.1e})")
+            }
+        }
+    }
+}
+
+/// One quantity as evaluated: its channels (a scalar, RGB, or the pixels of
+/// an image), the error estimate per channel, and the evaluations it cost.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Measured {
+    /// The value, per channel.
+    pub value: Vec<f64>,
+    /// The method's own estimate of the absolute error, per channel.
+    pub error: Vec<f64>,
+    /// Evaluations of the integrand's costly part (density lookups, rays).
+    pub evaluations: u64,
+    /// Facts a report must show.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub flags: Vec<Flag>,
+}
+
+impl Measured {
+    /// A one-channel value.
+    pub fn scalar(value: f64, error: f64, evaluations: u64) -> Self {
+        Measured {
+            value: vec![value],
+            error: vec![error],
+            evaluations,
+            flags: Vec::new(),
+        }
+    }
+
+    /// The same, with a flag.
+    pub fn flagged(mut self, flag: Flag) -> Self {
+        self.flags.push(flag);
+        self
+    }
+}
+
+/// The quantities of one evaluation.
+pub type Outcome<Q> = BTreeMap<Q, Measured>;
+
+/// An equation family: see the module documentation.
+pub trait Family: Sized + Send + Sync + 'static {
+    /// The tag in experiment files (`"family": "volume"`).
+    const NAME: &'static str;
+    /// One line on what the family covers.
+    const ABOUT: &'static str;
+    /// The equation IDs of docs/EQUATIONS.md it instantiates.
+    const EQUATIONS: &'static [&'static str];
+
+    /// The scene as written in an experiment file.
+    type SceneSpec: Clone + Debug + PartialEq + Serialize + DeserializeOwned + JsonSchema + Send + Sync;
+    /// The scene, built and checked.
+    type Scene: Debug + Send + Sync;
+    /// Its quantities.
+    type Quantity: Quantity;
+    /// Its estimators beside the quadrature rules ([`NoEstimator`] for none).
+    type Estimator: Estimator;
+
+    /// Checks every number of the scene once and builds it; errors name the
+    /// JSON path from the file's root (`scene.medium.kappa`).
+    fn build(spec: &Self::SceneSpec) -> Result<Self::Scene, SpecError>;
+
+    /// The dimension of the unit cube over which a rule integrates `quantity`.
+    fn dimension(quantity: Self::Quantity) -> usize;
+
+    /// The quantities `estimator` estimates.
+    fn estimates(estimator: &Self::Estimator) -> &'static [Self::Quantity];
+
+    /// Evaluates `quantities` with `method` at `budget`, drawing randomness from
+    /// `rng` only.
+    fn evaluate(
+        scene: &Self::Scene,
+        method: &Method<Self::Estimator>,
+        budget: usize,
+        rng: &mut rand_pcg::Pcg64,
+        quantities: &[Self::Quantity],
+    ) -> Result<Outcome<Self::Quantity>, QuadError>;
+
+    /// The closed form of `quantity` for this scene, when one is known.
+    fn closed_form(scene: &Self::Scene, quantity: Self::Quantity) -> Option<Vec<f64>>;
+
+    /// Where the family has closed forms (for the error when one is missing).
+    fn closed_forms_available() -> &'static str;
+
+    /// `quantities` by the family's most accurate deterministic method with
+    /// `n` nodes per smooth piece: the converged reference, and lightquad's
+    /// column in the Mitsuba comparison.
+    fn converged(
+        scene: &Self::Scene,
+        n: usize,
+        quantities: &[Self::Quantity],
+    ) -> Result<Outcome<Self::Quantity>, QuadError>;
+
+    /// How the scene is evaluated, in words, for the report's header
+    /// (e.g. the volume family's depth scheme).
+    fn settings(_spec: &Self::SceneSpec) -> String {
+        String::new()
+    }
+
+    /// The family's audit of printed formulas, as Markdown, if it has one.
+    fn audit() -> Option<String> {
+        None
+    }
+}

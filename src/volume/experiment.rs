@@ -1,0 +1,619 @@
+//! The volume-rendering family (V-* in docs/EQUATIONS.md) as the experiment
+//! layer sees it: the scene format of an experiment file (`"family":
+//! "volume"`), its quantities, the tracking estimators beside the rules, the
+//! closed forms and the converged reference.
+
+use std::sync::Arc;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::tracking::{Extinction, Tracker, transmittance};
+use super::{
+    ConstantSphere, DepthScheme, DirectionalLight, EmissionMap, GaussianBlob, GaussianBlobs,
+    Medium, ShadowMethod, VolumeResult, VolumeScene, evaluate, linear_gradient::LinearGradient,
+    voxel_grid::VoxelGrid,
+};
+use crate::domain::Vec3;
+use crate::error::{QuadError, SpecError};
+use crate::exact::volume as exact;
+use crate::family::{self, Family, Flag, Measured, Method, Outcome};
+use crate::geometry::Ray;
+use crate::quadrature::GaussLegendre;
+
+/// The volume family.
+#[derive(Debug, Clone, Copy)]
+pub struct Volume;
+
+/// The scene along one eye ray.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// How `tau(t_n, t)` inside V-E and V-L is computed.
+    #[serde(default)]
+    pub depth_scheme: DepthSchemeSpec,
+    /// How the shadow ray's optical depth in V-Lp is computed.
+    #[serde(default)]
+    pub shadow: ShadowSpec,
+    /// The eye ray.
+    pub ray: RaySpec,
+    /// Start of the looked-at part of the ray (default 0).
+    #[serde(default)]
+    pub t_min: Option<f64>,
+    /// End of the looked-at part (default: infinite).
+    #[serde(default)]
+    pub t_max: Option<f64>,
+    /// The medium, if any.
+    #[serde(default)]
+    pub medium: Option<MediumSpec>,
+    /// `lambda` in `sigma = lambda v_r` (default 1).
+    #[serde(default)]
+    pub lambda: Option<f64>,
+    /// The emission map, if the medium emits.
+    #[serde(default)]
+    pub emission: Option<EmissionSpec>,
+    /// Background radiance `I_b`, if any.
+    #[serde(default)]
+    pub background: Option<f64>,
+    /// The directional light, if any.
+    #[serde(default)]
+    pub light: Option<LightSpec>,
+}
+
+/// A ray `e + t v`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RaySpec {
+    /// `e`.
+    pub origin: [f64; 3],
+    /// `v` (normalised; t is arc length).
+    pub direction: [f64; 3],
+}
+
+/// A medium.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum MediumSpec {
+    /// Constant density `kappa` in a sphere.
+    ConstantSphere {
+        /// Centre.
+        centre: [f64; 3],
+        /// Radius.
+        radius: f64,
+        /// Density.
+        kappa: f64,
+    },
+    /// A sum of Gaussian blobs.
+    GaussianBlobs {
+        /// The blobs.
+        blobs: Vec<BlobSpec>,
+    },
+    /// `max(0, base + gradient . (x - centre))` inside a sphere.
+    LinearGradient {
+        /// Centre of the bounding sphere.
+        centre: [f64; 3],
+        /// Its radius.
+        radius: f64,
+        /// Density at the centre.
+        base: f64,
+        /// Gradient.
+        gradient: [f64; 3],
+    },
+    /// A voxel grid (values at voxel centres, trilinear, `[z][y][x]`).
+    VoxelGrid {
+        /// Lower corner.
+        min: [f64; 3],
+        /// Upper corner.
+        max: [f64; 3],
+        /// Voxels per axis.
+        resolution: [usize; 3],
+        /// Densities, x fastest.
+        data: Vec<f64>,
+    },
+}
+
+/// One Gaussian blob.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BlobSpec {
+    /// Centre.
+    pub centre: [f64; 3],
+    /// Peak density.
+    pub amplitude: f64,
+    /// Width (standard deviation).
+    pub width: f64,
+}
+
+/// The emission map `c(v)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum EmissionSpec {
+    /// `c(v) = c` inside the medium.
+    Constant {
+        /// The constant.
+        c: f64,
+    },
+    /// `c(v) = k v`.
+    Proportional {
+        /// The factor.
+        k: f64,
+    },
+}
+
+/// A directional light.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LightSpec {
+    /// Direction from a point toward the light.
+    pub toward_light: [f64; 3],
+    /// Intensity `I_p`.
+    pub intensity: f64,
+    /// Single-scattering albedo (omit for the document's reduced V-L).
+    #[serde(default)]
+    pub albedo: Option<f64>,
+}
+
+/// How the nested optical depth is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum DepthSchemeSpec {
+    /// Cumulative (cost ~ n).
+    #[default]
+    Cumulative,
+    /// Nested (cost ~ n^2).
+    Nested,
+}
+
+/// How the shadow ray is integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShadowSpec {
+    /// Closed form where the medium has one.
+    #[default]
+    ClosedForm,
+    /// Always quadrature.
+    Quadrature,
+}
+
+/// A quantity of the volume family.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema,
+)]
+pub enum VolumeQuantity {
+    /// V-tau over the looked-at part of the ray.
+    #[serde(rename = "tau")]
+    Tau,
+    /// V-E.
+    #[serde(rename = "I_E")]
+    Emission,
+    /// V-B.
+    #[serde(rename = "I_B")]
+    Background,
+    /// V-L.
+    #[serde(rename = "I_L")]
+    Light,
+    /// V-I.
+    #[serde(rename = "I")]
+    Total,
+}
+
+impl family::Quantity for VolumeQuantity {
+    fn name(&self) -> &'static str {
+        match self {
+            VolumeQuantity::Tau => "tau",
+            VolumeQuantity::Emission => "I_E",
+            VolumeQuantity::Background => "I_B",
+            VolumeQuantity::Light => "I_L",
+            VolumeQuantity::Total => "I",
+        }
+    }
+
+    fn all() -> &'static [Self] {
+        use VolumeQuantity::*;
+        &[Tau, Emission, Background, Light, Total]
+    }
+}
+
+impl family::Estimator for Tracker {
+    fn name(&self) -> &'static str {
+        Tracker::name(self)
+    }
+    fn about(&self) -> &'static str {
+        match self {
+            Tracker::Delta => "delta (Woodcock) tracking of tau, per-span majorants; standard error",
+            Tracker::Ratio => "ratio tracking of tau, per-span majorants; standard error",
+            Tracker::ResidualRatio => {
+                "residual ratio tracking of tau with a per-span control extinction; standard error"
+            }
+        }
+    }
+    /// Two walks: a standard error needs them.
+    fn min_budget(&self) -> usize {
+        2
+    }
+    fn is_random(&self) -> bool {
+        true
+    }
+    fn all() -> Vec<Self> {
+        vec![Tracker::Delta, Tracker::Ratio, Tracker::ResidualRatio]
+    }
+}
+
+/// The built scene with how it is evaluated.
+#[derive(Debug, Clone)]
+pub struct Built {
+    /// The scene.
+    pub scene: VolumeScene,
+    /// The inner optical depth of V-E and V-L.
+    pub scheme: DepthScheme,
+    /// The shadow rays of V-Lp.
+    pub shadow: ShadowMethod,
+    /// `kappa` of a constant-sphere medium (its closed forms need it).
+    pub sphere_kappa: Option<f64>,
+}
+
+impl Family for Volume {
+    const NAME: &'static str = "volume";
+    const ABOUT: &'static str =
+        "volume rendering along one eye ray with a directional light (V-tau .. V-I)";
+    const EQUATIONS: &'static [&'static str] = &["V-tau", "V-E", "V-B", "V-Lp", "V-L", "V-I"];
+
+    type SceneSpec = SceneSpec;
+    type Scene = Built;
+    type Quantity = VolumeQuantity;
+    type Estimator = Tracker;
+
+    fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
+        Ok(Built {
+            scene: scene(spec)?,
+            scheme: match spec.depth_scheme {
+                DepthSchemeSpec::Cumulative => DepthScheme::Cumulative,
+                DepthSchemeSpec::Nested => DepthScheme::Nested,
+            },
+            shadow: match spec.shadow {
+                ShadowSpec::ClosedForm => ShadowMethod::ClosedFormWhereAvailable,
+                ShadowSpec::Quadrature => ShadowMethod::Quadrature,
+            },
+            sphere_kappa: match spec.medium {
+                Some(MediumSpec::ConstantSphere { kappa, .. }) => Some(kappa),
+                _ => None,
+            },
+        })
+    }
+
+    /// Every volume integral is along a ray segment.
+    fn dimension(_: VolumeQuantity) -> usize {
+        1
+    }
+
+    fn estimates(_: &Tracker) -> &'static [VolumeQuantity] {
+        &[VolumeQuantity::Tau]
+    }
+
+    fn evaluate(
+        built: &Built,
+        method: &Method<Tracker>,
+        budget: usize,
+        rng: &mut rand_pcg::Pcg64,
+        quantities: &[VolumeQuantity],
+    ) -> Result<Outcome<VolumeQuantity>, QuadError> {
+        match method {
+            Method::Rule(rule) => {
+                let res = evaluate(&built.scene, rule, budget, built.scheme, built.shadow, rng)?;
+                Ok(collect(&res, quantities))
+            }
+            Method::Estimator(tracker) => {
+                let scene = &built.scene;
+                let est = match scene.medium.as_deref() {
+                    // No medium: tau = 1 with no work.
+                    None => Measured::scalar(1.0, 0.0, 0),
+                    Some(medium) => {
+                        let sigma = Extinction {
+                            medium,
+                            lambda: scene.lambda,
+                        };
+                        let (t0, t1) = (scene.t_min, scene.t_max);
+                        let e = transmittance(*tracker, sigma, &scene.ray, t0, t1, budget, rng)?;
+                        Measured::scalar(e.value, e.error, e.evaluations)
+                    }
+                };
+                Ok([(VolumeQuantity::Tau, est)].into_iter().collect())
+            }
+        }
+    }
+
+    fn closed_form(built: &Built, q: VolumeQuantity) -> Option<Vec<f64>> {
+        closed_form(built, q).map(|v| vec![v])
+    }
+
+    fn closed_forms_available() -> &'static str {
+        "closed forms: tau for the constant sphere, blobs and gradient; I_E for the constant \
+         sphere; I_L for the constant sphere with the light along the ray"
+    }
+
+    /// Gauss–Legendre without its error estimate, `n` nodes per graded piece,
+    /// cumulative depth, closed-form shadow rays where the medium has them.
+    fn converged(
+        built: &Built,
+        n: usize,
+        quantities: &[VolumeQuantity],
+    ) -> Result<Outcome<VolumeQuantity>, QuadError> {
+        let rule = GaussLegendre {
+            error_estimate: false,
+        };
+        let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
+        let res = evaluate(
+            &built.scene,
+            &rule,
+            n,
+            DepthScheme::Cumulative,
+            ShadowMethod::ClosedFormWhereAvailable,
+            &mut rng,
+        )?;
+        Ok(collect(&res, quantities))
+    }
+
+    fn settings(spec: &SceneSpec) -> String {
+        format!(
+            "depth scheme {:?}, shadow rays {:?}",
+            spec.depth_scheme, spec.shadow
+        )
+    }
+
+    fn audit() -> Option<String> {
+        Some(super::audit::markdown())
+    }
+}
+
+/// The quantities asked for from one evaluation of the terms. A term the
+/// scene does not have is 0 at no cost.
+fn collect(res: &VolumeResult, quantities: &[VolumeQuantity]) -> Outcome<VolumeQuantity> {
+    let term = |t: Option<super::Term>| {
+        t.map_or(Measured::scalar(0.0, 0.0, 0), |t| {
+            Measured::scalar(t.value, t.error, t.evaluations)
+        })
+    };
+    quantities
+        .iter()
+        .map(|&q| {
+            let m = match q {
+                VolumeQuantity::Tau => {
+                    let tau = Measured::scalar(
+                        res.transmittance,
+                        res.transmittance * res.optical_depth.error,
+                        res.optical_depth.evaluations,
+                    );
+                    if res.underflow {
+                        tau.flagged(Flag::Underflow)
+                    } else {
+                        tau
+                    }
+                }
+                VolumeQuantity::Emission => term(res.emission),
+                VolumeQuantity::Background => term(res.background),
+                VolumeQuantity::Light => term(res.light),
+                VolumeQuantity::Total => total(res),
+            };
+            (q, m)
+        })
+        .collect()
+}
+
+/// V-I with the errors and costs of its terms, flagged when the sum lost
+/// digits to cancellation.
+fn total(res: &VolumeResult) -> Measured {
+    let terms = [res.emission, res.background, res.light];
+    let error = terms.iter().flatten().map(|t| t.error).sum();
+    let evaluations = res.optical_depth.evaluations
+        + terms.iter().flatten().map(|t| t.evaluations).sum::<u64>();
+    let parts = terms.iter().flatten().map(|t| t.value.abs()).sum::<f64>();
+    let m = Measured::scalar(res.total, error, evaluations);
+    if parts > 0.0 && res.total.abs() < 1e-6 * parts {
+        m.flagged(Flag::Cancellation { parts })
+    } else {
+        m
+    }
+}
+
+/// The closed form of a quantity for this scene, when `exact` has one.
+fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
+    let scene = &built.scene;
+    let ray = scene.ray;
+    let tau = match &scene.medium {
+        None => 1.0,
+        Some(m) => (-scene.lambda * m.density_integral(&ray, scene.t_min, scene.t_max)?).exp(),
+    };
+    // The constant sphere's chord inside the looked-at part, and whether that
+    // part holds the whole chord (the light closed forms need it).
+    let sphere = match built.sphere_kappa {
+        Some(kappa) => scene
+            .medium
+            .as_ref()
+            .and_then(|m| {
+                m.support(&ray, scene.t_min, scene.t_max)
+                    .first()
+                    .map(|s| (s.start(), s.end()))
+            })
+            .map(|(a, b)| {
+                (
+                    scene.lambda * kappa,
+                    b - a,
+                    a > scene.t_min && b < scene.t_max,
+                )
+            }),
+        _ => None,
+    };
+    let emission = || -> Option<f64> {
+        let Some(map) = scene.emission else {
+            return Some(0.0);
+        };
+        if scene.medium.is_none() {
+            return Some(0.0);
+        }
+        let (sigma, chord, _) = sphere?;
+        let kappa = if scene.lambda > 0.0 {
+            sigma / scene.lambda
+        } else {
+            return None;
+        };
+        let c = match map {
+            EmissionMap::Constant(c) => c,
+            EmissionMap::Proportional(k) => k * kappa,
+        };
+        Some(exact::emission(sigma, chord, c))
+    };
+    let light = || -> Option<f64> {
+        let Some(light) = scene.light else {
+            return Some(0.0);
+        };
+        if scene.medium.is_none() {
+            return Some(0.0);
+        }
+        let (sigma, chord, whole) = sphere?;
+        if !whole {
+            return None;
+        }
+        let cos = light.toward_light.dot(&ray.dir);
+        if (cos - 1.0).abs() < 1e-12 {
+            Some(exact::light_ahead(
+                sigma,
+                chord,
+                light.intensity,
+                light.albedo,
+            ))
+        } else if (cos + 1.0).abs() < 1e-12 {
+            Some(exact::light_behind(
+                sigma,
+                chord,
+                light.intensity,
+                light.albedo,
+            ))
+        } else {
+            None
+        }
+    };
+    let background = scene.background.unwrap_or(0.0) * tau;
+    match q {
+        VolumeQuantity::Tau => Some(tau),
+        VolumeQuantity::Background => Some(background),
+        VolumeQuantity::Emission => emission(),
+        VolumeQuantity::Light => light(),
+        VolumeQuantity::Total => Some(emission()? + background + light()?),
+    }
+}
+
+fn vec3(v: [f64; 3]) -> Vec3 {
+    Vec3::new(v[0], v[1], v[2])
+}
+
+fn finite(path: &str, x: f64, accepted: &str) -> Result<f64, SpecError> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(SpecError::at(path, format!("{x} is not {accepted}")))
+    }
+}
+
+fn medium(spec: &MediumSpec) -> Result<Arc<dyn Medium>, SpecError> {
+    let at = "scene.medium";
+    Ok(match spec {
+        MediumSpec::ConstantSphere {
+            centre,
+            radius,
+            kappa,
+        } => Arc::new(
+            ConstantSphere::new(vec3(*centre), *radius, *kappa)
+                .map_err(|e| SpecError::from_quad(at, e))?,
+        ),
+        MediumSpec::GaussianBlobs { blobs } => Arc::new(
+            GaussianBlobs::new(
+                blobs
+                    .iter()
+                    .map(|b| GaussianBlob {
+                        centre: vec3(b.centre),
+                        amplitude: b.amplitude,
+                        width: b.width,
+                    })
+                    .collect(),
+            )
+            .map_err(|e| SpecError::from_quad(at, e))?,
+        ),
+        MediumSpec::LinearGradient {
+            centre,
+            radius,
+            base,
+            gradient,
+        } => Arc::new(
+            LinearGradient::new(vec3(*centre), *radius, *base, vec3(*gradient))
+                .map_err(|e| SpecError::from_quad(at, e))?,
+        ),
+        MediumSpec::VoxelGrid {
+            min,
+            max,
+            resolution,
+            data,
+        } => Arc::new(
+            VoxelGrid::new(vec3(*min), vec3(*max), *resolution, data.clone())
+                .map_err(|e| SpecError::from_quad(at, e))?,
+        ),
+    })
+}
+
+/// Builds the scene, naming the path of any bad number.
+fn scene(s: &SceneSpec) -> Result<VolumeScene, SpecError> {
+    let ray = Ray::new(vec3(s.ray.origin), vec3(s.ray.direction))
+        .map_err(|e| SpecError::from_quad("scene.ray", e))?;
+    let mut scene = VolumeScene::new(ray);
+    if let Some(t) = s.t_min {
+        scene.t_min = finite("scene.t_min", t, "a finite number")?;
+    }
+    if let Some(t) = s.t_max {
+        if t.is_nan() || t < scene.t_min {
+            return Err(SpecError::at(
+                "scene.t_max",
+                format!("{t} must be >= t_min = {} (t_f >= t_n)", scene.t_min),
+            ));
+        }
+        scene.t_max = t;
+    }
+    if let Some(l) = s.lambda {
+        if !(l.is_finite() && l >= 0.0) {
+            return Err(SpecError::at(
+                "scene.lambda",
+                format!("{l} is not a finite number >= 0"),
+            ));
+        }
+        scene.lambda = l;
+    }
+    scene.medium = s.medium.as_ref().map(medium).transpose()?;
+    scene.emission = match s.emission {
+        None => None,
+        Some(EmissionSpec::Constant { c }) => Some(EmissionMap::Constant(finite(
+            "scene.emission.c",
+            c,
+            "a finite number",
+        )?)),
+        Some(EmissionSpec::Proportional { k }) => Some(EmissionMap::Proportional(finite(
+            "scene.emission.k",
+            k,
+            "a finite number",
+        )?)),
+    };
+    if let Some(b) = s.background {
+        if !(b.is_finite() && b >= 0.0) {
+            return Err(SpecError::at(
+                "scene.background",
+                format!("{b} is not a finite radiance >= 0"),
+            ));
+        }
+        scene.background = Some(b);
+    }
+    if let Some(l) = &s.light {
+        scene.light = Some(
+            DirectionalLight::new(vec3(l.toward_light), l.intensity, l.albedo)
+                .map_err(|e| SpecError::from_quad("scene.light", e))?,
+        );
+    }
+    Ok(scene)
+}
+
