@@ -151,16 +151,10 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
                 names.join(", ")
             )));
         };
-        // Faults inside the rule keep their path below the rule (`.outer.rule`).
+        // A fault inside the rule is reported at the rule, naming the field
+        // (serde's tagged enums do not track paths below the tag).
         fn inner<T: DeserializeOwned, Er: Error>(value: serde_json::Value) -> Result<T, Er> {
-            serde_path_to_error::deserialize(value).map_err(|e| {
-                let path = e.path().to_string();
-                if path == "." || path.is_empty() {
-                    Er::custom(e.inner())
-                } else {
-                    Er::custom(format!("at `.{path}`: {}", e.inner()))
-                }
-            })
+            serde_json::from_value(value).map_err(Er::custom)
         }
         if E::all().iter().any(|e| e.name() == tag) {
             inner(value).map(Method::Estimator)

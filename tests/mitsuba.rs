@@ -6,9 +6,11 @@
 
 use std::path::{Path, PathBuf};
 
-use lightquad::experiment::load;
-use lightquad::experiment::spec::Quantity;
+use lightquad::experiment::run::file_hash;
+use lightquad::experiment::validate::{deserialize, parse_json};
+use lightquad::family::Family;
 use lightquad::quadrature::GaussLegendre;
+use lightquad::volume::experiment::{Built, Volume, VolumeQuantity as Quantity};
 use lightquad::volume::{DepthScheme, ShadowMethod, evaluate};
 use rand::SeedableRng;
 use serde_json::Value;
@@ -26,13 +28,13 @@ fn values_dir() -> PathBuf {
 /// lightquad's converged value (Gauss–Legendre, 400 nodes per graded piece)
 /// and `ln tau` for V-tau, which stays exact where tau underflows.
 fn lightquad_value(file: &Path, q: Quantity) -> (f64, f64) {
-    let (exp, _) = load(file).unwrap_or_else(|e| panic!("{e}"));
+    let scene = volume_scene(file).scene;
     let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
     let rule = GaussLegendre {
         error_estimate: false,
     };
     let res = evaluate(
-        &exp.scene,
+        &scene,
         &rule,
         400,
         DepthScheme::Cumulative,
@@ -47,6 +49,15 @@ fn lightquad_value(file: &Path, q: Quantity) -> (f64, f64) {
         Quantity::Background => (res.background.map_or(0.0, |t| t.value), f64::NAN),
         Quantity::Total => (res.total, f64::NAN),
     }
+}
+
+/// The volume scene of an experiment file, built.
+fn volume_scene(file: &Path) -> Built {
+    let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    let spec = parse_json(&text)
+        .and_then(deserialize::<Volume>)
+        .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    Volume::build(&spec.scene).unwrap_or_else(|e| panic!("{}: {e}", file.display()))
 }
 
 fn quantity(name: &str) -> Quantity {
@@ -75,7 +86,7 @@ fn lightquad_agrees_with_mitsuba_within_four_standard_errors() {
         let v: Value = serde_json::from_str(&std::fs::read_to_string(&path).expect("read"))
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let experiment = root().join(v["experiment_file"].as_str().expect("experiment_file"));
-        let (_, hash) = load(&experiment).unwrap_or_else(|e| panic!("{e}"));
+        let hash = file_hash(&std::fs::read(&experiment).expect("experiment file"));
         assert_eq!(
             v["experiment_hash"].as_str(),
             Some(hash.as_str()),

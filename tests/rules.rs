@@ -300,8 +300,9 @@ fn rgb_integrands_integrate_per_channel() {
 
 #[test]
 fn bad_input_is_a_clear_error_never_a_panic() {
-    for (name, _) in lightquad::quadrature::RULES {
-        let rule = AnyRule::by_name(name).expect("known");
+    for base in lightquad::quadrature::BaseRule::defaults() {
+        let name = base.name();
+        let rule = AnyRule::from(base);
         let e = rule
             .integrate(0, &mut rng(0), |u: [f64; 1]| u[0])
             .expect_err("n = 0");
@@ -386,4 +387,38 @@ fn product_names_and_dimensions_are_checked() {
         .integrate(100, &mut rng(0), exp1)
         .expect_err("1-D");
     assert!(e.to_string().contains("dimension 1"), "{e}");
+}
+
+/// An integrand's error stops every rule at once and comes back unchanged:
+/// no later node is evaluated (products included, the error raised inside
+/// the inner rule).
+#[test]
+fn an_integrand_error_propagates_through_every_rule() {
+    let mut rules: Vec<AnyRule> = lightquad::quadrature::BaseRule::defaults()
+        .into_iter()
+        .map(AnyRule::from)
+        .collect();
+    rules.push(AnyRule::by_name("product(gauss-legendre,stratified)").expect("known"));
+    for rule in rules {
+        let dim2 = rule.name() == "product";
+        for fail_at in [0usize, 5] {
+            let mut calls = 0usize;
+            let mut f = |u: f64| {
+                calls += 1;
+                if calls > fail_at {
+                    Err(QuadError::invalid("density", u, "a test failure"))
+                } else {
+                    Ok(u)
+                }
+            };
+            let e = if dim2 {
+                rule.try_integrate(256, &mut rng(1), |u: [f64; 2]| f(u[0] * u[1]))
+            } else {
+                rule.try_integrate(256, &mut rng(1), |u: [f64; 1]| f(u[0]))
+            }
+            .expect_err("the integrand failed");
+            assert!(e.to_string().contains("a test failure"), "{}: {e}", rule.name());
+            assert_eq!(calls, fail_at + 1, "{}: evaluated past the failure", rule.name());
+        }
+    }
 }

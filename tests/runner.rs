@@ -32,6 +32,7 @@ fn stderr(o: &Output) -> String {
 
 const VALID: &str = r#"{
   "name": "t",
+  "family": "volume",
   "equations": ["V-tau", "V-E"],
   "scene": {
     "ray": { "origin": [-3.0, 0.3, 0.0], "direction": [1.0, 0.0, 0.0] },
@@ -111,8 +112,48 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
     );
     rejected(
         &VALID.replace("\"rule\": \"stratified\"", "\"rule\": \"simpson\""),
-        "rules[1].rule",
-        "unknown variant `simpson`, expected one of",
+        "rules[1]",
+        "unknown rule `simpson`: expected one of trapezoid, gauss-legendre",
+    );
+    rejected(
+        &VALID.replace("\"family\": \"volume\"", "\"family\": \"plasma\""),
+        "family",
+        "unknown family \"plasma\": expected one of volume",
+    );
+    rejected(
+        &VALID.replace("\"family\": \"volume\",", ""),
+        "family",
+        "missing: expected one of volume",
+    );
+    // A tracking estimator estimates tau only: asking it for I_E is refused
+    // at `check`, not a row of NaN in the report.
+    rejected(
+        &VALID.replace("{ \"rule\": \"stratified\" }", "{ \"rule\": \"ratio-tracking\" }"),
+        "rules[1]",
+        "estimator `ratio-tracking` estimates only tau, but quantities[1] is I_E",
+    );
+    // A 2-D product rule cannot integrate along a ray segment.
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"product\", \"outer\": { \"rule\": \"trapezoid\" }, \"inner\": { \"rule\": \"gauss-legendre\" } }",
+        ),
+        "rules[1]",
+        "rule `product` integrates in dimension 2 only",
+    );
+    // Every rule parameter is checked where it is written, products included.
+    rejected(
+        &VALID.replace("{ \"rule\": \"stratified\" }", "{ \"rule\": \"sobol\", \"replicates\": 1 }"),
+        "rules[1].replicates",
+        "an integer >= 2",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"product\", \"outer\": { \"rule\": \"gauss-legendre\", \"error_estimat\": true }, \"inner\": { \"rule\": \"trapezoid\" } }",
+        ),
+        "rules[1]",
+        "unknown field `error_estimat`, expected `error_estimate`",
     );
     rejected(
         &VALID.replace("\"kappa\": 2.0", "\"kappa\": 2.0, \"sigma\": 1"),
@@ -198,10 +239,8 @@ fn a_killed_run_resumes_to_the_results_of_an_uninterrupted_one() {
     // Nested optical depth makes each job slow enough to kill the run midway.
     let slow = VALID
         .replace("[4, 16, 64]", "[64, 128, 256, 512, 768, 1024]")
-        .replace(
-            "\"repeats\": 2",
-            "\"repeats\": 3, \"depth_scheme\": \"nested\"",
-        );
+        .replace("\"repeats\": 2", "\"repeats\": 3")
+        .replace("\"scene\": {", "\"scene\": { \"depth_scheme\": \"nested\",");
     fs::write(&file, &slow).expect("write");
     let full = dir.join("full");
     let o = bin()
@@ -362,17 +401,19 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
     let schema = bin().arg("schema").output().expect("runs");
     let schema: serde_json::Value =
         serde_json::from_slice(&schema.stdout).expect("the schema is JSON");
-    assert!(schema["properties"]["scene"].is_object());
+    // One schema per family, each with its scene format.
+    let volume = &schema["oneOf"][0];
+    assert!(volume["properties"]["scene"].is_object(), "{schema}");
+    assert!(volume["properties"]["family"].is_object(), "{schema}");
     let _ = fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn cancellation_in_the_total_is_flagged() {
     use lightquad::exact::volume::emission;
-    use lightquad::experiment::report::rows;
-    use lightquad::experiment::run::run_job;
-    use lightquad::experiment::spec::Quantity;
-    use lightquad::experiment::validate::{parse, validate};
+    use lightquad::experiment::report::{RowFlag, RuleInfo, rows};
+    use lightquad::experiment::validate::parse_json;
+    use lightquad::family::Flag;
     // Negative emission c = -1 on a chord of 2 at sigma = 1 and a background
     // I_b = -I_E / tau: the total V-I is zero up to rounding.
     let (sigma, chord) = (1.0f64, 2.0f64);
@@ -390,16 +431,20 @@ fn cancellation_in_the_total_is_flagged() {
             "{ \"type\": \"closed-form\" }",
             "{ \"type\": \"value\", \"values\": { \"I\": 0.0 } }",
         );
-    let exp = validate(parse(&text).expect("parses")).expect("valid");
-    let jobs: Vec<_> = [4usize, 16]
-        .iter()
-        .map(|&n| run_job(&exp, "h", 0, n, 0))
-        .collect();
-    let table = rows(&exp, &jobs, Quantity::Total, 0.0);
+    let exp = lightquad::families::builtin()
+        .load(parse_json(&text).expect("parses"), "h")
+        .expect("valid");
+    let jobs: Vec<_> = [4usize, 16].iter().map(|&n| exp.run_job((0, n, 0))).collect();
+    let rules = [RuleInfo {
+        label: "gauss-legendre".into(),
+        is_random: false,
+    }];
+    let table = rows(&rules, &jobs, "I", &[0.0]);
     assert!(
-        table
+        table.iter().all(|r| r
+            .flags
             .iter()
-            .all(|r| r.flags.iter().any(|f| f.starts_with("cancellation"))),
+            .any(|f| matches!(f, RowFlag::Job(Flag::Cancellation { .. })))),
         "{table:?}"
     );
 }

@@ -4,7 +4,7 @@
 //! strings. The law: never a panic, and every rejection names a JSON path and
 //! says what is wrong. (4,096 + 4,096 + 2,048 cases per run.)
 
-use lightquad::experiment::validate::{parse, validate};
+use lightquad::experiment::validate::parse_json;
 use proptest::prelude::*;
 use serde_json::Value;
 
@@ -24,7 +24,8 @@ fn bundled() -> Vec<String> {
 
 /// Parse and validate; an error must carry a path and a message.
 fn check(text: &str) -> Result<(), TestCaseError> {
-    match parse(text).and_then(validate) {
+    let registry = lightquad::families::builtin();
+    match parse_json(text).and_then(|json| registry.load(json, "h").map(|_| ())) {
         Ok(_) => Ok(()),
         Err(e) => {
             prop_assert!(!e.path.is_empty(), "no path in {e}");
@@ -126,8 +127,46 @@ proptest! {
     }
 }
 
+/// A tag: a known name, a near miss, or anything.
+fn tag() -> impl Strategy<Value = Value> {
+    prop_oneof![
+        Just(Value::from("volume")),
+        Just(Value::from("product")),
+        Just(Value::from("ratio-tracking")),
+        Just(Value::from("gauss-legendre")),
+        "[a-z-]{0,16}".prop_map(Value::from),
+        extreme(),
+    ]
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 2048, ..ProptestConfig::default() })]
+
+    /// The family tag and the rule tags replaced by known names, near misses,
+    /// other types, or dropped; and products nested in any slot.
+    #[test]
+    fn family_and_rule_tags_never_panic(
+        file in 0usize..64, family in tag(), rule in tag(), slot in 0usize..8, drop in any::<bool>(),
+        nest in any::<bool>(),
+    ) {
+        let files = bundled();
+        let mut tree: Value = serde_json::from_str(&files[file % files.len()]).expect("bundled JSON");
+        if drop {
+            tree.as_object_mut().map(|m| m.remove("family"));
+        } else {
+            tree["family"] = family;
+        }
+        if let Some(rules) = tree["rules"].as_array_mut() {
+            let n = rules.len();
+            let r = &mut rules[slot % n];
+            if nest {
+                *r = serde_json::json!({"rule": "product", "outer": r.clone(), "inner": {"rule": rule}});
+            } else {
+                r["rule"] = rule;
+            }
+        }
+        check(&tree.to_string())?;
+    }
 
     #[test]
     fn arbitrary_strings_never_panic(text in ".{0,300}") {

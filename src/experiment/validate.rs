@@ -33,22 +33,29 @@ pub struct Experiment<F: Family> {
     pub known: Option<Known<F::Quantity>>,
 }
 
-/// Parses the text of an experiment file as JSON (syntax errors only; the
-/// family's format is checked by [`deserialize`]).
+/// Parses the text of an experiment file as JSON (syntax only: the family's
+/// format is checked by [`deserialize`]); a syntax error names the JSON path
+/// it is in, and its line and column.
 pub fn parse_json(text: &str) -> Result<serde_json::Value, SpecError> {
-    serde_json::from_str(text).map_err(|e| SpecError::at(".", e.to_string()))
+    let de = &mut serde_json::Deserializer::from_str(text);
+    let json: serde_json::Value = serde_path_to_error::deserialize(&mut *de).map_err(path_error)?;
+    de.end().map_err(|e| SpecError::at(".", e.to_string()))?;
+    Ok(json)
+}
+
+/// A serde error at its JSON path (`.` for the root).
+fn path_error<E: std::fmt::Display>(e: serde_path_to_error::Error<E>) -> SpecError {
+    let path = e.path().to_string();
+    SpecError::at(
+        if path.is_empty() { ".".into() } else { path },
+        e.inner().to_string(),
+    )
 }
 
 /// Reads a parsed file as an experiment of family `F`, naming the JSON path
 /// of any fault.
 pub fn deserialize<F: Family>(json: serde_json::Value) -> Result<ExperimentSpec<F>, SpecError> {
-    serde_path_to_error::deserialize(json).map_err(|e| {
-        let path = e.path().to_string();
-        SpecError::at(
-            if path.is_empty() { ".".into() } else { path },
-            e.inner().to_string(),
-        )
-    })
+    serde_path_to_error::deserialize(json).map_err(path_error)
 }
 
 /// Validates a parsed experiment whose file hashes to `hash`.
