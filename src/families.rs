@@ -6,5 +6,7 @@ use crate::experiment::Registry;
 /// Every family this crate ships, in listing order. Adding a family is its
 /// module and one line here.
 pub fn builtin() -> Registry {
-    Registry::new().with::<crate::volume::experiment::Volume>()
+    Registry::new()
+        .with::<crate::calibration::Calibration>()
+        .with::<crate::volume::experiment::Volume>()
 }

@@ -25,15 +25,7 @@ use crate::quadrature::{AnyRule, Rule};
 
 /// A quantity a family computes (`tau`, `I_L`, a pixel image, ...).
 pub trait Quantity:
-    Copy
-    + Ord
-    + Debug
-    + Serialize
-    + DeserializeOwned
-    + JsonSchema
-    + Send
-    + Sync
-    + 'static
+    Copy + Ord + Debug + Serialize + DeserializeOwned + JsonSchema + Send + Sync + 'static
 {
     /// The name in experiment files, results and reports.
     fn name(&self) -> &'static str;
@@ -96,6 +88,14 @@ impl<E: Estimator> Method<E> {
         match self {
             Method::Rule(r) => r.name(),
             Method::Estimator(e) => e.name(),
+        }
+    }
+
+    /// The name, with a product's factors (`product(gauss-legendre,trapezoid)`).
+    pub fn label(&self) -> String {
+        match self {
+            Method::Rule(r) => r.label(),
+            Method::Estimator(e) => e.name().to_string(),
         }
     }
 
@@ -252,7 +252,14 @@ pub trait Family: Sized + Send + Sync + 'static {
     const EQUATIONS: &'static [&'static str];
 
     /// The scene as written in an experiment file.
-    type SceneSpec: Clone + Debug + PartialEq + Serialize + DeserializeOwned + JsonSchema + Send + Sync;
+    type SceneSpec: Clone
+        + Debug
+        + PartialEq
+        + Serialize
+        + DeserializeOwned
+        + JsonSchema
+        + Send
+        + Sync;
     /// The scene, built and checked.
     type Scene: Debug + Send + Sync;
     /// Its quantities.
@@ -264,8 +271,9 @@ pub trait Family: Sized + Send + Sync + 'static {
     /// JSON path from the file's root (`scene.medium.kappa`).
     fn build(spec: &Self::SceneSpec) -> Result<Self::Scene, SpecError>;
 
-    /// The dimension of the unit cube over which a rule integrates `quantity`.
-    fn dimension(quantity: Self::Quantity) -> usize;
+    /// The dimension of the unit cube over which a rule integrates `quantity`
+    /// in `scene`.
+    fn dimension(scene: &Self::Scene, quantity: Self::Quantity) -> usize;
 
     /// The quantities `estimator` estimates.
     fn estimates(estimator: &Self::Estimator) -> &'static [Self::Quantity];

@@ -32,6 +32,7 @@
 #![deny(clippy::unwrap_used, clippy::expect_used)]
 #![warn(missing_docs)]
 
+pub mod calibration;
 pub mod domain;
 pub mod error;
 pub mod estimate;

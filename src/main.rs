@@ -7,8 +7,8 @@ use clap::{Parser, Subcommand};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use lightquad::experiment::run::RunOptions;
 use lightquad::experiment;
+use lightquad::experiment::run::RunOptions;
 use lightquad::families;
 use lightquad::quadrature::gauss_legendre;
 

@@ -14,7 +14,10 @@ use proptest::prelude::*;
 
 /// Every registered rule.
 fn rules() -> Vec<AnyRule> {
-    BaseRule::defaults().into_iter().map(AnyRule::from).collect()
+    BaseRule::defaults()
+        .into_iter()
+        .map(AnyRule::from)
+        .collect()
 }
 
 /// `sum c_i t^i` by Horner's scheme.

@@ -417,8 +417,17 @@ fn an_integrand_error_propagates_through_every_rule() {
                 rule.try_integrate(256, &mut rng(1), |u: [f64; 1]| f(u[0]))
             }
             .expect_err("the integrand failed");
-            assert!(e.to_string().contains("a test failure"), "{}: {e}", rule.name());
-            assert_eq!(calls, fail_at + 1, "{}: evaluated past the failure", rule.name());
+            assert!(
+                e.to_string().contains("a test failure"),
+                "{}: {e}",
+                rule.name()
+            );
+            assert_eq!(
+                calls,
+                fail_at + 1,
+                "{}: evaluated past the failure",
+                rule.name()
+            );
         }
     }
 }

@@ -128,7 +128,10 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
     // A tracking estimator estimates tau only: asking it for I_E is refused
     // at `check`, not a row of NaN in the report.
     rejected(
-        &VALID.replace("{ \"rule\": \"stratified\" }", "{ \"rule\": \"ratio-tracking\" }"),
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"ratio-tracking\" }",
+        ),
         "rules[1]",
         "estimator `ratio-tracking` estimates only tau, but quantities[1] is I_E",
     );
@@ -143,7 +146,10 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
     );
     // Every rule parameter is checked where it is written, products included.
     rejected(
-        &VALID.replace("{ \"rule\": \"stratified\" }", "{ \"rule\": \"sobol\", \"replicates\": 1 }"),
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"sobol\", \"replicates\": 1 }",
+        ),
         "rules[1].replicates",
         "an integer >= 2",
     );
@@ -434,7 +440,10 @@ fn cancellation_in_the_total_is_flagged() {
     let exp = lightquad::families::builtin()
         .load(parse_json(&text).expect("parses"), "h")
         .expect("valid");
-    let jobs: Vec<_> = [4usize, 16].iter().map(|&n| exp.run_job((0, n, 0))).collect();
+    let jobs: Vec<_> = [4usize, 16]
+        .iter()
+        .map(|&n| exp.run_job((0, n, 0)))
+        .collect();
     let rules = [RuleInfo {
         label: "gauss-legendre".into(),
         is_random: false,

@@ -124,7 +124,10 @@ pub fn run_files(
 ) -> Result<PathBuf, RunError> {
     let loaded = load_all(registry, files)?;
     writable(&opts.out)?;
-    let total: usize = loaded.iter().map(|(e, _, _)| e.jobs(opts.shard).len()).sum();
+    let total: usize = loaded
+        .iter()
+        .map(|(e, _, _)| e.jobs(opts.shard).len())
+        .sum();
     let bar = if opts.progress {
         indicatif::ProgressBar::new(total as u64)
     } else {
@@ -179,7 +182,11 @@ fn write_reports(
     for (exp, results) in done {
         let dir = out.join(exp.name());
         let (summary, rows) = exp.write_report(&dir, results).map_err(|e| io(&dir, e))?;
-        entries.push((exp.name().to_string(), exp.description().to_string(), summary));
+        entries.push((
+            exp.name().to_string(),
+            exp.description().to_string(),
+            summary,
+        ));
         checks.extend(rows);
     }
     // The audits of the families that have experiments here.
@@ -292,4 +299,3 @@ pub fn experiment_files(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
     files.sort();
     Ok(files)
 }
-

@@ -183,7 +183,9 @@ pub fn rms(xs: impl Iterator<Item = f64> + Clone) -> f64 {
 /// The reference of a run.
 pub fn reference<F: Family>(exp: &Experiment<F>) -> Reference {
     let by_name = |m: BTreeMap<F::Quantity, Vec<f64>>| -> BTreeMap<String, Vec<f64>> {
-        m.into_iter().map(|(q, v)| (q.name().to_string(), v)).collect()
+        m.into_iter()
+            .map(|(q, v)| (q.name().to_string(), v))
+            .collect()
     };
     if let Some(known) = &exp.known {
         // Relative accuracy: the stated uncertainty against the smallest
@@ -309,8 +311,7 @@ pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
             Some((v, se)) if se > 0.0 => format!("{:+.2} SE", (r.lightquad - v) / se),
             Some((v, _)) => format!(
                 "{:+.1e} relative (deterministic, float32)",
-                relative_distance(&[r.lightquad], &[v])
-                    * if r.lightquad >= v { 1.0 } else { -1.0 }
+                relative_distance(&[r.lightquad], &[v]) * if r.lightquad >= v { 1.0 } else { -1.0 }
             ),
             None => "—".into(),
         };

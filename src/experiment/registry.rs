@@ -55,11 +55,7 @@ impl<F: Family> Loaded for Experiment<F> {
         &self.hash
     }
     fn shape(&self) -> (usize, usize, usize) {
-        (
-            self.spec.rules.len(),
-            self.budgets.len(),
-            self.spec.repeats,
-        )
+        (self.spec.rules.len(), self.budgets.len(), self.spec.repeats)
     }
     fn jobs(&self, shard: Option<(usize, usize)>) -> Vec<JobKey> {
         jobs(self, shard)
@@ -91,12 +87,12 @@ fn page<'a, F: Family>(
         .iter()
         .enumerate()
         .map(|(i, m)| {
-            let twice = spec.rules.iter().filter(|r| r.name() == m.name()).count() > 1;
+            let twice = spec.rules.iter().filter(|r| r.label() == m.label()).count() > 1;
             RuleInfo {
                 label: if twice {
-                    format!("{}#{i}", m.name())
+                    format!("{}#{i}", m.label())
                 } else {
-                    m.name().to_string()
+                    m.label()
                 },
                 is_random: m.is_random(),
             }
@@ -237,11 +233,8 @@ impl Registry {
 
     /// The JSON Schema of experiment files: one of the families' schemas.
     pub fn schema(&self) -> serde_json::Value {
-        let schemas: Vec<serde_json::Value> = self
-            .entries
-            .iter()
-            .map(|e| e.schema().to_value())
-            .collect();
+        let schemas: Vec<serde_json::Value> =
+            self.entries.iter().map(|e| e.schema().to_value()).collect();
         serde_json::json!({
             "$schema": "https://json-schema.org/draft/2020-12/schema",
             "title": "lightquad experiment",

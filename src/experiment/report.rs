@@ -16,7 +16,7 @@ use plotters::prelude::*;
 use super::fit::fitted_order;
 use super::reference::{Crosscheck, Reference, crosscheck_markdown, rms};
 use super::run::{JobResult, write_atomic};
-use crate::family::Flag;
+use crate::family::{Flag, Measured};
 
 /// What a report page shows of an experiment, whatever its family.
 #[derive(Debug, Clone)]
@@ -199,12 +199,14 @@ fn row(
     {
         flags.push(RowFlag::NonFinite);
     }
-    for m in &measured {
-        for f in &m.flags {
-            let same = |g: &RowFlag| matches!(g, RowFlag::Job(h) if std::mem::discriminant(h) == std::mem::discriminant(f));
-            if !flags.iter().any(same) {
-                flags.push(RowFlag::Job(*f));
-            }
+    // The families' flags, once per kind.
+    for f in measured.iter().flat_map(|m| &m.flags) {
+        let kind = std::mem::discriminant(f);
+        if !flags
+            .iter()
+            .any(|g| matches!(g, RowFlag::Job(h) if std::mem::discriminant(h) == kind))
+        {
+            flags.push(RowFlag::Job(*f));
         }
     }
     let count = measured.len() as f64;
@@ -224,21 +226,8 @@ fn row(
         / count
         / scale;
     let evaluations = measured.iter().map(|m| m.evaluations as f64).sum::<f64>() / count;
-    // The rule's own error estimate against the truth.
-    if random {
-        let outside = measured.iter().any(|m| {
-            m.error.iter().enumerate().any(|(c, e)| {
-                e.is_finite() && (channel(&m.value, c) - channel(reference, c)).abs() > 4.0 * e
-            })
-        });
-        if outside {
-            flags.push(RowFlag::OutsideStandardErrors);
-        }
-    } else if rel_error > 100.0 * FLOOR
-        && rel_estimate.is_finite()
-        && (rel_estimate > 10.0 * rel_error || rel_estimate < rel_error / 10.0)
-    {
-        flags.push(RowFlag::EstimateOff);
+    if let Some(flag) = judge_estimate(&measured, reference, rel_error, rel_estimate, random) {
+        flags.push(flag);
     }
     Row {
         rule_index,
@@ -249,6 +238,31 @@ fn row(
         evaluations,
         seconds,
         flags,
+    }
+}
+
+/// The rule's own error estimate against the truth: a random estimate more
+/// than 4 standard errors off in any channel; a deterministic estimate off by
+/// more than 10x, above the rounding floor.
+fn judge_estimate(
+    measured: &[&Measured],
+    reference: &[f64],
+    rel_error: f64,
+    rel_estimate: f64,
+    random: bool,
+) -> Option<RowFlag> {
+    if random {
+        let outside = measured.iter().any(|m| {
+            m.error.iter().enumerate().any(|(c, e)| {
+                e.is_finite() && (channel(&m.value, c) - channel(reference, c)).abs() > 4.0 * e
+            })
+        });
+        outside.then_some(RowFlag::OutsideStandardErrors)
+    } else {
+        let off = rel_error > 100.0 * FLOOR
+            && rel_estimate.is_finite()
+            && (rel_estimate > 10.0 * rel_error || rel_estimate < rel_error / 10.0);
+        off.then_some(RowFlag::EstimateOff)
     }
 }
 
@@ -410,16 +424,24 @@ fn header(page: &Page, results: &[JobResult]) -> String {
     } else {
         format!(", {}", page.settings)
     };
+    let equations = if page.equations.is_empty() {
+        String::new()
+    } else {
+        format!(" Equations: {}.", page.equations.join(", "))
+    };
+    let shared = if page.quantities.len() > 1 {
+        format!(
+            " A job evaluates all {} quantities together: its time is theirs together.",
+            page.quantities.len()
+        )
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         md,
-        "Family `{}`. Equations: {}. Budgets {:?} per smooth piece, {} repeat(s), seed {}{settings}.\n\n\
+        "Family `{}`.{equations} Budgets {:?} per smooth piece, {} repeat(s), seed {}{settings}.{shared}\n\n\
          Reference: {}\n",
-        page.family,
-        page.equations.join(", "),
-        page.budgets,
-        page.repeats,
-        page.seed,
-        page.reference.note
+        page.family, page.budgets, page.repeats, page.seed, page.reference.note
     );
     if let Some(r) = results.first() {
         let _ = writeln!(
@@ -510,9 +532,23 @@ fn orders_and_plots(
         let _ = writeln!(md, "| {label} | {order} | {} |", times.join(" | "));
         ranking.push((label.clone(), reach(middle)));
         // Errors at exactly 0 are drawn at 1e-17; NaN (failed) rows are dropped.
-        let err = |r: &&Row| if r.rel_error.is_nan() { f64::NAN } else { r.rel_error.max(1e-17) };
-        by_time.push((label.clone(), mine.iter().map(|r| (r.seconds.max(1e-9), err(r))).collect()));
-        by_n.push((label, mine.iter().map(|r| (r.evaluations.max(1.0), err(r))).collect()));
+        let err = |r: &&Row| {
+            if r.rel_error.is_nan() {
+                f64::NAN
+            } else {
+                r.rel_error.max(1e-17)
+            }
+        };
+        by_time.push((
+            label.clone(),
+            mine.iter().map(|r| (r.seconds.max(1e-9), err(r))).collect(),
+        ));
+        by_n.push((
+            label,
+            mine.iter()
+                .map(|r| (r.evaluations.max(1.0), err(r)))
+                .collect(),
+        ));
     }
     let base = format!("{}-{q}", page.name);
     plot(
@@ -552,7 +588,11 @@ fn csv(results: &[JobResult]) -> String {
         );
         let failure = r.failure.as_deref().unwrap_or("").replace([',', '\n'], ";");
         if r.quantities.is_empty() {
-            let why = if failure.is_empty() { "no value" } else { &failure };
+            let why = if failure.is_empty() {
+                "no value"
+            } else {
+                &failure
+            };
             let _ = writeln!(csv, "{lead},,,,,{:e},{why}", r.seconds);
         }
         for (q, m) in &r.quantities {

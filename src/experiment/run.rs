@@ -126,7 +126,7 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         experiment_hash: exp.hash.clone(),
         family: F::NAME.to_string(),
         rule_index,
-        rule: method.name().to_string(),
+        rule: method.label(),
         budget,
         repeat,
         seed,
@@ -158,7 +158,7 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
 pub fn jobs<F: Family>(exp: &Experiment<F>, shard: Option<(usize, usize)>) -> Vec<JobKey> {
     let mut all = Vec::new();
     for (r, method) in exp.spec.rules.iter().enumerate() {
-        let least = min_budget::<F>(method, &exp.spec.quantities);
+        let least = min_budget::<F>(&exp.scene, method, &exp.spec.quantities);
         for &b in exp.budgets.iter().filter(|&&b| b >= least) {
             for k in 0..exp.spec.repeats {
                 all.push((r, b, k));
@@ -243,7 +243,8 @@ pub fn run_experiment(
     }
     write_atomic(&path, text.as_bytes())?;
     let done: BTreeSet<_> = kept.iter().map(JobResult::key).collect();
-    let pending: Vec<_> = exp.jobs(opts.shard)
+    let pending: Vec<_> = exp
+        .jobs(opts.shard)
         .into_iter()
         .filter(|j| !done.contains(j))
         .collect();

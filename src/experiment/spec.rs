@@ -23,7 +23,9 @@ pub struct ExperimentSpec<F: Family> {
     /// What the experiment shows.
     #[serde(default)]
     pub description: String,
-    /// The equation IDs it instantiates (docs/EQUATIONS.md: `V-tau`, `V-E`, ...).
+    /// The equation IDs it instantiates (docs/EQUATIONS.md: `V-tau`, `V-E`, ...;
+    /// default none).
+    #[serde(default)]
     pub equations: Vec<String>,
     /// The scene, in the family's format: only the parts it has.
     pub scene: F::SceneSpec,
@@ -103,7 +105,10 @@ impl Literal {
     tag = "type",
     rename_all = "kebab-case",
     deny_unknown_fields,
-    bound(serialize = "Q: Serialize + Ord", deserialize = "Q: Deserialize<'de> + Ord")
+    bound(
+        serialize = "Q: Serialize + Ord",
+        deserialize = "Q: Deserialize<'de> + Ord"
+    )
 )]
 pub enum ReferenceSpec<Q> {
     /// The family's closed forms (an error at validation when a quantity has none).

@@ -64,14 +64,14 @@ pub fn validate<F: Family>(
     hash: &str,
 ) -> Result<Experiment<F>, SpecError> {
     check_header::<F>(&spec)?;
-    check_methods::<F>(&spec)?;
     let scene = F::build(&spec.scene)?;
+    check_methods::<F>(&spec, &scene)?;
     let budgets = budgets(&spec.budgets)?;
     // Budgets below a rule's minimum are skipped for that rule; a rule left
     // with none is an error, so no rule silently disappears.
     let largest = budgets.last().copied().unwrap_or(0);
     for (i, m) in spec.rules.iter().enumerate() {
-        let need = min_budget::<F>(m, &spec.quantities);
+        let need = min_budget::<F>(&scene, m, &spec.quantities);
         if largest < need {
             return Err(SpecError::at(
                 "budgets",
@@ -93,10 +93,14 @@ pub fn validate<F: Family>(
 }
 
 /// The smallest budget `method` needs for every quantity of the experiment.
-pub fn min_budget<F: Family>(method: &Method<F::Estimator>, quantities: &[F::Quantity]) -> usize {
+pub fn min_budget<F: Family>(
+    scene: &F::Scene,
+    method: &Method<F::Estimator>,
+    quantities: &[F::Quantity],
+) -> usize {
     quantities
         .iter()
-        .map(|q| method.min_budget(F::dimension(*q)))
+        .map(|q| method.min_budget(F::dimension(scene, *q)))
         .max()
         .unwrap_or(1)
 }
@@ -162,7 +166,7 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
 /// Every rule's parameters, and that every rule and estimator can compute
 /// every quantity asked for (a rule in the quantity's dimension; an
 /// estimator only the quantities it estimates).
-fn check_methods<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
+fn check_methods<F: Family>(spec: &ExperimentSpec<F>, scene: &F::Scene) -> Result<(), SpecError> {
     if spec.rules.is_empty() {
         return Err(SpecError::at(
             "rules",
@@ -178,7 +182,7 @@ fn check_methods<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
             Method::Rule(rule) => {
                 rule.check().map_err(|e| SpecError::from_quad(&at, e))?;
                 for (k, q) in spec.quantities.iter().enumerate() {
-                    let dim = F::dimension(*q);
+                    let dim = F::dimension(scene, *q);
                     if !rule.dimensions().contains(dim) {
                         return Err(SpecError::at(
                             at,

@@ -317,6 +317,15 @@ impl AnyRule {
         BaseRule::by_name(name).map(AnyRule::Base)
     }
 
+    /// The rule's name, with its factors for a product:
+    /// `product(gauss-legendre,trapezoid)`.
+    pub fn label(&self) -> String {
+        match self {
+            AnyRule::Base(r) => r.name().to_string(),
+            AnyRule::Product(p) => format!("product({},{})", p.outer.name(), p.inner.name()),
+        }
+    }
+
     /// Every rule's name and one line about it, products last (for `lightquad rules`).
     pub fn listing() -> Vec<(&'static str, &'static str)> {
         let mut lines: Vec<(&'static str, &'static str)> = BaseRule::defaults()
@@ -412,11 +421,12 @@ mod tests {
 
     /// The registry's name for a rule (its serde tag) is the rule's own name.
     #[test]
-    fn registry_names_match_rule_names() {
+    fn registry_names_match_rule_names() -> Result<(), serde_json::Error> {
         for rule in BaseRule::defaults() {
-            let json = serde_json::to_value(&rule).expect("serialises");
+            let json = serde_json::to_value(&rule)?;
             assert_eq!(json["rule"], rule.name());
             assert_eq!(BaseRule::by_name(rule.name()), Ok(rule));
         }
+        Ok(())
     }
 }

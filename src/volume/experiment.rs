@@ -220,7 +220,9 @@ impl family::Estimator for Tracker {
     }
     fn about(&self) -> &'static str {
         match self {
-            Tracker::Delta => "delta (Woodcock) tracking of tau, per-span majorants; standard error",
+            Tracker::Delta => {
+                "delta (Woodcock) tracking of tau, per-span majorants; standard error"
+            }
             Tracker::Ratio => "ratio tracking of tau, per-span majorants; standard error",
             Tracker::ResidualRatio => {
                 "residual ratio tracking of tau with a per-span control extinction; standard error"
@@ -282,7 +284,7 @@ impl Family for Volume {
     }
 
     /// Every volume integral is along a ray segment.
-    fn dimension(_: VolumeQuantity) -> usize {
+    fn dimension(_: &Built, _: VolumeQuantity) -> usize {
         1
     }
 
@@ -404,8 +406,8 @@ fn collect(res: &VolumeResult, quantities: &[VolumeQuantity]) -> Outcome<VolumeQ
 fn total(res: &VolumeResult) -> Measured {
     let terms = [res.emission, res.background, res.light];
     let error = terms.iter().flatten().map(|t| t.error).sum();
-    let evaluations = res.optical_depth.evaluations
-        + terms.iter().flatten().map(|t| t.evaluations).sum::<u64>();
+    let evaluations =
+        res.optical_depth.evaluations + terms.iter().flatten().map(|t| t.evaluations).sum::<u64>();
     let parts = terms.iter().flatten().map(|t| t.value.abs()).sum::<f64>();
     let m = Measured::scalar(res.total, error, evaluations);
     if parts > 0.0 && res.total.abs() < 1e-6 * parts {
@@ -616,4 +618,3 @@ fn scene(s: &SceneSpec) -> Result<VolumeScene, SpecError> {
     }
     Ok(scene)
 }
-

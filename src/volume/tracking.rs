@@ -17,9 +17,9 @@
 //! Every smooth piece is cut into 16 spans, each with its own majorant (and
 //! control); the per-walk scores of the spans multiply.
 
+use rand::RngExt;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use rand::RngExt;
 
 use super::medium::Medium;
 use crate::error::QuadError;

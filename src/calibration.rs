@@ -1,0 +1,185 @@
+//! The calibration family: integrals whose values are known in closed form,
+//! over the domains of rendering, so every rule's accuracy, error estimate,
+//! cost and order can be read against the truth before it meets an equation
+//! (`"family": "calibration"`). Its scene is empty; its quantities are the
+//! integrals themselves:
+//!
+//! | quantity | integral | value | dimension |
+//! |---|---|---|---:|
+//! | `exp` | `int_0^1 e^u du` | `e - 1` | 1 |
+//! | `exp-rgb` | `int_0^1 (e^u, e^{2u}, e^{3u}) du` | `((e-1), (e^2-1)/2, (e^3-1)/3)` | 1 |
+//! | `gaussian-disk` | `int_{unit disk} e^{-(x^2+y^2)} dA` | `pi (1 - 1/e)` | 2 |
+//! | `cos3-hemisphere` | `int_{H^2} cos^3(theta) d omega` | `pi / 2` | 2 |
+
+use std::f64::consts::{E, PI};
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::domain::{Disk, Hemisphere, Vec3, integrate_over};
+use crate::error::{QuadError, SpecError};
+use crate::estimate::Estimate;
+use crate::family::{self, Family, Measured, Method, NoEstimator, Outcome};
+use crate::quadrature::{GaussLegendre, Rule};
+use crate::value::Rgb;
+
+/// The calibration family.
+#[derive(Debug, Clone, Copy)]
+pub struct Calibration;
+
+/// The calibration scene: nothing (the quantities are the integrals).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct NoScene {}
+
+/// An integral with a known value.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Integral {
+    /// `int_0^1 e^u du = e - 1`.
+    Exp,
+    /// `int_0^1 (e^u, e^{2u}, e^{3u}) du`, one channel each.
+    ExpRgb,
+    /// `int_{unit disk} e^{-(x^2+y^2)} dA = pi (1 - 1/e)`.
+    GaussianDisk,
+    /// `int_{H^2} cos^3(theta) d omega = pi / 2`.
+    Cos3Hemisphere,
+}
+
+impl family::Quantity for Integral {
+    fn name(&self) -> &'static str {
+        match self {
+            Integral::Exp => "exp",
+            Integral::ExpRgb => "exp-rgb",
+            Integral::GaussianDisk => "gaussian-disk",
+            Integral::Cos3Hemisphere => "cos3-hemisphere",
+        }
+    }
+
+    fn all() -> &'static [Self] {
+        &[
+            Integral::Exp,
+            Integral::ExpRgb,
+            Integral::GaussianDisk,
+            Integral::Cos3Hemisphere,
+        ]
+    }
+}
+
+/// `q` with `rule` at budget `n`; evaluations are integrand evaluations.
+fn integrate<R: Rule>(
+    q: Integral,
+    rule: &R,
+    n: usize,
+    rng: &mut rand_pcg::Pcg64,
+) -> Result<Measured, QuadError> {
+    let channels = |e: Estimate<Rgb>| Measured {
+        value: e.value.iter().copied().collect(),
+        error: e.error.iter().copied().collect(),
+        evaluations: e.evaluations,
+        flags: Vec::new(),
+    };
+    let scalar = |e: Estimate<f64>| Measured::scalar(e.value, e.error, e.evaluations);
+    Ok(match q {
+        Integral::Exp => scalar(rule.integrate(n, rng, |u: [f64; 1]| u[0].exp())?),
+        Integral::ExpRgb => channels(rule.integrate(n, rng, |u: [f64; 1]| {
+            Rgb::new(u[0].exp(), (2.0 * u[0]).exp(), (3.0 * u[0]).exp())
+        })?),
+        Integral::GaussianDisk => {
+            let disk = Disk::new(Vec3::zeros(), Vec3::z(), 1.0)?;
+            scalar(integrate_over(rule, &disk, n, rng, |p| {
+                (-(p.x * p.x + p.y * p.y)).exp()
+            })?)
+        }
+        Integral::Cos3Hemisphere => {
+            scalar(integrate_over(rule, &Hemisphere::uniform(), n, rng, |w| {
+                w.z * w.z * w.z
+            })?)
+        }
+    })
+}
+
+impl Family for Calibration {
+    const NAME: &'static str = "calibration";
+    const ABOUT: &'static str =
+        "integrals with closed forms over a segment, a disk and the hemisphere, to calibrate rules";
+    const EQUATIONS: &'static [&'static str] = &[];
+
+    type SceneSpec = NoScene;
+    type Scene = NoScene;
+    type Quantity = Integral;
+    type Estimator = NoEstimator;
+
+    fn build(spec: &NoScene) -> Result<NoScene, SpecError> {
+        Ok(spec.clone())
+    }
+
+    fn dimension(_: &NoScene, q: Integral) -> usize {
+        match q {
+            Integral::Exp | Integral::ExpRgb => 1,
+            Integral::GaussianDisk | Integral::Cos3Hemisphere => 2,
+        }
+    }
+
+    fn estimates(e: &NoEstimator) -> &'static [Integral] {
+        match *e {}
+    }
+
+    fn evaluate(
+        _: &NoScene,
+        method: &Method<NoEstimator>,
+        budget: usize,
+        rng: &mut rand_pcg::Pcg64,
+        quantities: &[Integral],
+    ) -> Result<Outcome<Integral>, QuadError> {
+        let Method::Rule(rule) = method else {
+            return Err(QuadError::invalid(
+                "rule",
+                method.name(),
+                "a quadrature rule",
+            ));
+        };
+        quantities
+            .iter()
+            .map(|&q| Ok((q, integrate(q, rule, budget, rng)?)))
+            .collect()
+    }
+
+    fn closed_form(_: &NoScene, q: Integral) -> Option<Vec<f64>> {
+        Some(match q {
+            Integral::Exp => vec![E - 1.0],
+            Integral::ExpRgb => vec![
+                E - 1.0,
+                (2.0f64.exp() - 1.0) / 2.0,
+                (3.0f64.exp() - 1.0) / 3.0,
+            ],
+            Integral::GaussianDisk => vec![PI * (1.0 - (-1.0f64).exp())],
+            Integral::Cos3Hemisphere => vec![PI / 2.0],
+        })
+    }
+
+    fn closed_forms_available() -> &'static str {
+        "every calibration integral has one"
+    }
+
+    /// Gauss–Legendre with `n` nodes per axis.
+    fn converged(
+        scene: &NoScene,
+        n: usize,
+        quantities: &[Integral],
+    ) -> Result<Outcome<Integral>, QuadError> {
+        let rule = GaussLegendre {
+            error_estimate: false,
+        };
+        let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
+        quantities
+            .iter()
+            .map(|&q| {
+                let budget = n.saturating_pow(Self::dimension(scene, q) as u32);
+                Ok((q, integrate(q, &rule, budget, &mut rng)?))
+            })
+            .collect()
+    }
+}
