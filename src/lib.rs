@@ -10,10 +10,19 @@
 //!
 //! - a **rule** ([`quadrature`]) places weighted nodes in `[0, 1]^D` for a budget
 //!   of `n` evaluations and returns an [`Estimate`] (value, error estimate,
-//!   evaluations);
+//!   evaluations); its facts (minimum budget, randomness, dimensions) are its
+//!   own methods. Adding one: its file and one line in the `registry!` of
+//!   [`quadrature`].
 //! - a **domain** ([`domain`]) maps `[0, 1]^D` onto a ray segment, a surface
-//!   patch, the hemisphere or a pixel, with the Jacobian of the map;
-//! - an **equation** supplies the integrand.
+//!   patch, the hemisphere or a pixel, with the Jacobian of the map. Adding
+//!   one: its file.
+//! - a **family** of equations ([`family::Family`]: [`volume`], [`calibration`])
+//!   owns its scene format, quantities, estimators beside the rules, closed
+//!   forms and audit. Adding one: its module and one line in [`families`],
+//!   the only place that names them.
+//!
+//! [`experiment`] (files, runs, references, reports) is generic over the
+//! family and never names one.
 //!
 //! ```
 //! use lightquad::domain::{Domain, Hemisphere, integrate_over};

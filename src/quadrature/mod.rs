@@ -5,7 +5,7 @@
 //! [`domain`](crate::domain)'s job) nor which equation it serves. Every rule
 //! implements [`Rule`]; [`AnyRule`] selects one by name at run time.
 //!
-//! **The registry** is the one [`registry!`] line per rule below: it declares
+//! **The registry** is the one `registry!` line per rule below: it declares
 //! the rule's module and its name in experiment files, and generates
 //! [`BaseRule`] (the serde rule spec, tagged by `"rule"`, every parameter a
 //! field of the rule's own struct) with dispatch of every [`Rule`] method.
