@@ -5,6 +5,7 @@ import argparse
 import sys
 import time
 
+from .mitsuba3 import MitsubaMissing, require_mitsuba
 from .runner import DEFAULT_OUT, check, compute
 from .spec import SpecError
 
@@ -34,10 +35,9 @@ def main(argv=None):
     if not args.files:
         ap.error("give one or more experiment files (or --check)")
 
-    try:
-        from .mitsuba_scene import MitsubaMissing, require_mitsuba
-        from .quantities import Settings
-    except ImportError as e:  # numpy, before Mitsuba is even tried
+    try:  # the families' dependencies (numpy), before Mitsuba is even tried
+        from . import families  # noqa: F401
+    except ImportError as e:
         print(f"error: {e} (Python {sys.executable}).\nInstall the pinned versions with:\n"
               "    pip install -r reference/requirements.txt", file=sys.stderr)
         return 3
@@ -47,13 +47,12 @@ def main(argv=None):
         print(f"error: {e}", file=sys.stderr)
         return 3
 
-    settings = Settings(quick=args.quick)
     failed = 0
     t0 = time.perf_counter()
     for path in args.files:
         print(f"{path}:", flush=True)
         try:
-            rec = compute(path, settings, args.out)
+            rec = compute(path, args.quick, args.out)
         except SpecError as e:
             print(f"error: {path}: {e}", file=sys.stderr, flush=True)
             failed += 1

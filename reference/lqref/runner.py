@@ -1,5 +1,6 @@
-"""Computing an experiment's values with Mitsuba 3, writing them, and checking
-values files against their experiment files (stale when the hash differs)."""
+"""Computing an experiment's values with Mitsuba 3 (its family computes each
+quantity), writing them, and checking values files against their experiment
+files (stale when the hash differs)."""
 
 import json
 import os
@@ -7,78 +8,40 @@ import platform
 import time
 from pathlib import Path
 
-from . import spec as spec_mod
+from . import spec
 from .fnv import file_hash
-from .spec import SpecError
+from .mitsuba3 import versions
 
 REFERENCE_DIR = Path(__file__).resolve().parent.parent  # reference/
 REPO_ROOT = REFERENCE_DIR.parent
 DEFAULT_OUT = REFERENCE_DIR / "values"
-EXPRESSIBLE_MEDIA = ("constant-sphere", "voxel-grid")
-
-NO_EMISSION = ("Mitsuba 3 media have no volumetric emission (homogeneous and heterogeneous "
-               "media take no radiance): no counterpart of V-E")
-
-
-def unsupported_reason(exp, quantity):
-    """Why ``quantity`` is not computed for ``exp``, or None if it is."""
-    if quantity == "I_E":
-        return NO_EMISSION
-    if quantity == "I_B":
-        return ("not computed by this harness: I_B = I_b * tau, use the tau value "
-                "(or add a function for it)")
-    if quantity == "I":
-        if exp.emission is not None:
-            return "I = I_E + I_B + I_L needs I_E: " + NO_EMISSION
-        return "not computed by this harness: I = I_B + I_L here, I_B is not computed"
-    if quantity == "I_L" and exp.light is None:
-        return "the scene has no light"
-    return None
 
 
 def _log(message):
     print(message, flush=True)
 
 
-def compute(path, settings, out_dir=DEFAULT_OUT, log=_log):
-    """Computes the supported quantities of the experiment at ``path`` and
-    writes ``out_dir/<name>.json``; returns the record. Raises SpecError for a
-    scene element Mitsuba cannot express."""
-    from . import mitsuba_scene as ms
-    from . import quantities as qt
+def compute(path, quick=False, out_dir=DEFAULT_OUT, log=_log):
+    """Computes the supported quantities of the experiment at ``path`` with its
+    family's sample counts (``quick``: a smoke run's) and writes
+    ``out_dir/<name>.json``; returns the record. Raises SpecError for a fault in
+    the file or a scene element Mitsuba cannot express."""
+    from .families import FAMILIES  # here, not above: they need numpy, --check does not
 
-    exp = spec_mod.load(path)
-    if exp.medium is not None and exp.medium["type"] not in EXPRESSIBLE_MEDIA:
-        raise SpecError(
-            "scene.medium.type",
-            f"Mitsuba 3 cannot express a `{exp.medium['type']}` medium: its media are "
-            "homogeneous or voxel grids (gridvolume), and a voxelised copy would be a "
-            "different field")
+    exp = spec.load(path)
+    family = FAMILIES[exp.family]
+    family.require_expressible(exp)
+    settings = family.Settings(quick)
     digest = file_hash(path)
     start = time.perf_counter()
     values, unsupported = {}, {}
     for q in dict.fromkeys(exp.quantities):
-        reason = unsupported_reason(exp, q)
+        reason = family.unsupported_reason(exp, q)
         if reason is not None:
             unsupported[q] = reason
             continue
         t0 = time.perf_counter()
-        if q == "tau":
-            if exp.medium is None:
-                result = {"value": 1.0, "std_error": 0.0, "samples": 0,
-                          "method": "no medium: tau = 1"}
-            elif exp.medium["type"] == "constant-sphere":
-                result = qt.tau_constant_sphere(exp, settings)
-            else:
-                result = qt.tau_voxel_grid(exp, settings)
-        elif q == "I_L":
-            if exp.medium is None:
-                result = {"value": 0.0, "std_error": 0.0, "samples": 0,
-                          "method": "no medium: nothing scatters, I_L = 0"}
-            else:
-                result = qt.light_single_scattering(exp, settings)
-        else:  # unreachable: every quantity has a reason or a function
-            raise AssertionError(q)
+        result = family.compute(exp, q, settings)
         result["seconds"] = round(time.perf_counter() - t0, 3)
         values[q] = result
         log(f"  {q:4s} = {result['value']:.10g} +- {result['std_error']:.3g}"
@@ -90,7 +53,7 @@ def compute(path, settings, out_dir=DEFAULT_OUT, log=_log):
         "experiment": exp.name,
         "experiment_file": _display_path(path),
         "experiment_hash": digest,
-        **ms.versions(),
+        **versions(),
         "settings": settings.as_dict(),
         "seed": exp.seed,
         "machine": f"{platform.machine()} {platform.system()}, {os.cpu_count()} cpus, "

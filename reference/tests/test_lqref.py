@@ -12,18 +12,19 @@ import numpy as np
 import pytest
 
 from lqref import fnv1a64, file_hash
-from lqref import mitsuba_scene as ms
-from lqref import quantities as qt
-from lqref import runner, spec
+from lqref import mitsuba3, runner, spec
 from lqref.__main__ import main
+from lqref.families import FAMILIES, volume
 
 REPO = Path(__file__).resolve().parents[2]
 LIGHTQUAD = REPO / "target" / "release" / "lightquad"
 
 
-def write_experiment(tmp_path, name, scene, quantities, reference=None):
+def write_experiment(tmp_path, name, scene, quantities, reference=None, family="volume"):
+    """A volume experiment file (``family=None``: without the tag)."""
     doc = {
         "name": name,
+        **({} if family is None else {"family": family}),
         "description": "test",
         "equations": ["V-tau"],
         "scene": scene,
@@ -38,7 +39,7 @@ def write_experiment(tmp_path, name, scene, quantities, reference=None):
 
 
 def settings(passes=None, walks=None):
-    s = qt.Settings(quick=True)
+    s = volume.Settings(quick=True)
     if passes is not None:
         s.passes = passes
     if walks is not None:
@@ -108,10 +109,10 @@ def distinct_grid():
 
 
 def test_grid_export_round_trip_at_voxel_centres():
-    mi, dr = ms.require_mitsuba()
+    mi, dr = mitsuba3.require_mitsuba()
     grid = distinct_grid()
     assert len(set(grid["data"])) == len(grid["data"])
-    vol = ms.gridvolume(grid)
+    vol = volume.gridvolume(grid)
     nx, ny, nz = grid["resolution"]
     lo, hi = np.array(grid["min"]), np.array(grid["max"])
     it = dr.zeros(mi.Interaction3f)
@@ -119,7 +120,7 @@ def test_grid_export_round_trip_at_voxel_centres():
         for y in range(ny):
             for x in range(nx):
                 centre = lo + (np.array([x, y, z]) + 0.5) / np.array([nx, ny, nz]) * (hi - lo)
-                it.p = ms.point(centre)
+                it.p = mitsuba3.point(centre)
                 expected = grid["data"][(z * ny + y) * nx + x]
                 assert vol.eval_1(it) == pytest.approx(expected, rel=2e-6), (x, y, z)
 
@@ -130,13 +131,13 @@ def test_grid_export_matches_lightquad_trilinear_everywhere(tmp_path):
         "ray": {"origin": [-3.0, 1.0, 0.0], "direction": [1.0, 0.0, 0.0]},
         "medium": grid, "lambda": 1.7}, ["tau"])
     exp = spec.load(path)
-    _, medium = ms.build_scene(exp)
+    _, medium = volume.build_scene(exp)
     rng = np.random.default_rng(5)
     lo, hi = np.array(grid["min"]), np.array(grid["max"])
     pts = lo + rng.random((2000, 3)) * (hi - lo)  # includes the clamped half-voxel margins
     pts = pts.astype(np.float32).astype(np.float64)  # the points Mitsuba sees
     expected = 1.7 * lightquad_voxel_density(grid, pts)
-    assert np.allclose(ms.sigma_t_at(medium, pts), expected, rtol=2e-6, atol=0)
+    assert np.allclose(volume.sigma_t_at(medium, pts), expected, rtol=2e-6, atol=0)
 
 
 def test_voxel_tau_ratio_tracking_and_ray_march(tmp_path):
@@ -146,9 +147,9 @@ def test_voxel_tau_ratio_tracking_and_ray_march(tmp_path):
         "ray": {"origin": [-2.0, 0.7, -1.9], "direction": [1.0, 0.1, 0.7]},
         "medium": grid, "lambda": 1.5}, ["tau"], {"type": "converged", "n": 50})
     exp = spec.load(path)
-    res = qt.tau_voxel_grid(exp, settings(walks=2 ** 13))
+    res = volume.tau_voxel_grid(exp, settings(walks=2 ** 13))
     # Independent: lightquad's field in float64, fine midpoint rule on the chord.
-    o, d = np.array(exp.origin), np.array(exp.direction)
+    o, d = np.array(exp.scene.origin), np.array(exp.scene.direction)
     t_n, t_f = box_chord(o, d, grid["min"], grid["max"])
     assert res["chord"] == pytest.approx([t_n, t_f], abs=1e-6)
     n = 2 ** 20
@@ -184,7 +185,7 @@ def test_tau_constant_sphere_closed_form(tmp_path, origin, direction, centre, ra
         "ray": {"origin": origin, "direction": direction},
         "medium": {"type": "constant-sphere", "centre": centre, "radius": radius,
                    "kappa": kappa}, "lambda": lam}, ["tau"])
-    res = qt.tau_constant_sphere(spec.load(path))
+    res = volume.tau_constant_sphere(spec.load(path))
     t_n, t_f = sphere_chord(origin, direction, centre, radius)
     depth = lam * kappa * (t_f - t_n)
     exact = math.exp(-depth)
@@ -193,7 +194,7 @@ def test_tau_constant_sphere_closed_form(tmp_path, origin, direction, centre, ra
 
 
 def test_tau_stiff_sphere_log_value():
-    res = qt.tau_constant_sphere(spec.load(REPO / "experiments" / "v-tau-stiff-sphere.json"))
+    res = volume.tau_constant_sphere(spec.load(REPO / "experiments" / "v-tau-stiff-sphere.json"))
     assert res["value"] == 0.0
     assert res["log_value"] == pytest.approx(-1e5, rel=1e-6)
 
@@ -203,7 +204,7 @@ def test_tau_ray_missing_the_sphere(tmp_path):
         "ray": {"origin": [-3.0, 2.0, 0.0], "direction": [1.0, 0.0, 0.0]},
         "medium": {"type": "constant-sphere", "centre": [0, 0, 0], "radius": 1.0,
                    "kappa": 1.0}}, ["tau"])
-    assert qt.tau_constant_sphere(spec.load(path))["value"] == 1.0
+    assert volume.tau_constant_sphere(spec.load(path))["value"] == 1.0
 
 
 # ---------------------------------------------------------------- I_L, single scattering
@@ -226,13 +227,76 @@ def test_single_scattering_light_behind_closed_form(tmp_path, kappa, passes):
                    "kappa": kappa},
         "light": {"toward_light": [-1.0, 0.0, 0.0], "intensity": 2.0, "albedo": 0.8}},
         ["I_L"])
-    res = qt.light_single_scattering(spec.load(path), settings(passes=passes))
+    res = volume.light_single_scattering(spec.load(path), settings(passes=passes))
     t_n, t_f = sphere_chord(origin, direction, [0, 0, 0], 1.0)
     exact = light_behind(kappa, t_f - t_n, 2.0, 0.8)
     float32_floor = 1e-5 * exact
     assert abs(res["value"] - exact) <= 4 * res["std_error"] + float32_floor, \
         (res["value"], exact, res["std_error"])
     assert res["std_error"] < 0.01 * exact
+
+
+# ---------------------------------------------------------------- families
+
+
+SPHERE_SCENE = {
+    "ray": {"origin": [-3.0, 0.3, 0.0], "direction": [1.0, 0.0, 0.0]},
+    "medium": {"type": "constant-sphere", "centre": [0, 0, 0], "radius": 1.0, "kappa": 2.0},
+}
+
+
+def test_every_family_module_has_the_interface():
+    assert list(FAMILIES) == ["volume"]
+    for module in FAMILIES.values():
+        assert module.QUANTITIES
+        for name in ("Settings", "read_scene", "require_expressible", "unsupported_reason",
+                     "compute"):
+            assert callable(getattr(module, name)), name
+
+
+@pytest.mark.parametrize("path", sorted((REPO / "experiments").glob("*.json")),
+                         ids=lambda p: p.stem)
+def test_every_bundled_experiment_file_reads_or_names_its_family(path):
+    """Files of a family the harness knows read; those of lightquad's other
+    families (e.g. `calibration`, no scene for Mitsuba) are rejected at `family`."""
+    tag = json.loads(path.read_text())["family"]
+    if tag in FAMILIES:
+        exp = spec.load(path)
+        assert exp.family == tag
+        assert set(exp.quantities) <= set(FAMILIES[tag].QUANTITIES)
+    else:
+        with pytest.raises(spec.SpecError, match=f"unknown family '{tag}'") as err:
+            spec.load(path)
+        assert err.value.path == "family"
+
+
+def test_unknown_family_is_rejected_with_the_path(tmp_path):
+    path = write_experiment(tmp_path, "acoustic", SPHERE_SCENE, ["tau"], family="acoustics")
+    with pytest.raises(spec.SpecError) as err:
+        spec.load(path)
+    assert err.value.path == "family"
+    assert "unknown family 'acoustics'" in str(err.value)
+    assert "accepted families: volume" in str(err.value)
+    assert main([str(path), "--out", str(tmp_path / "v")]) == 2
+    assert not (tmp_path / "v" / "acoustic.json").exists()
+
+
+def test_missing_family_is_rejected(tmp_path):
+    path = write_experiment(tmp_path, "untagged", SPHERE_SCENE, ["tau"], family=None)
+    with pytest.raises(spec.SpecError, match="accepted families: volume") as err:
+        spec.load(path)
+    assert err.value.path == "family"
+    assert "missing field" in str(err.value)
+
+
+def test_depth_scheme_and_shadow_in_the_scene_are_accepted(tmp_path):
+    """lightquad's numerical choices: read without error, no effect on the values."""
+    plain = write_experiment(tmp_path, "plain", SPHERE_SCENE, ["tau"])
+    tagged = write_experiment(tmp_path, "tagged", {
+        **SPHERE_SCENE, "depth_scheme": "nested", "shadow": "quadrature"}, ["tau"])
+    values = [runner.compute(p, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
+              ["quantities"]["tau"]["value"] for p in (plain, tagged)]
+    assert values[0] == values[1]
 
 
 # ---------------------------------------------------------------- files, errors
@@ -243,7 +307,7 @@ def test_stale_hash_detection(tmp_path):
     path = tmp_path / "exp.json"
     shutil.copy(src, path)
     out = tmp_path / "values"
-    rec = runner.compute(path, settings(), out, log=lambda *a: None)
+    rec = runner.compute(path, quick=True, out_dir=out, log=lambda *a: None)
     assert rec["experiment_hash"] == file_hash(path)
     assert [s for s, *_ in runner.check([path], out)] == ["ok"]
     assert main(["--check", str(path), "--out", str(out)]) == 0
@@ -263,7 +327,7 @@ def test_values_file_layout_and_unsupported(tmp_path):
                    "kappa": 2.0},
         "emission": {"type": "constant", "c": 1.0}, "background": 0.5},
         ["tau", "I_E", "I_B", "I"])
-    rec = runner.compute(path, settings(), tmp_path / "v", log=lambda *a: None)
+    rec = runner.compute(path, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
     on_disk = json.loads((tmp_path / "v" / "mixed.json").read_text())
     assert on_disk == rec
     for key in ("mitsuba_variant", "mitsuba_version", "run_seconds", "experiment_hash"):
@@ -282,14 +346,14 @@ def test_inexpressible_scene_elements_are_named(tmp_path):
                    "blobs": [{"centre": [0, 0, 0], "amplitude": 1.0, "width": 0.5}]}},
         ["tau"])
     with pytest.raises(spec.SpecError, match="scene.medium.type"):
-        runner.compute(blobs, settings(), tmp_path / "v", log=lambda *a: None)
+        runner.compute(blobs, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
     reduced = write_experiment(tmp_path, "reduced", {
         "ray": {"origin": [-3.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0]},
         "medium": {"type": "constant-sphere", "centre": [0, 0, 0], "radius": 1.0,
                    "kappa": 1.0},
         "light": {"toward_light": [-1.0, 0.0, 0.0], "intensity": 1.0}}, ["I_L"])
     with pytest.raises(spec.SpecError, match="scene.light.albedo"):
-        runner.compute(reduced, settings(), tmp_path / "v", log=lambda *a: None)
+        runner.compute(reduced, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
     assert main([str(blobs), "--out", str(tmp_path / "v")]) == 2
 
 
@@ -302,7 +366,7 @@ def test_missing_mitsuba_message(monkeypatch):
             raise ImportError(f"No module named '{name}'")
         return real_import(name, *args, **kwargs)
 
-    monkeypatch.setattr(ms, "_MI", None)
+    monkeypatch.setattr(mitsuba3, "_MI", None)
     monkeypatch.setattr(builtins, "__import__", no_mitsuba)
-    with pytest.raises(ms.MitsubaMissing, match=r"pip install -r reference/requirements.txt"):
-        ms.require_mitsuba()
+    with pytest.raises(mitsuba3.MitsubaMissing, match=r"pip install -r reference/requirements.txt"):
+        mitsuba3.require_mitsuba()

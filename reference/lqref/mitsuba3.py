@@ -1,0 +1,61 @@
+"""Mitsuba 3 for every family: importing it (variant ``scalar_rgb``), the
+versions a values file records, and points and vectors from Python sequences.
+
+Every Mitsuba variant computes in float32; this one is ``scalar_rgb`` (CPU, no
+LLVM or CUDA). How a family's scene becomes a Mitsuba scene is in its module
+under ``lqref/families/``.
+"""
+
+import sys
+
+VARIANT = "scalar_rgb"
+_MI = None
+
+
+class MitsubaMissing(RuntimeError):
+    """Mitsuba 3 (or the variant) is not available in this Python."""
+
+
+def require_mitsuba():
+    """Imports Mitsuba 3 and Dr.Jit and selects ``scalar_rgb``; returns ``(mi, dr)``.
+
+    Raises MitsubaMissing with the install command when they are absent."""
+    global _MI
+    if _MI is not None:
+        return _MI
+    try:
+        import drjit as dr
+        import mitsuba as mi
+    except ImportError as e:
+        raise MitsubaMissing(
+            f"Mitsuba 3 is not installed for {sys.executable} ({e}).\n"
+            "Install the pinned versions with:\n"
+            "    pip install -r reference/requirements.txt"
+        ) from e
+    if VARIANT not in mi.variants():
+        raise MitsubaMissing(
+            f"this Mitsuba build has no `{VARIANT}` variant (it has {mi.variants()}); "
+            "install the pinned wheel: pip install -r reference/requirements.txt"
+        )
+    mi.set_variant(VARIANT)
+    _MI = (mi, dr)
+    return _MI
+
+
+def versions():
+    """The variant and the Mitsuba and Dr.Jit versions, as a values file records them."""
+    mi, dr = require_mitsuba()
+    return {"mitsuba_variant": VARIANT, "mitsuba_version": mi.__version__,
+            "drjit_version": dr.__version__}
+
+
+def point(p):
+    """``p`` (three numbers) as a Mitsuba ``Point3f``."""
+    mi, _ = require_mitsuba()
+    return mi.Point3f(float(p[0]), float(p[1]), float(p[2]))
+
+
+def vector(v):
+    """``v`` (three numbers) as a Mitsuba ``Vector3f``."""
+    mi, _ = require_mitsuba()
+    return mi.Vector3f(float(v[0]), float(v[1]), float(v[2]))
