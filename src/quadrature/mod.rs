@@ -249,6 +249,7 @@ macro_rules! registry {
 
 registry! {
     trapezoid::Trapezoid = "trapezoid",
+    simpson::Simpson = "simpson",
     gauss_legendre::GaussLegendre = "gauss-legendre",
     gauss_kronrod::GaussKronrod = "gauss-kronrod",
     monte_carlo::MonteCarlo = "monte-carlo",
