@@ -68,6 +68,49 @@ fn trapezoid_converges_at_order_two_and_richardson_estimates_the_error() {
 }
 
 #[test]
+fn simpson_is_exact_for_cubics_converges_at_order_four_and_richardson_estimates_the_error() {
+    use lightquad::quadrature::Simpson;
+    // Exact for a cubic: int_0^1 (1 + 2u - 3u^2 + 4u^3) du = 1 + 1 - 1 + 1 = 2.
+    let cubic = Simpson
+        .integrate(5, &mut rng(0), |u: [f64; 1]| {
+            1.0 + 2.0 * u[0] - 3.0 * u[0] * u[0] + 4.0 * u[0].powi(3)
+        })
+        .expect("finite");
+    assert!((cubic.value - 2.0).abs() < 4.0 * EPS, "{}", cubic.value);
+    // Not exact for u^4: S_h - 1/5 = 2 h^4 / 15, the Euler–Maclaurin term
+    // (f3(1) - f3(0)) h^4 / 180 with the third derivative f3 = 24u.
+    for m in [5usize, 9, 17] {
+        let h = 1.0 / (m - 1) as f64;
+        let est = Simpson
+            .integrate(m, &mut rng(0), |u: [f64; 1]| u[0].powi(4))
+            .expect("finite");
+        let want = 2.0 * h.powi(4) / 15.0;
+        assert!(
+            rel(est.value - 0.2, want) < 1e-9,
+            "m={m}: {} vs {want}",
+            est.value - 0.2
+        );
+    }
+    let mut pts = Vec::new();
+    for j in 3..=9 {
+        let n = (1 << j) + 1;
+        let est = Simpson.integrate(n, &mut rng(0), exp1).expect("finite");
+        assert_eq!(est.evaluations, n as u64, "n = 4k + 1 is used whole");
+        let err = (est.value - EXP1).abs();
+        // (S_h - S_2h)/15 is the leading error term: within 2% of the truth.
+        assert!(
+            rel(est.error, err) < 0.02,
+            "n={n}: est {} true {err}",
+            est.error
+        );
+        pts.push((est.evaluations as f64 - 1.0, err));
+    }
+    let order = fitted_order(&pts);
+    eprintln!("simpson order {order:.3}");
+    assert!((order + 4.0).abs() < 0.1, "simpson order {order}");
+}
+
+#[test]
 fn trapezoid_2d_product_rule_converges_at_order_one_in_total_evaluations() {
     let mut pts = Vec::new();
     for j in 3..=7 {
@@ -377,8 +420,8 @@ fn product_with_a_random_inner_rule_is_unbiased_and_its_error_covers() {
 fn product_names_and_dimensions_are_checked() {
     let e = AnyRule::by_name("product(gauss-legendre)").expect_err("one argument");
     assert!(e.to_string().contains("product(A,B)"), "{e}");
-    let e = AnyRule::by_name("product(gauss-legendre,simpson)").expect_err("unknown inner");
-    assert!(e.to_string().contains("unknown rule `simpson`"), "{e}");
+    let e = AnyRule::by_name("product(gauss-legendre,boole)").expect_err("unknown inner");
+    assert!(e.to_string().contains("unknown rule `boole`"), "{e}");
     let e =
         AnyRule::by_name("product(product(trapezoid,trapezoid),trapezoid)").expect_err("nested");
     assert!(e.to_string().contains("unknown rule"), "{e}");

@@ -111,19 +111,19 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
         "expected value",
     );
     rejected(
-        &VALID.replace("\"rule\": \"stratified\"", "\"rule\": \"simpson\""),
+        &VALID.replace("\"rule\": \"stratified\"", "\"rule\": \"boole\""),
         "rules[1]",
-        "unknown rule `simpson`: expected one of trapezoid, gauss-legendre",
+        "unknown rule `boole`: expected one of trapezoid, simpson, gauss-legendre",
     );
     rejected(
         &VALID.replace("\"family\": \"volume\"", "\"family\": \"plasma\""),
         "family",
-        "unknown family \"plasma\": expected one of volume",
+        "unknown family \"plasma\": expected one of calibration, volume",
     );
     rejected(
         &VALID.replace("\"family\": \"volume\",", ""),
         "family",
-        "missing: expected one of volume",
+        "missing: expected one of calibration, volume",
     );
     // A tracking estimator estimates tau only: asking it for I_E is refused
     // at `check`, not a row of NaN in the report.
