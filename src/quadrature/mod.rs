@@ -16,6 +16,7 @@
 //! | name | rule | error estimate |
 //! |---|---|---|
 //! | `trapezoid` | composite trapezoid, product in D > 1 | Richardson, half step |
+//! | `simpson` | composite Simpson, product in D > 1 | Richardson, half step |
 //! | `gauss-legendre` | Gauss–Legendre of any order, product in D > 1 | geometric tail of `Q_{m-2}, Q_{m-1}, Q_m` |
 //! | `gauss-kronrod` | adaptive Gauss–Kronrod G7–K15 (D = 1) | embedded G7 |
 //! | `monte-carlo` | plain Monte Carlo | standard error |
