@@ -86,68 +86,16 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
+type Failure = Box<dyn std::error::Error>;
+
+fn run(command: Command) -> Result<(), Failure> {
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
+    let registry = families::builtin();
     match command {
-        Command::Rules => {
-            let registry = families::builtin();
-            for (name, about) in registry.methods() {
-                writeln!(out, "{name:<40} {about}")?;
-            }
-            writeln!(out)?;
-            for f in registry.entries() {
-                writeln!(
-                    out,
-                    "family {:<9} {} (equations {}; quantities {})",
-                    f.name,
-                    f.about,
-                    f.equations.join(", "),
-                    f.quantities().join(", ")
-                )?;
-            }
-        }
+        Command::Rules => list_rules(&mut out, &registry)?,
         Command::Nodes { rule, n } => {
-            let (x, w) = match rule.as_str() {
-                "gauss-legendre" => {
-                    let t = gauss_legendre::table(n)?;
-                    (t.x, t.w)
-                }
-                "trapezoid" => {
-                    if n > lightquad::quadrature::trapezoid::MAX_POINTS {
-                        return Err(lightquad::QuadError::invalid(
-                            "n",
-                            n,
-                            format!(
-                                "at most {} trapezoid nodes",
-                                lightquad::quadrature::trapezoid::MAX_POINTS
-                            ),
-                        )
-                        .into());
-                    }
-                    if n < 2 {
-                        return Err(lightquad::QuadError::invalid(
-                            "n",
-                            n,
-                            "at least 2 trapezoid nodes",
-                        )
-                        .into());
-                    }
-                    let h = 2.0 / (n - 1) as f64;
-                    let x = (0..n).map(|i| -1.0 + i as f64 * h).collect();
-                    let w = (0..n)
-                        .map(|i| if i == 0 || i == n - 1 { 0.5 * h } else { h })
-                        .collect();
-                    (x, w)
-                }
-                other => {
-                    return Err(format!(
-                        "invalid rule `{other}` for `nodes`: expected gauss-legendre or trapezoid \
-                         (the rules with a fixed node set)"
-                    )
-                    .into());
-                }
-            };
+            let (x, w) = fixed_nodes(&rule, n)?;
             write_json_array(&mut out, "{\"nodes\": [", &x)?;
             write_json_array(&mut out, "], \"weights\": [", &w)?;
             writeln!(out, "]}}")?;
@@ -178,19 +126,17 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 shard,
                 progress: std::io::stderr().is_terminal(),
             };
-            let index = experiment::run_files(&families::builtin(), &files, &opts)?;
-            if shard.is_none() {
-                writeln!(out, "report: {}", index.display())?;
-            } else {
-                writeln!(
+            let index = experiment::run_files(&registry, &files, &opts)?;
+            match shard {
+                None => writeln!(out, "report: {}", index.display())?,
+                Some(_) => writeln!(
                     out,
                     "shard written under {}; join shards with `lightquad merge`",
                     opts.out.display()
-                )?;
+                )?,
             }
         }
         Command::Check { files } => {
-            let registry = families::builtin();
             for f in files {
                 let exp = experiment::load(&registry, &f)?;
                 let (rules, budgets, repeats) = exp.shape();
@@ -204,25 +150,73 @@ fn run(command: Command) -> Result<(), Box<dyn std::error::Error>> {
                 )?;
             }
         }
-        Command::Schema => writeln!(
-            out,
-            "{}",
-            serde_json::to_string_pretty(&families::builtin().schema())?
-        )?,
+        Command::Schema => writeln!(out, "{}", serde_json::to_string_pretty(&registry.schema())?)?,
         Command::Merge { inputs, out: dir } => {
-            let index = experiment::merge(&families::builtin(), &inputs, &dir)?;
+            let index = experiment::merge(&registry, &inputs, &dir)?;
             writeln!(out, "report: {}", index.display())?;
         }
         Command::Audit => {
-            for f in families::builtin().entries() {
-                if let Some(audit) = f.audit() {
-                    writeln!(out, "{audit}")?;
-                }
+            for audit in registry.entries().iter().filter_map(|f| f.audit()) {
+                writeln!(out, "{audit}")?;
             }
         }
     }
     out.flush()?;
     Ok(())
+}
+
+/// Every rule and estimator, then the families with their quantities.
+fn list_rules(out: &mut impl Write, registry: &experiment::Registry) -> Result<(), Failure> {
+    for (name, about) in registry.methods() {
+        writeln!(out, "{name:<40} {about}")?;
+    }
+    writeln!(out)?;
+    for f in registry.entries() {
+        writeln!(
+            out,
+            "family {:<12} {} (equations {}; quantities {})",
+            f.name,
+            f.about,
+            if f.equations.is_empty() {
+                "none".to_string()
+            } else {
+                f.equations.join(", ")
+            },
+            f.quantities().join(", ")
+        )?;
+    }
+    Ok(())
+}
+
+/// Nodes and weights on `[-1, 1]` of a rule with a fixed node set.
+fn fixed_nodes(rule: &str, n: usize) -> Result<(Vec<f64>, Vec<f64>), Failure> {
+    use lightquad::QuadError;
+    use lightquad::quadrature::trapezoid::MAX_POINTS;
+    match rule {
+        "gauss-legendre" => {
+            let t = gauss_legendre::table(n)?;
+            Ok((t.x, t.w))
+        }
+        "trapezoid" if n > MAX_POINTS => {
+            Err(QuadError::invalid("n", n, format!("at most {MAX_POINTS} trapezoid nodes")).into())
+        }
+        "trapezoid" if n < 2 => {
+            Err(QuadError::invalid("n", n, "at least 2 trapezoid nodes").into())
+        }
+        "trapezoid" => {
+            let h = 2.0 / (n - 1) as f64;
+            let x = (0..n).map(|i| -1.0 + i as f64 * h).collect();
+            let w = (0..n)
+                .map(|i| if i == 0 || i == n - 1 { 0.5 * h } else { h })
+                .collect();
+            Ok((x, w))
+        }
+        other => Err(format!(
+            "invalid rule `{other}` for `nodes`: expected gauss-legendre or trapezoid \
+             (the rules with a fixed node set)"
+        )
+        .into()),
+    }
 }
 
 /// Writes `prefix` then the numbers comma-separated; `{:?}` prints the shortest

@@ -336,7 +336,7 @@ impl AnyRule {
             .collect();
         lines.push((
             "product",
-            "2-D iterated rule of two single rules: {\"rule\": \"product\", \"outer\": {..}, \"inner\": {..}} (CLI: product(A,B))",
+            "2-D iterated rule of two 1-D rules: {\"rule\": \"product\", \"outer\": {..}, \"inner\": {..}}",
         ));
         lines
     }
