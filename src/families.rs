@@ -10,3 +10,39 @@ pub fn builtin() -> Registry {
         .with::<crate::calibration::Calibration>()
         .with::<crate::volume::experiment::Volume>()
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::family::{Estimator, Family, Quantity};
+    use crate::quadrature::AnyRule;
+
+    /// A family's names agree with its serde forms (results and reports use
+    /// `name()`, experiment files the serde form), and no estimator hides a rule.
+    fn names_agree<F: Family>() -> Result<(), serde_json::Error> {
+        for q in F::Quantity::all() {
+            assert_eq!(serde_json::to_value(q)?, q.name(), "{} quantity", F::NAME);
+        }
+        let rules: Vec<&str> = AnyRule::listing().iter().map(|r| r.0).collect();
+        for e in F::Estimator::all() {
+            assert_eq!(serde_json::to_value(&e)?["rule"], e.name(), "{}", F::NAME);
+            assert!(!rules.contains(&e.name()), "{} hides a rule", e.name());
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn every_builtin_familys_names_agree_with_its_serde_forms() -> Result<(), serde_json::Error> {
+        names_agree::<crate::calibration::Calibration>()?;
+        names_agree::<crate::volume::experiment::Volume>()?;
+        // Every family listed above is the registry's.
+        assert_eq!(
+            super::builtin()
+                .entries()
+                .iter()
+                .map(|e| e.name)
+                .collect::<Vec<_>>(),
+            ["calibration", "volume"]
+        );
+        Ok(())
+    }
+}

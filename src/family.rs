@@ -139,34 +139,78 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
         use serde::de::Error;
         let value = serde_json::Value::deserialize(d)?;
         let names = Self::names();
+        let accepted = || format!("expected one of {}", names.join(", "));
+        if !value.is_object() {
+            return Err(D::Error::custom(format!(
+                "{value} is not a rule: expected {{\"rule\": <name>, <parameters>}}, the name one of {}",
+                names.join(", ")
+            )));
+        }
         let Some(tag) = value.get("rule") else {
             return Err(D::Error::custom(format!(
-                "missing field `rule`: expected one of {}",
-                names.join(", ")
+                "missing field `rule`: {}",
+                accepted()
             )));
         };
         let Some(tag) = tag.as_str() else {
             return Err(D::Error::custom(format!(
-                "`rule` is {tag}, not a name: expected one of {}",
-                names.join(", ")
+                "`rule` is {tag}, not a name: {}",
+                accepted()
             )));
         };
-        // A fault inside the rule is reported at the rule, naming the field
+        // A fault inside a rule is reported at the rule, naming the field
         // (serde's tagged enums do not track paths below the tag).
-        fn inner<T: DeserializeOwned, Er: Error>(value: serde_json::Value) -> Result<T, Er> {
-            serde_json::from_value(value).map_err(Er::custom)
-        }
         if E::all().iter().any(|e| e.name() == tag) {
-            inner(value).map(Method::Estimator)
+            serde_json::from_value(value)
+                .map(Method::Estimator)
+                .map_err(D::Error::custom)
+        } else if tag == "product" {
+            product(&value).map(Method::Rule)
         } else if names.contains(&tag) {
-            inner(value).map(Method::Rule)
+            serde_json::from_value(value)
+                .map(Method::Rule)
+                .map_err(D::Error::custom)
         } else {
             Err(D::Error::custom(format!(
-                "unknown rule `{tag}`: expected one of {}",
-                names.join(", ")
+                "unknown rule `{tag}`: {}",
+                accepted()
             )))
         }
     }
+}
+
+/// Marks the start of a path below the current one in an error message
+/// (`at `.outer`: ...`), which [`crate::experiment::validate`] moves into the
+/// error's JSON path.
+pub const SUB_PATH: &str = "at `.";
+
+/// `{"rule": "product", "outer": {..}, "inner": {..}}`, a fault in a factor
+/// reported below it (`.outer`).
+fn product<Er: serde::de::Error>(value: &serde_json::Value) -> Result<AnyRule, Er> {
+    use crate::quadrature::{BaseRule, Product};
+    let map = value.as_object().into_iter().flatten();
+    if let Some((key, _)) = map
+        .clone()
+        .find(|(k, _)| !matches!(k.as_str(), "rule" | "outer" | "inner"))
+    {
+        return Err(Er::custom(format!(
+            "unknown field `{key}`, expected `outer` or `inner`"
+        )));
+    }
+    let factor = |field: &str| -> Result<BaseRule, Er> {
+        let v = value
+            .get(field)
+            .ok_or_else(|| Er::custom(format!("missing field `{field}`")))?;
+        serde_json::from_value(v.clone()).map_err(|e| {
+            Er::custom(format!(
+                "{SUB_PATH}{field}`: {e} (a product's factors are single 1-D rules)"
+            ))
+        })
+    };
+    Ok(AnyRule::Product(Box::new(Product {
+        outer: factor("outer")?,
+        inner: factor("inner")?,
+    })))
 }
 
 impl<E: JsonSchema> JsonSchema for Method<E> {
@@ -239,6 +283,18 @@ impl Measured {
     }
 }
 
+impl<V: crate::value::Value> From<crate::estimate::Estimate<V>> for Measured {
+    /// The estimate's channels, error per channel and cost.
+    fn from(e: crate::estimate::Estimate<V>) -> Self {
+        Measured {
+            value: (0..V::CHANNELS).map(|c| e.value.channel(c)).collect(),
+            error: (0..V::CHANNELS).map(|c| e.error.channel(c)).collect(),
+            evaluations: e.evaluations,
+            flags: Vec::new(),
+        }
+    }
+}
+
 /// The quantities of one evaluation.
 pub type Outcome<Q> = BTreeMap<Q, Measured>;
 
@@ -250,6 +306,9 @@ pub trait Family: Sized + Send + Sync + 'static {
     const ABOUT: &'static str;
     /// The equation IDs of docs/EQUATIONS.md it instantiates.
     const EQUATIONS: &'static [&'static str];
+    /// What a budget counts, for reports ("evaluations per smooth piece of
+    /// the ray", ...).
+    const BUDGET_UNIT: &'static str;
 
     /// The scene as written in an experiment file.
     type SceneSpec: Clone
@@ -274,6 +333,11 @@ pub trait Family: Sized + Send + Sync + 'static {
     /// The dimension of the unit cube over which a rule integrates `quantity`
     /// in `scene`.
     fn dimension(scene: &Self::Scene, quantity: Self::Quantity) -> usize;
+
+    /// The number of channels of `quantity` in `scene` (1 for a scalar, 3 for
+    /// RGB, the pixel count of an image): every value, error and reference of
+    /// it must have that many.
+    fn channels(scene: &Self::Scene, quantity: Self::Quantity) -> usize;
 
     /// The quantities `estimator` estimates.
     fn estimates(estimator: &Self::Estimator) -> &'static [Self::Quantity];

@@ -29,9 +29,10 @@ enum Command {
     /// Print a rule's nodes and weights on [-1, 1] as JSON
     /// `{"nodes": [...], "weights": [...]}`, every digit needed to round-trip an f64.
     Nodes {
-        /// Rule name: `gauss-legendre` or `trapezoid` (rules with a fixed node set).
+        /// Rule name: `gauss-legendre`, `trapezoid` or `simpson` (rules with a
+        /// fixed node set).
         rule: String,
-        /// Number of nodes (Gauss–Legendre: 1..=100000000; trapezoid: >= 2).
+        /// Number of nodes (Gauss–Legendre: 1..=100000000; trapezoid: >= 2; Simpson: odd, >= 3).
         n: usize,
     },
     /// Run experiments (default: every file in experiments/) and write a report
@@ -197,6 +198,20 @@ fn fixed_nodes(rule: &str, n: usize) -> Result<(Vec<f64>, Vec<f64>), Failure> {
             let t = gauss_legendre::table(n)?;
             Ok((t.x, t.w))
         }
+        "simpson" if !(3..=MAX_POINTS).contains(&n) || n % 2 == 0 => Err(QuadError::invalid(
+            "n",
+            n,
+            format!("an odd number of Simpson nodes in 3..={MAX_POINTS}"),
+        )
+        .into()),
+        "simpson" => {
+            let t = lightquad::quadrature::simpson::unit_nodes(n);
+            // From [0, 1] to [-1, 1].
+            Ok((
+                t.u.iter().map(|u| 2.0 * u - 1.0).collect(),
+                t.w.iter().map(|w| 2.0 * w).collect(),
+            ))
+        }
         "trapezoid" if n > MAX_POINTS => {
             Err(QuadError::invalid("n", n, format!("at most {MAX_POINTS} trapezoid nodes")).into())
         }
@@ -212,7 +227,7 @@ fn fixed_nodes(rule: &str, n: usize) -> Result<(Vec<f64>, Vec<f64>), Failure> {
             Ok((x, w))
         }
         other => Err(format!(
-            "invalid rule `{other}` for `nodes`: expected gauss-legendre or trapezoid \
+            "invalid rule `{other}` for `nodes`: expected gauss-legendre, trapezoid or simpson \
              (the rules with a fixed node set)"
         )
         .into()),

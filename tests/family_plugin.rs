@@ -86,19 +86,11 @@ fn moments(k: f64, u: f64) -> lightquad::Rgb {
     lightquad::Rgb::new(u.powf(k), u.powf(k + 1.0), u.powf(k + 2.0))
 }
 
-fn measured(e: lightquad::Estimate<lightquad::Rgb>) -> Measured {
-    Measured {
-        value: e.value.iter().copied().collect(),
-        error: e.error.iter().copied().collect(),
-        evaluations: e.evaluations,
-        flags: Vec::new(),
-    }
-}
-
 impl Family for Poly {
     const NAME: &'static str = "poly";
     const ABOUT: &'static str = "monomials";
     const EQUATIONS: &'static [&'static str] = &["P-1"];
+    const BUDGET_UNIT: &'static str = "evaluations";
     type SceneSpec = PolyScene;
     type Scene = f64;
     type Quantity = PolyQuantity;
@@ -116,6 +108,10 @@ impl Family for Poly {
 
     fn dimension(_: &f64, q: PolyQuantity) -> usize {
         if q == PolyQuantity::Square { 2 } else { 1 }
+    }
+
+    fn channels(_: &f64, q: PolyQuantity) -> usize {
+        if q == PolyQuantity::Moments { 3 } else { 1 }
     }
 
     fn estimates(_: &Riemann) -> &'static [PolyQuantity] {
@@ -141,7 +137,7 @@ impl Family for Poly {
                         error: lightquad::Rgb::repeat(1.0 / n as f64),
                         evaluations: n as u64,
                     };
-                    let mut m = measured(e);
+                    let mut m = Measured::from(e);
                     if q == PolyQuantity::Moment {
                         m.value.truncate(1);
                         m.error.truncate(1);
@@ -153,7 +149,7 @@ impl Family for Poly {
                     Measured::scalar(e.value, e.error, e.evaluations)
                 }
                 (Method::Rule(r), PolyQuantity::Moments) => {
-                    measured(r.integrate(n, rng, |u: [f64; 1]| moments(k, u[0]))?)
+                    r.integrate(n, rng, |u: [f64; 1]| moments(k, u[0]))?.into()
                 }
                 (Method::Rule(r), PolyQuantity::Square) => {
                     let e = r.integrate(n, rng, |u: [f64; 2]| (u[0] * u[1]).powf(k))?;

@@ -158,7 +158,7 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
             "{ \"rule\": \"stratified\" }",
             "{ \"rule\": \"product\", \"outer\": { \"rule\": \"gauss-legendre\", \"error_estimat\": true }, \"inner\": { \"rule\": \"trapezoid\" } }",
         ),
-        "rules[1]",
+        "rules[1].outer",
         "unknown field `error_estimat`, expected `error_estimate`",
     );
     rejected(
@@ -407,10 +407,41 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
     let schema = bin().arg("schema").output().expect("runs");
     let schema: serde_json::Value =
         serde_json::from_slice(&schema.stdout).expect("the schema is JSON");
-    // One schema per family, each with its scene format.
-    let volume = &schema["oneOf"][0];
-    assert!(volume["properties"]["scene"].is_object(), "{schema}");
-    assert!(volume["properties"]["family"].is_object(), "{schema}");
+    // One schema per family, told apart by a constant family tag, and every
+    // reference resolves to a definition at the root.
+    let families: Vec<&str> = schema["oneOf"]
+        .as_array()
+        .expect("oneOf")
+        .iter()
+        .map(|b| {
+            b["properties"]["family"]["const"]
+                .as_str()
+                .expect("const family")
+        })
+        .collect();
+    assert_eq!(families, ["calibration", "volume"]);
+    let volume = &schema["oneOf"][1];
+    assert!(
+        volume["properties"]["scene"]["$ref"].is_string(),
+        "{volume}"
+    );
+    fn refs(v: &serde_json::Value, out: &mut Vec<String>) {
+        match v {
+            serde_json::Value::Object(m) => m.iter().for_each(|(k, c)| match c {
+                serde_json::Value::String(s) if k == "$ref" => out.push(s.clone()),
+                _ => refs(c, out),
+            }),
+            serde_json::Value::Array(a) => a.iter().for_each(|c| refs(c, out)),
+            _ => {}
+        }
+    }
+    let mut all = Vec::new();
+    refs(&schema, &mut all);
+    assert!(all.len() > 10);
+    for r in all {
+        let name = r.strip_prefix("#/$defs/").expect("a local definition");
+        assert!(schema["$defs"][name].is_object(), "{r} does not resolve");
+    }
     let _ = fs::remove_dir_all(&dir);
 }
 
@@ -447,6 +478,7 @@ fn cancellation_in_the_total_is_flagged() {
     let rules = [RuleInfo {
         label: "gauss-legendre".into(),
         is_random: false,
+        min_budget: 1,
     }];
     let table = rows(&rules, &jobs, "I", &[0.0]);
     assert!(
@@ -590,5 +622,184 @@ fn regressions_from_the_runner_review() {
         "{}",
         stderr(&o)
     );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// Faults below a rule and in the shape of references are named where they are.
+#[test]
+fn faults_inside_rules_and_references_are_named_where_they_are() {
+    let product = |outer: &str, inner: &str| {
+        VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            &format!("{{ \"rule\": \"product\", \"outer\": {outer}, \"inner\": {inner} }}"),
+        )
+    };
+    rejected(
+        &product(
+            "{ \"rule\": \"product\", \"outer\": { \"rule\": \"trapezoid\" }, \"inner\": { \"rule\": \"trapezoid\" } }",
+            "{ \"rule\": \"trapezoid\" }",
+        ),
+        "rules[1].outer",
+        "unknown variant `product`",
+    );
+    rejected(
+        &product(
+            "{ \"rule\": \"trapezoid\" }",
+            "{ \"rule\": \"sobol\", \"replicates\": 1 }",
+        )
+        .replace("[\"tau\", \"I_E\"]", "[\"tau\"]"),
+        "rules[1].inner.replicates",
+        "an integer >= 2",
+    );
+    rejected(
+        &VALID.replace("[\"tau\", \"I_E\"]", "[\"tau\", \"I_E\", \"tau\"]"),
+        "quantities[2]",
+        "tau is named twice",
+    );
+    rejected(
+        &VALID.replace("{ \"rule\": \"stratified\" }", "\"stratified\""),
+        "rules[1]",
+        "is not a rule: expected {\"rule\": <name>, <parameters>}",
+    );
+    // A reference of the wrong shape: exp-rgb has three channels.
+    let rgb = r#"{ "name": "c", "family": "calibration", "scene": {}, "quantities": ["exp-rgb"],
+        "rules": [{ "rule": "gauss-legendre" }], "budgets": [8],
+        "reference": { "type": "value", "values": { "exp-rgb": 1.7 } } }"#;
+    rejected(
+        rgb,
+        "reference.values.exp-rgb",
+        "1 value(s) given, but exp-rgb has 3 channel(s): give a list of 3 numbers",
+    );
+    // A product's factor's parameter, checked where it is written.
+    let disk = r#"{ "name": "c", "family": "calibration", "scene": {}, "quantities": ["gaussian-disk"],
+        "rules": [{ "rule": "product", "outer": { "rule": "gauss-legendre" }, "inner": { "rule": "sobol", "replicates": 1 } }],
+        "budgets": [64], "reference": { "type": "closed-form" } }"#;
+    rejected(disk, "rules[0].inner.replicates", "an integer >= 2");
+}
+
+/// A reference that cannot be computed is said so on the page, and the run
+/// fails: never a page that claims convergence and shows no table.
+#[test]
+fn a_reference_that_cannot_be_computed_fails_the_run_and_says_why() {
+    let dir = scratch("noref");
+    let file = dir.join("e.json");
+    let text = VALID
+        .replace(
+            "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
+            "{ \"type\": \"gaussian-blobs\", \"blobs\": [{ \"centre\": [0.0, 0.0, 0.0], \"amplitude\": 1e308, \"width\": 1.0 }, { \"centre\": [0.1, 0.0, 0.0], \"amplitude\": 1e308, \"width\": 1.0 }] }",
+        )
+        .replace("{ \"type\": \"closed-form\" }", "{ \"type\": \"converged\" }");
+    fs::write(&file, text).expect("write");
+    let out = dir.join("out");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(!o.status.success(), "a run without a reference succeeded");
+    assert!(stderr(&o).contains("has no reference"), "{}", stderr(&o));
+    let report = fs::read_to_string(out.join("t").join("report.md")).expect("report");
+    assert!(report.contains("## tau (no reference)"), "{report}");
+    assert!(!report.contains("(converged)"), "{report}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// The CSV has as many fields on every line as in its header, product labels
+/// (which hold a comma) included.
+#[test]
+fn the_csv_keeps_its_columns_with_product_labels() {
+    let dir = scratch("csv");
+    let file = dir.join("e.json");
+    fs::write(
+        &file,
+        r#"{ "name": "c", "family": "calibration", "scene": {}, "quantities": ["gaussian-disk"],
+        "rules": [{ "rule": "product", "outer": { "rule": "gauss-legendre" }, "inner": { "rule": "trapezoid" } }],
+        "budgets": [16, 64], "repeats": 1, "reference": { "type": "closed-form" } }"#,
+    )
+    .expect("write");
+    let out = dir.join("out");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = fs::read_to_string(out.join("c").join("results.csv")).expect("csv");
+    // RFC 4180 fields: commas inside quotes do not separate.
+    let fields = |line: &str| {
+        let mut quoted = false;
+        1 + line
+            .chars()
+            .filter(|&c| {
+                if c == '"' {
+                    quoted = !quoted;
+                }
+                c == ',' && !quoted
+            })
+            .count()
+    };
+    let mut lines = csv.lines();
+    let header = fields(lines.next().expect("header"));
+    let mut n = 0;
+    for line in lines {
+        assert_eq!(fields(line), header, "{line}");
+        assert!(
+            line.contains("\"product(gauss-legendre,trapezoid)\""),
+            "{line}"
+        );
+        n += 1;
+    }
+    assert_eq!(n, 2);
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// Where shards disagree on a job, `merge` keeps the finished result over a
+/// failed one, whichever folder comes first.
+#[test]
+fn merge_prefers_a_finished_job_over_a_failed_copy() {
+    let dir = scratch("mergedup");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let good = dir.join("a-good");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&good)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A copy whose every job failed.
+    let bad = dir.join("0-bad");
+    fs::create_dir_all(bad.join("t")).expect("folder");
+    fs::copy(
+        good.join("t/experiment.json"),
+        bad.join("t/experiment.json"),
+    )
+    .expect("copy");
+    let failed: String = fs::read_to_string(good.join("t/results.jsonl"))
+        .expect("results")
+        .lines()
+        .map(|l| {
+            let mut v: serde_json::Value = serde_json::from_str(l).expect("json");
+            v["quantities"] = serde_json::json!({});
+            v["failure"] = "killed".into();
+            format!("{v}\n")
+        })
+        .collect();
+    fs::write(bad.join("t/results.jsonl"), failed).expect("write");
+    for order in [[&bad, &good], [&good, &bad]] {
+        let merged = dir.join("merged");
+        let o = bin()
+            .args(["merge", "--out"])
+            .arg(&merged)
+            .args(order)
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{}", stderr(&o));
+        same(&results(&merged, "t"), &results(&good, "t"));
+        let _ = fs::remove_dir_all(&merged);
+    }
     let _ = fs::remove_dir_all(&dir);
 }

@@ -48,6 +48,15 @@ pub enum RunError {
         /// The report's index page.
         index: String,
     },
+    /// The report was written but lacks something: a shard's jobs after a
+    /// merge, or a quantity's reference.
+    #[error("the report is incomplete ({index}): {problems}")]
+    Incomplete {
+        /// What is missing, `;`-separated.
+        problems: String,
+        /// The report's index page.
+        index: String,
+    },
     /// A file or folder that cannot be read or written.
     #[error("{path}: {message}")]
     Io {
@@ -122,6 +131,14 @@ pub fn run_files(
     files: &[PathBuf],
     opts: &RunOptions,
 ) -> Result<PathBuf, RunError> {
+    if let Some((k, n)) = opts.shard {
+        if k == 0 || k > n {
+            return Err(RunError::Io {
+                path: opts.out.display().to_string(),
+                message: format!("invalid shard {k}/{n}: expected k/n with 1 <= k <= n"),
+            });
+        }
+    }
     let loaded = load_all(registry, files)?;
     writable(&opts.out)?;
     let total: usize = loaded
@@ -179,15 +196,17 @@ fn write_reports(
 ) -> Result<PathBuf, RunError> {
     let mut entries = Vec::new();
     let mut checks = Vec::new();
+    let mut problems = missing;
     for (exp, results) in done {
         let dir = out.join(exp.name());
-        let (summary, rows) = exp.write_report(&dir, results).map_err(|e| io(&dir, e))?;
+        let written = exp.write_report(&dir, results).map_err(|e| io(&dir, e))?;
         entries.push((
             exp.name().to_string(),
             exp.description().to_string(),
-            summary,
+            written.summary,
         ));
-        checks.extend(rows);
+        checks.extend(written.crosscheck);
+        problems.extend(written.problems);
     }
     // The audits of the families that have experiments here.
     let families: BTreeSet<&str> = done.iter().map(|(e, _)| e.family()).collect();
@@ -199,13 +218,10 @@ fn write_reports(
         .collect();
     report::write_index(out, &entries, &checks, &audits).map_err(|e| io(out, e))?;
     let index = out.join("index.md");
-    if !missing.is_empty() {
-        return Err(RunError::Io {
-            path: out.display().to_string(),
-            message: format!(
-                "merged an incomplete set (is a shard missing, or from another version of the file?): {}",
-                missing.join("; ")
-            ),
+    if !problems.is_empty() {
+        return Err(RunError::Incomplete {
+            problems: problems.join("; "),
+            index: index.display().to_string(),
         });
     }
     match failures(done) {
@@ -223,8 +239,14 @@ fn write_reports(
 pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
     let mut by_name: BTreeMap<String, (Box<dyn Loaded>, Vec<JobResult>)> = BTreeMap::new();
     for input in inputs {
-        for entry in fs::read_dir(input).map_err(|e| io(input, e))?.flatten() {
-            let spec_file = entry.path().join("experiment.json");
+        let mut dirs: Vec<PathBuf> = fs::read_dir(input)
+            .map_err(|e| io(input, e))?
+            .flatten()
+            .map(|e| e.path())
+            .collect();
+        dirs.sort();
+        for dir in dirs {
+            let spec_file = dir.join("experiment.json");
             if spec_file.is_file() {
                 gather(registry, &spec_file, &mut by_name)?;
             }
@@ -244,11 +266,18 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
     let mut missing = Vec::new();
     let mut done = Vec::new();
     for (name, (exp, mut results)) in by_name {
-        results.sort_by_key(JobResult::key);
+        // One result per job of this experiment, a finished one before a
+        // failed one where shards disagree.
+        let expected: BTreeSet<_> = exp.jobs(None).into_iter().collect();
+        results.retain(|r| expected.contains(&r.key()));
+        results.sort_by_key(|r| (r.key(), r.failure.is_some()));
         results.dedup_by_key(|r| r.key());
-        let expected = exp.jobs(None).len();
-        if results.len() < expected {
-            missing.push(format!("{name}: {} of {expected} jobs", results.len()));
+        if results.len() < expected.len() {
+            missing.push(format!(
+                "{name}: {} of {} jobs (is a shard missing, or from another version of the file or of lightquad?)",
+                results.len(),
+                expected.len()
+            ));
         }
         let dir = out.join(&name);
         fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
@@ -280,11 +309,25 @@ fn gather(
         ));
     }
     let dir = spec_file.parent().unwrap_or(Path::new("."));
-    for f in fs::read_dir(dir).map_err(|e| io(dir, e))?.flatten() {
-        let name = f.file_name().to_string_lossy().to_string();
-        if name.starts_with("results") && name.ends_with(".jsonl") {
-            slot.1.extend(read_results(&f.path(), Some(&hash)));
-        }
+    let mut files: Vec<PathBuf> = fs::read_dir(dir)
+        .map_err(|e| io(dir, e))?
+        .flatten()
+        .map(|f| f.path())
+        .filter(|p| {
+            p.file_name()
+                .map(|n| n.to_string_lossy())
+                .is_some_and(|n| n.starts_with("results") && n.ends_with(".jsonl"))
+        })
+        .collect();
+    files.sort();
+    for f in files {
+        // Lines of this lightquad version only, as `--resume` keeps.
+        let lines = read_results(&f, Some(&hash));
+        slot.1.extend(
+            lines
+                .into_iter()
+                .filter(|r| r.version == env!("CARGO_PKG_VERSION")),
+        );
     }
     Ok(())
 }

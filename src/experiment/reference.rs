@@ -29,6 +29,8 @@ pub struct Known<Q> {
 pub struct Reference {
     /// Value per quantity name, per channel.
     pub values: BTreeMap<String, Vec<f64>>,
+    /// Quantities without a reference value, with the reason.
+    pub missing: BTreeMap<String, String>,
     /// Where they come from, in a sentence.
     pub note: String,
     /// Relative accuracy.
@@ -46,7 +48,9 @@ pub fn known_values<F: Family>(
         ReferenceSpec::ClosedForm {} => {
             let mut values = BTreeMap::new();
             for q in &spec.quantities {
-                let Some(v) = F::closed_form(scene, *q) else {
+                let Some(v) =
+                    F::closed_form(scene, *q).filter(|v| v.len() == F::channels(scene, *q))
+                else {
                     return Err(SpecError::at(
                         "reference",
                         format!(
@@ -75,12 +79,29 @@ pub fn known_values<F: Family>(
                 ));
             }
             Known {
-                values: literal_values(values, &spec.quantities)?,
+                values: literal_values(values, &spec.quantities, |q| F::channels(scene, q))?,
                 uncertainty: *uncertainty,
                 note: format!("literal values, uncertainty {uncertainty:e}."),
             }
         }
-        ReferenceSpec::Mitsuba { file } => mitsuba_values(file, hash, &spec.quantities)?,
+        ReferenceSpec::Mitsuba { file } => {
+            // The harness writes one number per quantity.
+            if let Some(q) = spec
+                .quantities
+                .iter()
+                .find(|q| F::channels(scene, **q) != 1)
+            {
+                return Err(SpecError::at(
+                    "reference",
+                    format!(
+                        "Mitsuba values files hold scalars, and {} has {} channels",
+                        q.name(),
+                        F::channels(scene, *q)
+                    ),
+                ));
+            }
+            mitsuba_values(file, hash, &spec.quantities)?
+        }
         ReferenceSpec::Converged { n } => {
             if !(2..=100_000).contains(n) {
                 return Err(SpecError::at(
@@ -148,11 +169,14 @@ pub fn mitsuba_values<Q: Quantity>(
 }
 
 /// The family's converged values of every quantity of the experiment with
-/// `n` nodes per piece; a quantity that cannot be computed is left out.
-pub fn converged<F: Family>(exp: &Experiment<F>, n: usize) -> BTreeMap<F::Quantity, Vec<f64>> {
+/// `n` nodes per piece.
+pub fn converged<F: Family>(
+    exp: &Experiment<F>,
+    n: usize,
+) -> Result<BTreeMap<F::Quantity, Vec<f64>>, String> {
     F::converged(&exp.scene, n, &exp.spec.quantities)
         .map(|out| out.into_iter().map(|(q, m)| (q, m.value)).collect())
-        .unwrap_or_default()
+        .map_err(|e| e.to_string())
 }
 
 /// `sqrt(mean_c (a_c - b_c)^2) / sqrt(mean_c b_c^2)`: the relative distance of
@@ -182,49 +206,98 @@ pub fn rms(xs: impl Iterator<Item = f64> + Clone) -> f64 {
 
 /// The reference of a run.
 pub fn reference<F: Family>(exp: &Experiment<F>) -> Reference {
-    let by_name = |m: BTreeMap<F::Quantity, Vec<f64>>| -> BTreeMap<String, Vec<f64>> {
-        m.into_iter()
-            .map(|(q, v)| (q.name().to_string(), v))
-            .collect()
+    if let ReferenceSpec::Converged { n } = exp.spec.reference {
+        return converged_reference(exp, n);
+    }
+    let Some(known) = &exp.known else {
+        let why = "no reference values were loaded";
+        return Reference {
+            values: BTreeMap::new(),
+            missing: names::<F>(exp, why),
+            note: format!("none: {why}."),
+            accuracy: 0.0,
+        };
     };
-    if let Some(known) = &exp.known {
-        // Relative accuracy: the stated uncertainty against the smallest
-        // reference magnitude.
-        let smallest = known
+    // Relative accuracy: the stated uncertainty against the smallest
+    // reference magnitude.
+    let smallest = known
+        .values
+        .values()
+        .map(|v| rms(v.iter().copied()))
+        .filter(|v| *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    Reference {
+        values: known
             .values
-            .values()
-            .map(|v| rms(v.iter().copied()))
-            .filter(|v| *v > 0.0)
-            .fold(f64::INFINITY, f64::min);
-        let accuracy = if smallest.is_finite() {
+            .iter()
+            .map(|(q, v)| (q.name().to_string(), v.clone()))
+            .collect(),
+        missing: BTreeMap::new(),
+        note: known.note.clone(),
+        accuracy: if smallest.is_finite() {
             known.uncertainty / smallest
         } else {
             0.0
-        };
-        return Reference {
-            values: by_name(known.values.clone()),
-            note: known.note.clone(),
-            accuracy,
-        };
+        },
     }
-    let n = match exp.spec.reference {
-        ReferenceSpec::Converged { n } => n,
-        _ => 400,
-    };
-    let (a, b) = (converged(exp, n), converged(exp, 2 * n));
-    let change = exp
-        .spec
+}
+
+/// Every quantity of the experiment, with the same reason.
+fn names<F: Family>(exp: &Experiment<F>, why: &str) -> BTreeMap<String, String> {
+    exp.spec
         .quantities
         .iter()
-        .filter_map(|q| Some(relative_distance(a.get(q)?, b.get(q)?)))
-        .fold(0.0, f64::max);
+        .map(|q| (q.name().to_string(), why.to_string()))
+        .collect()
+}
+
+/// The converged reference at `2n` nodes, judged against `n`: a quantity the
+/// family could not compute, or whose value is not finite, has no reference,
+/// with the reason.
+fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
+    let (a, b) = match (converged(exp, n), converged(exp, 2 * n)) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => {
+            let why = format!("the converged evaluation failed: {e}");
+            return Reference {
+                values: BTreeMap::new(),
+                missing: names::<F>(exp, &why),
+                note: format!("none: {why}."),
+                accuracy: 0.0,
+            };
+        }
+    };
+    let mut values = BTreeMap::new();
+    let mut missing = BTreeMap::new();
+    let mut change = 0.0f64;
+    for q in &exp.spec.quantities {
+        match (a.get(q), b.get(q)) {
+            (Some(x), Some(y)) if y.iter().all(|v| v.is_finite()) => {
+                change = change.max(relative_distance(x, y));
+                values.insert(q.name().to_string(), y.clone());
+            }
+            (_, Some(y)) => {
+                missing.insert(
+                    q.name().to_string(),
+                    format!("its converged value {y:?} is not finite"),
+                );
+            }
+            _ => {
+                missing.insert(
+                    q.name().to_string(),
+                    "the family's converged evaluation did not produce it".into(),
+                );
+            }
+        }
+    }
     let verdict = if change <= 1e-12 {
         "converged"
     } else {
         "NOT converged: treat errors below this with suspicion"
     };
     Reference {
-        values: by_name(b),
+        values,
+        missing,
         note: format!(
             "the {} family's converged evaluation with {} nodes per piece; against {n} nodes the \
              largest relative change is {change:.1e} ({verdict}).",
@@ -264,7 +337,7 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
         return Vec::new();
     };
     let stale = json["experiment_hash"].as_str() != Some(exp.hash.as_str());
-    let lightquad = converged(exp, 400);
+    let lightquad = converged(exp, 400).unwrap_or_default();
     let scalar = |v: Option<&Vec<f64>>| v.and_then(|v| (v.len() == 1).then(|| v[0]));
     exp.spec
         .quantities

@@ -32,13 +32,8 @@ pub trait Loaded: Send + Sync {
     fn jobs(&self, shard: Option<(usize, usize)>) -> Vec<JobKey>;
     /// Runs one job.
     fn run_job(&self, key: JobKey) -> JobResult;
-    /// Writes its report page from `results` into `dir`; returns the index
-    /// summary and the Mitsuba comparison rows.
-    fn write_report(
-        &self,
-        dir: &Path,
-        results: &[JobResult],
-    ) -> Result<(Summary, Vec<Crosscheck>), String>;
+    /// Writes its report page from `results` into `dir`.
+    fn write_report(&self, dir: &Path, results: &[JobResult]) -> Result<Written, String>;
 }
 
 impl<F: Family> Loaded for Experiment<F> {
@@ -63,16 +58,33 @@ impl<F: Family> Loaded for Experiment<F> {
     fn run_job(&self, key: JobKey) -> JobResult {
         run_job(self, key)
     }
-    fn write_report(
-        &self,
-        dir: &Path,
-        results: &[JobResult],
-    ) -> Result<(Summary, Vec<Crosscheck>), String> {
+    fn write_report(&self, dir: &Path, results: &[JobResult]) -> Result<Written, String> {
         let reference = reference(self);
-        let rows = crosscheck(self);
-        let page = page(self, &reference, &rows);
-        Ok((write_experiment(dir, &page, results)?, rows))
+        let crosscheck = crosscheck(self);
+        let page = page(self, &reference, &crosscheck);
+        let summary = write_experiment(dir, &page, results)?;
+        let problems = reference
+            .missing
+            .iter()
+            .map(|(q, why)| format!("{}: {q} has no reference ({why})", self.spec.name))
+            .collect();
+        Ok(Written {
+            summary,
+            crosscheck,
+            problems,
+        })
     }
+}
+
+/// What writing an experiment's report page gives the index.
+#[derive(Debug, Clone)]
+pub struct Written {
+    /// Per quantity, each rule's time to the middle target.
+    pub summary: Summary,
+    /// The Mitsuba comparison rows.
+    pub crosscheck: Vec<Crosscheck>,
+    /// What the page could not show (a quantity without a reference).
+    pub problems: Vec<String>,
 }
 
 /// The report's view of an experiment.
@@ -95,6 +107,7 @@ fn page<'a, F: Family>(
                     m.label()
                 },
                 is_random: m.is_random(),
+                min_budget: super::validate::min_budget::<F>(&exp.scene, m, &spec.quantities),
             }
         })
         .collect();
@@ -104,6 +117,7 @@ fn page<'a, F: Family>(
         family: F::NAME,
         equations: &spec.equations,
         budgets: &exp.budgets,
+        budget_unit: F::BUDGET_UNIT,
         repeats: spec.repeats,
         seed: spec.seed,
         settings: F::settings(&spec.scene),
@@ -231,15 +245,33 @@ impl Registry {
         (entry.load)(json, hash)
     }
 
-    /// The JSON Schema of experiment files: one of the families' schemas.
+    /// The JSON Schema (2020-12) of experiment files: one of the families'
+    /// schemas, told apart by the constant `family`; each family's
+    /// definitions are kept under `$defs/<family>.<name>`.
     pub fn schema(&self) -> serde_json::Value {
-        let schemas: Vec<serde_json::Value> =
-            self.entries.iter().map(|e| e.schema().to_value()).collect();
+        let mut defs = serde_json::Map::new();
+        let mut branches = Vec::new();
+        for e in &self.entries {
+            let mut branch = e.schema().to_value();
+            prefix_refs(&mut branch, e.name);
+            let Some(object) = branch.as_object_mut() else {
+                continue;
+            };
+            if let Some(serde_json::Value::Object(own)) = object.remove("$defs") {
+                defs.extend(own.into_iter().map(|(k, v)| (format!("{}.{k}", e.name), v)));
+            }
+            object.remove("$schema");
+            object.insert("title".into(), format!("{} experiment", e.name).into());
+            branch["properties"]["family"] =
+                serde_json::json!({ "const": e.name, "description": e.about });
+            branches.push(branch);
+        }
         serde_json::json!({
             "$schema": "https://json-schema.org/draft/2020-12/schema",
             "title": "lightquad experiment",
             "description": "An experiment file; `family` decides the format of `scene`, `quantities` and the family's estimators in `rules`.",
-            "oneOf": schemas,
+            "oneOf": branches,
+            "$defs": defs,
         })
     }
 
@@ -255,6 +287,26 @@ impl Registry {
             }
         }
         out
+    }
+}
+
+/// Rewrites every `{"$ref": "#/$defs/X"}` below `v` to `#/$defs/<family>.X`.
+fn prefix_refs(v: &mut serde_json::Value, family: &str) {
+    match v {
+        serde_json::Value::Object(map) => {
+            for (key, child) in map.iter_mut() {
+                match child {
+                    serde_json::Value::String(target) if key == "$ref" => {
+                        if let Some(name) = target.strip_prefix("#/$defs/") {
+                            *target = format!("#/$defs/{family}.{name}");
+                        }
+                    }
+                    _ => prefix_refs(child, family),
+                }
+            }
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(|c| prefix_refs(c, family)),
+        _ => {}
     }
 }
 

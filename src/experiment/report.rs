@@ -31,6 +31,8 @@ pub struct Page<'a> {
     pub equations: &'a [String],
     /// Budgets, ascending.
     pub budgets: &'a [usize],
+    /// What a budget counts.
+    pub budget_unit: &'static str,
     /// Repeats per (rule, budget).
     pub repeats: usize,
     /// The file's seed.
@@ -56,6 +58,8 @@ pub struct RuleInfo {
     pub label: String,
     /// True for randomised rules (their estimate is a standard error).
     pub is_random: bool,
+    /// The smallest budget it runs at (smaller budgets are skipped for it).
+    pub min_budget: usize,
 }
 
 /// A fact about a row of a report table.
@@ -93,7 +97,8 @@ impl std::fmt::Display for RowFlag {
 
 /// The legend of the flags, below every page.
 const FLAG_LEGEND: &str = "Flags: `failed` (the job's reason follows); `non-finite value`; \
-`outside 4 standard errors` (a random estimate whose standard error misses the true error); \
+`outside 4 standard errors` (a random estimate whose standard error misses the true error: \
+the root mean square over channels of error / standard error above 4); \
 `estimate off by more than 10x` (a deterministic error estimate, above the rounding floor); \
 `error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
 parts); `underflows: log space` (the value is below the smallest f64, its logarithm is exact); \
@@ -252,10 +257,21 @@ fn judge_estimate(
     random: bool,
 ) -> Option<RowFlag> {
     if random {
+        // Per job, the root mean square over channels of the errors in units
+        // of their standard errors: |z| for a scalar, and for an image a test
+        // that does not fire merely because some of many pixels sit beyond 4.
         let outside = measured.iter().any(|m| {
-            m.error.iter().enumerate().any(|(c, e)| {
-                e.is_finite() && (channel(&m.value, c) - channel(reference, c)).abs() > 4.0 * e
-            })
+            let z = (0..m.value.len())
+                .filter(|&c| channel(&m.error, c).is_finite())
+                .map(|c| {
+                    let d = channel(&m.value, c) - channel(reference, c);
+                    match channel(&m.error, c) {
+                        e if e > 0.0 => d / e,
+                        _ if d == 0.0 => 0.0,
+                        _ => f64::INFINITY,
+                    }
+                });
+            rms(z.collect::<Vec<_>>().into_iter()) > 4.0
         });
         outside.then_some(RowFlag::OutsideStandardErrors)
     } else {
@@ -385,6 +401,16 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
     let mut summary = Summary::new();
     for &q in &page.quantities {
         let Some(reference) = page.reference.values.get(q) else {
+            let why = page
+                .reference
+                .missing
+                .get(q)
+                .map_or("no reference value", String::as_str);
+            let _ = writeln!(
+                md,
+                "## {q} (no reference)\n\nNo reference, so no true errors, orders or times to target: \
+                 {why}. The jobs' values and estimated errors are in results.csv.\n"
+            );
             continue;
         };
         let mut rows = rows(&page.rules, results, q, reference);
@@ -439,10 +465,23 @@ fn header(page: &Page, results: &[JobResult]) -> String {
     };
     let _ = writeln!(
         md,
-        "Family `{}`.{equations} Budgets {:?} per smooth piece, {} repeat(s), seed {}{settings}.{shared}\n\n\
+        "Family `{}`.{equations} Budgets {:?} ({}), {} repeat(s), seed {}{settings}.{shared}\n\n\
          Reference: {}\n",
-        page.family, page.budgets, page.repeats, page.seed, page.reference.note
+        page.family, page.budgets, page.budget_unit, page.repeats, page.seed, page.reference.note
     );
+    let skipped: Vec<String> = page
+        .rules
+        .iter()
+        .filter(|r| page.budgets.first().is_some_and(|&b| b < r.min_budget))
+        .map(|r| format!("{} needs at least {}", r.label, r.min_budget))
+        .collect();
+    if !skipped.is_empty() {
+        let _ = writeln!(
+            md,
+            "Budgets below a rule's minimum are skipped for it: {}.\n",
+            skipped.join(", ")
+        );
+    }
     if let Some(r) = results.first() {
         let _ = writeln!(
             md,
@@ -584,9 +623,14 @@ fn csv(results: &[JobResult]) -> String {
     for r in results {
         let lead = format!(
             "{},{},{},{},{},{}",
-            r.experiment, r.rule_index, r.rule, r.budget, r.repeat, r.seed
+            field(&r.experiment),
+            r.rule_index,
+            field(&r.rule),
+            r.budget,
+            r.repeat,
+            r.seed
         );
-        let failure = r.failure.as_deref().unwrap_or("").replace([',', '\n'], ";");
+        let failure = field(r.failure.as_deref().unwrap_or(""));
         if r.quantities.is_empty() {
             let why = if failure.is_empty() {
                 "no value"
@@ -598,7 +642,8 @@ fn csv(results: &[JobResult]) -> String {
         for (q, m) in &r.quantities {
             let _ = writeln!(
                 csv,
-                "{lead},{q},{},{},{},{:e},{failure}",
+                "{lead},{},{},{},{},{:e},{failure}",
+                field(q),
                 join(&m.value),
                 join(&m.error),
                 m.evaluations,
@@ -607,6 +652,15 @@ fn csv(results: &[JobResult]) -> String {
         }
     }
     csv
+}
+
+/// A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break.
+fn field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
 }
 
 /// Writes the index page: every experiment, per quantity the rules ranked by
@@ -647,8 +701,8 @@ pub fn write_index(
             md,
             "## lightquad vs Mitsuba 3 vs closed form\n\nEvery case the Mitsuba harness (reference/) covers: \
              lightquad's converged value, Mitsuba's value with its standard error (float32 renderer: \
-             expect ~1e-6 relative at best), the closed form where one exists. Mitsuba media have no \
-             volumetric emission, so V-E (and V-I with emission) has no Mitsuba counterpart.\n\n{}",
+             expect ~1e-6 relative at best), the closed form where one exists; where Mitsuba has no \
+             value, the row says why.\n\n{}",
             crosscheck_markdown(crosscheck)
         );
     }

@@ -120,13 +120,13 @@ fn read_machine() -> String {
 pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): JobKey) -> JobResult {
     let spec = &exp.spec;
     let seed = job_seed(spec.seed, rule_index, budget, repeat);
-    let method = &spec.rules[rule_index.min(spec.rules.len() - 1)];
+    let method = spec.rules.get(rule_index);
     let mut out = JobResult {
         experiment: spec.name.clone(),
         experiment_hash: exp.hash.clone(),
         family: F::NAME.to_string(),
         rule_index,
-        rule: method.label(),
+        rule: method.map_or_else(|| format!("rules[{rule_index}]"), |m| m.label()),
         budget,
         repeat,
         seed,
@@ -137,20 +137,60 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         git_commit: Some(env!("LIGHTQUAD_GIT_COMMIT").to_string()).filter(|c| !c.is_empty()),
         machine: machine(),
     };
+    let Some(method) = method else {
+        out.failure = Some(format!(
+            "no rules[{rule_index}]: the experiment has {} rule(s)",
+            spec.rules.len()
+        ));
+        return out;
+    };
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let start = Instant::now();
     let outcome = F::evaluate(&exp.scene, method, budget, &mut rng, &spec.quantities);
     out.seconds = start.elapsed().as_secs_f64();
-    match outcome {
-        Ok(values) => {
-            out.quantities = values
-                .into_iter()
-                .map(|(q, m)| (q.name().to_string(), m))
-                .collect();
-        }
-        Err(e) => out.failure = Some(e.to_string()),
+    match outcome
+        .map_err(|e| e.to_string())
+        .and_then(|values| shaped::<F>(&exp.scene, &spec.quantities, values))
+    {
+        Ok(values) => out.quantities = values,
+        Err(e) => out.failure = Some(e),
     }
     out
+}
+
+/// The family's outcome by quantity name, checked to hold exactly the
+/// quantities asked for, each with its channel count of values and errors (a
+/// family that breaks this gets a failed job, not a misattributed number).
+fn shaped<F: Family>(
+    scene: &F::Scene,
+    quantities: &[F::Quantity],
+    mut values: crate::family::Outcome<F::Quantity>,
+) -> Result<BTreeMap<String, Measured>, String> {
+    let mut out = BTreeMap::new();
+    for q in quantities {
+        let Some(m) = values.remove(q) else {
+            return Err(format!("the {} family returned no {}", F::NAME, q.name()));
+        };
+        let want = F::channels(scene, *q);
+        if m.value.len() != want || m.error.len() != want {
+            return Err(format!(
+                "the {} family returned {} value(s) and {} error(s) for {}, which has {want} channel(s)",
+                F::NAME,
+                m.value.len(),
+                m.error.len(),
+                q.name()
+            ));
+        }
+        out.insert(q.name().to_string(), m);
+    }
+    if let Some(q) = values.keys().next() {
+        return Err(format!(
+            "the {} family returned {}, which was not asked for",
+            F::NAME,
+            q.name()
+        ));
+    }
+    Ok(out)
 }
 
 /// Every job of an experiment in a fixed order, restricted to a shard; a

@@ -45,11 +45,17 @@ pub fn parse_json(text: &str) -> Result<serde_json::Value, SpecError> {
 
 /// A serde error at its JSON path (`.` for the root).
 fn path_error<E: std::fmt::Display>(e: serde_path_to_error::Error<E>) -> SpecError {
-    let path = e.path().to_string();
-    SpecError::at(
-        if path.is_empty() { ".".into() } else { path },
-        e.inner().to_string(),
-    )
+    let mut path = e.path().to_string();
+    let mut message = e.inner().to_string();
+    // A path below the one serde tracked, named at the start of the message.
+    if let Some((below, rest)) = message
+        .strip_prefix(crate::family::SUB_PATH)
+        .and_then(|m| m.split_once("`: "))
+    {
+        path = format!("{path}.{below}");
+        message = rest.to_string();
+    }
+    SpecError::at(if path.is_empty() { ".".into() } else { path }, message)
 }
 
 /// Reads a parsed file as an experiment of family `F`, naming the JSON path
@@ -145,6 +151,14 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
             "quantities",
             format!("an empty list: name at least one of {}", all.join(", ")),
         ));
+    }
+    for (i, q) in spec.quantities.iter().enumerate() {
+        if spec.quantities[..i].contains(q) {
+            return Err(SpecError::at(
+                format!("quantities[{i}]"),
+                format!("{} is named twice: name each quantity once", q.name()),
+            ));
+        }
     }
     if !(1..=1000).contains(&spec.repeats) {
         return Err(SpecError::at(
@@ -294,6 +308,7 @@ fn geometric(from: usize, to: usize, factor: f64) -> Result<Vec<usize>, SpecErro
 pub fn literal_values<Q: Quantity>(
     values: &BTreeMap<Q, super::spec::Literal>,
     quantities: &[Q],
+    channels: impl Fn(Q) -> usize,
 ) -> Result<BTreeMap<Q, Vec<f64>>, SpecError> {
     let mut out = BTreeMap::new();
     for q in quantities {
@@ -303,14 +318,28 @@ pub fn literal_values<Q: Quantity>(
                 format!("no value for quantity {}", q.name()),
             ));
         };
-        let channels = v.channels();
-        if channels.is_empty() || channels.iter().any(|x| !x.is_finite()) {
+        let at = format!("reference.values.{}", q.name());
+        let got = v.channels();
+        let want = channels(*q);
+        if got.iter().any(|x| !x.is_finite()) {
+            return Err(SpecError::at(at, format!("{got:?} is not finite")));
+        }
+        if got.len() != want {
             return Err(SpecError::at(
-                format!("reference.values.{}", q.name()),
-                format!("{channels:?} is not a finite number or a non-empty list of them"),
+                at,
+                format!(
+                    "{} value(s) given, but {} has {want} channel(s): give {}",
+                    got.len(),
+                    q.name(),
+                    if want == 1 {
+                        "one number".to_string()
+                    } else {
+                        format!("a list of {want} numbers")
+                    }
+                ),
             ));
         }
-        out.insert(*q, channels);
+        out.insert(*q, got);
     }
     Ok(out)
 }

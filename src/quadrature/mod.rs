@@ -22,7 +22,7 @@
 //! | `monte-carlo` | plain Monte Carlo | standard error |
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
 //! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles |
-//! | `product` | iterated 2-D rule from any two 1-D rules (`product(A,B)` on the command line) | outer estimate + integrated inner estimates |
+//! | `product` | iterated 2-D rule from any two 1-D rules (`AnyRule::by_name("product(A,B)")` in the library) | outer estimate + integrated inner estimates |
 
 pub mod nodes;
 pub mod product;

@@ -116,7 +116,19 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
                     "a rule that integrates in one dimension",
                 ));
             }
-            rule.check_params()?;
+            // A factor's parameter is named below the factor (`inner.replicates`).
+            rule.check_params().map_err(|e| match e {
+                QuadError::InvalidParameter {
+                    name,
+                    value,
+                    accepted,
+                } => QuadError::InvalidParameter {
+                    name: format!("{field}.{name}"),
+                    value,
+                    accepted,
+                },
+                other => other,
+            })?;
         }
         Ok(())
     }

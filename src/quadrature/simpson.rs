@@ -11,7 +11,7 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::nodes::{UnitNodes, product_sum};
+use super::nodes::{UnitNodes, product_sum, richardson};
 use super::trapezoid::MAX_POINTS;
 use super::{Rule, per_axis};
 use crate::error::QuadError;
@@ -45,7 +45,8 @@ fn weights(m: usize, h: f64, stride: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The m-point Simpson rule on `[0, 1]` (`m = 4k + 1 >= 5`) with the `2h` companion.
+/// The m-point Simpson rule on `[0, 1]` (m odd, >= 3), with the `2h` companion
+/// (a Simpson rule itself when `m = 4k + 1`, which the rule uses).
 pub fn unit_nodes(m: usize) -> UnitNodes {
     let intervals = (m - 1) as f64;
     let h = 1.0 / intervals;
@@ -90,14 +91,6 @@ impl Rule for Simpson {
             ));
         }
         let nodes = unit_nodes(m - (m - 1) % 4);
-        let sum = product_sum([&nodes; D], f)?;
-        let coarse = sum.companion.unwrap_or(sum.value);
-        Ok(Estimate {
-            value: sum.value,
-            error: sum
-                .value
-                .zip(coarse, |fine, coarse| (fine - coarse).abs() / 15.0),
-            evaluations: sum.evaluations,
-        })
+        Ok(richardson(product_sum([&nodes; D], f)?, 4))
     }
 }

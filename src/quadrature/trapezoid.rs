@@ -10,7 +10,7 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::nodes::{UnitNodes, product_sum};
+use super::nodes::{UnitNodes, product_sum, richardson};
 use super::{Rule, per_axis};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
@@ -83,14 +83,6 @@ impl Rule for Trapezoid {
             m -= 1;
         }
         let nodes = unit_nodes(m);
-        let sum = product_sum([&nodes; D], f)?;
-        let coarse = sum.companion.unwrap_or(sum.value);
-        Ok(Estimate {
-            value: sum.value,
-            error: sum
-                .value
-                .zip(coarse, |fine, coarse| (fine - coarse).abs() / 3.0),
-            evaluations: sum.evaluations,
-        })
+        Ok(richardson(product_sum([&nodes; D], f)?, 2))
     }
 }

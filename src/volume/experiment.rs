@@ -259,6 +259,8 @@ impl Family for Volume {
     const ABOUT: &'static str =
         "volume rendering along one eye ray with a directional light (V-tau .. V-I)";
     const EQUATIONS: &'static [&'static str] = &["V-tau", "V-E", "V-B", "V-Lp", "V-L", "V-I"];
+    const BUDGET_UNIT: &'static str =
+        "nodes or samples per smooth piece of the ray (walks for tracking)";
 
     type SceneSpec = SceneSpec;
     type Scene = Built;
@@ -285,6 +287,11 @@ impl Family for Volume {
 
     /// Every volume integral is along a ray segment.
     fn dimension(_: &Built, _: VolumeQuantity) -> usize {
+        1
+    }
+
+    /// Every volume quantity is a scalar.
+    fn channels(_: &Built, _: VolumeQuantity) -> usize {
         1
     }
 
