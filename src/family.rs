@@ -235,6 +235,7 @@ pub enum Flag {
     /// magnitudes of its parts, `parts`.
     Cancellation {
         /// `sum |part|`.
+        #[serde(with = "json_f64::one")]
         parts: f64,
     },
 }
@@ -255,8 +256,11 @@ impl std::fmt::Display for Flag {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Measured {
     /// The value, per channel.
+    #[serde(with = "json_f64::many")]
     pub value: Vec<f64>,
-    /// The method's own estimate of the absolute error, per channel.
+    /// The method's own estimate of the absolute error, per channel
+    /// (infinite where the method had no information to estimate it).
+    #[serde(with = "json_f64::many")]
     pub error: Vec<f64>,
     /// Evaluations of the integrand's costly part (density lookups, rays).
     pub evaluations: u64,
@@ -376,5 +380,74 @@ pub trait Family: Sized + Send + Sync + 'static {
     /// The family's audit of printed formulas, as Markdown, if it has one.
     fn audit() -> Option<String> {
         None
+    }
+}
+
+/// Serde for floats in results files that keeps the non-finite ones: JSON has
+/// no infinity or NaN (serde_json writes `null`, which reads back as nothing),
+/// so they are written as the strings `"inf"`, `"-inf"` and `"NaN"`.
+pub mod json_f64 {
+    use serde::de::Error;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// A number, or the name of a non-finite one.
+    #[derive(Serialize, Deserialize)]
+    #[serde(untagged)]
+    enum Num {
+        Finite(f64),
+        Named(String),
+    }
+
+    fn write(x: f64) -> Num {
+        match x {
+            _ if x.is_finite() => Num::Finite(x),
+            _ if x.is_nan() => Num::Named("NaN".into()),
+            _ if x > 0.0 => Num::Named("inf".into()),
+            _ => Num::Named("-inf".into()),
+        }
+    }
+
+    fn read<E: Error>(n: Num) -> Result<f64, E> {
+        match n {
+            Num::Finite(x) => Ok(x),
+            Num::Named(s) => match s.as_str() {
+                "inf" => Ok(f64::INFINITY),
+                "-inf" => Ok(f64::NEG_INFINITY),
+                "NaN" => Ok(f64::NAN),
+                other => Err(E::custom(format!(
+                    "{other:?} is not a number, \"inf\", \"-inf\" or \"NaN\""
+                ))),
+            },
+        }
+    }
+
+    /// One float.
+    pub mod one {
+        use super::*;
+
+        /// Writes `x`.
+        pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+            write(*x).serialize(s)
+        }
+
+        /// Reads a float.
+        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+            read(Num::deserialize(d)?)
+        }
+    }
+
+    /// A vector of floats.
+    pub mod many {
+        use super::*;
+
+        /// Writes `v`.
+        pub fn serialize<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+            s.collect_seq(v.iter().map(|&x| write(x)))
+        }
+
+        /// Reads a vector of floats.
+        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+            Vec::<Num>::deserialize(d)?.into_iter().map(read).collect()
+        }
     }
 }

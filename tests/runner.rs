@@ -803,3 +803,47 @@ fn merge_prefers_a_finished_job_over_a_failed_copy() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A job whose error estimate is infinite (Gauss–Legendre without its
+/// estimate) survives the results file: merge and resume read it back (JSON
+/// has no infinity; it used to be written as null and then dropped).
+#[test]
+fn infinite_error_estimates_survive_the_results_file() {
+    let dir = scratch("inf");
+    let file = dir.join("e.json");
+    fs::write(
+        &file,
+        VALID.replace(
+            "{ \"rule\": \"gauss-legendre\" }",
+            "{ \"rule\": \"gauss-legendre\", \"error_estimate\": false }",
+        ),
+    )
+    .expect("write");
+    let out = dir.join("out");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = fs::read_to_string(out.join("t/results.jsonl")).expect("results");
+    assert!(text.contains("\"error\":[\"inf\"]"), "{text}");
+    assert!(!text.contains("null]"), "{text}");
+    let read = lightquad::experiment::run::read_results(&out.join("t/results.jsonl"), None);
+    assert_eq!(read.len(), text.lines().count(), "a line did not read back");
+    assert!(
+        read.iter()
+            .any(|r| r.quantities["tau"].error[0] == f64::INFINITY)
+    );
+    let merged = dir.join("merged");
+    let o = bin()
+        .args(["merge", "--out"])
+        .arg(&merged)
+        .arg(&out)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    same(&results(&merged, "t"), &results(&out, "t"));
+    let _ = fs::remove_dir_all(&dir);
+}
