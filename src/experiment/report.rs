@@ -347,7 +347,8 @@ fn plot(
     };
     let (x0, x1) = decades(x0, x1);
     let (y0, y1) = decades(y0, y1);
-    let root = SVGBackend::new(path, (900, 520)).into_drawing_area();
+    // The legend panel is wide enough for a product label of two rule names.
+    let root = SVGBackend::new(path, (1020, 520)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     // The legend gets a panel of its own on the right, so it never hides a curve.
     let (left, right) = root.split_horizontally(700);
@@ -385,7 +386,7 @@ fn plot(
             ))
             .map_err(|e| e.to_string())?;
         right
-            .draw(&Text::new(name.clone(), (42, y - 8), ("sans-serif", 15)))
+            .draw(&Text::new(name.clone(), (42, y - 8), ("sans-serif", 14)))
             .map_err(|e| e.to_string())?;
     }
     root.present().map_err(|e| e.to_string())
