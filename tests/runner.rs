@@ -26,6 +26,21 @@ fn scratch(tag: &str) -> PathBuf {
     dir
 }
 
+/// Writes `text` to a scratch folder and runs it into `<folder>/out`.
+fn run_text(tag: &str, text: &str) -> (PathBuf, PathBuf, Output) {
+    let dir = scratch(tag);
+    let file = dir.join("e.json");
+    fs::write(&file, text).expect("write");
+    let out = dir.join("out");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    (dir, out, o)
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
 }
@@ -681,22 +696,13 @@ fn faults_inside_rules_and_references_are_named_where_they_are() {
 /// fails: never a page that claims convergence and shows no table.
 #[test]
 fn a_reference_that_cannot_be_computed_fails_the_run_and_says_why() {
-    let dir = scratch("noref");
-    let file = dir.join("e.json");
     let text = VALID
         .replace(
             "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
             "{ \"type\": \"gaussian-blobs\", \"blobs\": [{ \"centre\": [0.0, 0.0, 0.0], \"amplitude\": 1e308, \"width\": 1.0 }, { \"centre\": [0.1, 0.0, 0.0], \"amplitude\": 1e308, \"width\": 1.0 }] }",
         )
         .replace("{ \"type\": \"closed-form\" }", "{ \"type\": \"converged\" }");
-    fs::write(&file, text).expect("write");
-    let out = dir.join("out");
-    let o = bin()
-        .args(["run", "--out"])
-        .arg(&out)
-        .arg(&file)
-        .output()
-        .expect("runs");
+    let (dir, out, o) = run_text("noref", &text);
     assert!(!o.status.success(), "a run without a reference succeeded");
     assert!(stderr(&o).contains("has no reference"), "{}", stderr(&o));
     let report = fs::read_to_string(out.join("t").join("report.md")).expect("report");
@@ -709,22 +715,12 @@ fn a_reference_that_cannot_be_computed_fails_the_run_and_says_why() {
 /// (which hold a comma) included.
 #[test]
 fn the_csv_keeps_its_columns_with_product_labels() {
-    let dir = scratch("csv");
-    let file = dir.join("e.json");
-    fs::write(
-        &file,
+    let (dir, out, o) = run_text(
+        "csv",
         r#"{ "name": "c", "family": "calibration", "scene": {}, "quantities": ["gaussian-disk"],
         "rules": [{ "rule": "product", "outer": { "rule": "gauss-legendre" }, "inner": { "rule": "trapezoid" } }],
         "budgets": [16, 64], "repeats": 1, "reference": { "type": "closed-form" } }"#,
-    )
-    .expect("write");
-    let out = dir.join("out");
-    let o = bin()
-        .args(["run", "--out"])
-        .arg(&out)
-        .arg(&file)
-        .output()
-        .expect("runs");
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let csv = fs::read_to_string(out.join("c").join("results.csv")).expect("csv");
     // RFC 4180 fields: commas inside quotes do not separate.
@@ -809,23 +805,13 @@ fn merge_prefers_a_finished_job_over_a_failed_copy() {
 /// has no infinity; it used to be written as null and then dropped).
 #[test]
 fn infinite_error_estimates_survive_the_results_file() {
-    let dir = scratch("inf");
-    let file = dir.join("e.json");
-    fs::write(
-        &file,
-        VALID.replace(
+    let (dir, out, o) = run_text(
+        "inf",
+        &VALID.replace(
             "{ \"rule\": \"gauss-legendre\" }",
             "{ \"rule\": \"gauss-legendre\", \"error_estimate\": false }",
         ),
-    )
-    .expect("write");
-    let out = dir.join("out");
-    let o = bin()
-        .args(["run", "--out"])
-        .arg(&out)
-        .arg(&file)
-        .output()
-        .expect("runs");
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let text = fs::read_to_string(out.join("t/results.jsonl")).expect("results");
     assert!(text.contains("\"error\":[\"inf\"]"), "{text}");
