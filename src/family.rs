@@ -21,7 +21,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::{QuadError, SpecError};
-use crate::quadrature::{AnyRule, Rule};
+use crate::quadrature::{AnyRule, BaseRule, Product, Rule};
 
 /// A quantity a family computes (`tau`, `I_L`, a pixel image, ...).
 pub trait Quantity:
@@ -158,8 +158,9 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
                 accepted()
             )));
         };
-        // A fault inside a rule is reported at the rule, naming the field
-        // (serde's tagged enums do not track paths below the tag).
+        // A fault inside a rule is reported at its field; serde's tagged enums
+        // do not track paths below the tag, so a rule's parameters are read
+        // by [`BaseRule::from_json`] and an estimator's at the estimator.
         if E::all().iter().any(|e| e.name() == tag) {
             serde_json::from_value(value)
                 .map(Method::Estimator)
@@ -167,9 +168,9 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
         } else if tag == "product" {
             product(&value).map(Method::Rule)
         } else if names.contains(&tag) {
-            serde_json::from_value(value)
-                .map(Method::Rule)
-                .map_err(D::Error::custom)
+            BaseRule::from_json(&value)
+                .map(|r| Method::Rule(AnyRule::Base(r)))
+                .map_err(|(path, message)| below(&path, &message))
         } else {
             Err(D::Error::custom(format!(
                 "unknown rule `{tag}`: {}",
@@ -179,15 +180,23 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
     }
 }
 
+/// An error at `path` below the current one (none: at it).
+fn below<Er: serde::de::Error>(path: &str, message: &str) -> Er {
+    if path.is_empty() {
+        Er::custom(message)
+    } else {
+        Er::custom(format!("{SUB_PATH}{path}`: {message}"))
+    }
+}
+
 /// Marks the start of a path below the current one in an error message
 /// (`at `.outer`: ...`), which [`crate::experiment::validate`] moves into the
 /// error's JSON path.
 pub const SUB_PATH: &str = "at `.";
 
 /// `{"rule": "product", "outer": {..}, "inner": {..}}`, a fault in a factor
-/// reported below it (`.outer`).
+/// reported below it (`.outer.rel_tol`).
 fn product<Er: serde::de::Error>(value: &serde_json::Value) -> Result<AnyRule, Er> {
-    use crate::quadrature::{BaseRule, Product};
     let map = value.as_object().into_iter().flatten();
     if let Some((key, _)) = map
         .clone()
@@ -201,10 +210,16 @@ fn product<Er: serde::de::Error>(value: &serde_json::Value) -> Result<AnyRule, E
         let v = value
             .get(field)
             .ok_or_else(|| Er::custom(format!("missing field `{field}`")))?;
-        serde_json::from_value(v.clone()).map_err(|e| {
-            Er::custom(format!(
-                "{SUB_PATH}{field}`: {e} (a product's factors are single 1-D rules)"
-            ))
+        BaseRule::from_json(v).map_err(|(path, message)| {
+            let path = if path.is_empty() {
+                field.to_string()
+            } else {
+                format!("{field}.{path}")
+            };
+            below(
+                &path,
+                &format!("{message} (a product's factors are single 1-D rules)"),
+            )
         })
     };
     Ok(AnyRule::Product(Box::new(Product {

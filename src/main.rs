@@ -89,6 +89,9 @@ fn main() -> ExitCode {
 
 type Failure = Box<dyn std::error::Error>;
 
+/// The most worker threads `run` accepts (far above any core count it helps).
+const MAX_THREADS: usize = 1024;
+
 fn run(command: Command) -> Result<(), Failure> {
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
@@ -109,8 +112,11 @@ fn run(command: Command) -> Result<(), Failure> {
             threads,
         } => {
             if let Some(t) = threads {
-                if t == 0 {
-                    return Err("invalid --threads = 0: expected a number of threads >= 1".into());
+                if !(1..=MAX_THREADS).contains(&t) {
+                    return Err(format!(
+                        "invalid --threads = {t}: expected a number of threads in 1..={MAX_THREADS}"
+                    )
+                    .into());
                 }
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(t)

@@ -173,7 +173,7 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
             "{ \"rule\": \"stratified\" }",
             "{ \"rule\": \"product\", \"outer\": { \"rule\": \"gauss-legendre\", \"error_estimat\": true }, \"inner\": { \"rule\": \"trapezoid\" } }",
         ),
-        "rules[1].outer",
+        "rules[1].outer.error_estimat",
         "unknown field `error_estimat`, expected `error_estimate`",
     );
     rejected(
@@ -654,8 +654,8 @@ fn faults_inside_rules_and_references_are_named_where_they_are() {
             "{ \"rule\": \"product\", \"outer\": { \"rule\": \"trapezoid\" }, \"inner\": { \"rule\": \"trapezoid\" } }",
             "{ \"rule\": \"trapezoid\" }",
         ),
-        "rules[1].outer",
-        "unknown variant `product`",
+        "rules[1].outer.rule",
+        "\"product\" is not a single rule: expected one of trapezoid",
     );
     rejected(
         &product(
@@ -665,6 +665,22 @@ fn faults_inside_rules_and_references_are_named_where_they_are() {
         .replace("[\"tau\", \"I_E\"]", "[\"tau\"]"),
         "rules[1].inner.replicates",
         "an integer >= 2",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"gauss-kronrod\", \"rel_tol\": \"1e-3\" }",
+        ),
+        "rules[1].rel_tol",
+        "invalid type: string \"1e-3\", expected f64",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"stratified\", \"n\": 4 }",
+        ),
+        "rules[1].n",
+        "unknown field `n`: this rule takes no parameters",
     );
     rejected(
         &VALID.replace("[\"tau\", \"I_E\"]", "[\"tau\", \"I_E\", \"tau\"]"),
@@ -831,5 +847,91 @@ fn infinite_error_estimates_survive_the_results_file() {
         .expect("runs");
     assert!(o.status.success(), "{}", stderr(&o));
     same(&results(&merged, "t"), &results(&out, "t"));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A value that overflows is a failed job (exit non-zero, reason in the
+/// report), never a NaN with zero error that "reaches" every target.
+#[test]
+fn a_non_finite_value_is_a_failed_job() {
+    let (dir, out, o) = run_text(
+        "nan",
+        &VALID.replace("\"c\": 1.0", "\"c\": 1e308").replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"converged\" }",
+        ),
+    );
+    assert!(!o.status.success(), "overflow passed");
+    assert!(stderr(&o).contains("jobs failed"), "{}", stderr(&o));
+    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+    assert!(
+        report.contains("failed: the volume family computed a non-finite I_E"),
+        "{report}"
+    );
+    // Stratified overflows from n = 16 on: those rows claim no error.
+    let rows: Vec<&str> = report
+        .lines()
+        .filter(|l| l.starts_with("| stratified | 16 |") || l.starts_with("| stratified | 64 |"))
+        .collect();
+    assert!(
+        !rows.is_empty()
+            && rows
+                .iter()
+                .all(|l| l.contains("| NaN |") && l.contains("failed")),
+        "{report}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A key given twice is refused, not silently the last one.
+#[test]
+fn duplicate_keys_are_refused() {
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"trapezoid\", \"rule\": \"sobol\" }",
+        ),
+        "rules[1]",
+        "duplicate key `rule`",
+    );
+    rejected(
+        &VALID.replace(
+            "\"family\": \"volume\",",
+            "\"family\": \"calibration\", \"family\": \"volume\",",
+        ),
+        ".",
+        "duplicate key `family`",
+    );
+}
+
+/// A merge that misses a shard says so at the top of the index it writes.
+#[test]
+fn an_incomplete_merge_says_so_in_the_index() {
+    let dir = scratch("partial");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let shards = dir.join("shards");
+    let o = bin()
+        .args(["run", "--shard", "1/3", "--out"])
+        .arg(&shards)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let merged = dir.join("merged");
+    let o = bin()
+        .args(["merge", "--out"])
+        .arg(&merged)
+        .arg(&shards)
+        .output()
+        .expect("runs");
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("the report is incomplete"),
+        "{}",
+        stderr(&o)
+    );
+    let index = fs::read_to_string(merged.join("index.md")).expect("index");
+    assert!(index.contains("**This report is incomplete**"), "{index}");
     let _ = fs::remove_dir_all(&dir);
 }

@@ -216,7 +216,7 @@ fn write_reports(
         .filter(|e| families.contains(e.name))
         .filter_map(FamilyEntry::audit)
         .collect();
-    report::write_index(out, &entries, &checks, &audits).map_err(|e| io(out, e))?;
+    report::write_index(out, &entries, &checks, &audits, &problems).map_err(|e| io(out, e))?;
     let index = out.join("index.md");
     if !problems.is_empty() {
         return Err(RunError::Incomplete {

@@ -60,6 +60,16 @@ pub fn known_values<F: Family>(
                         ),
                     ));
                 };
+                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                    return Err(SpecError::at(
+                        "reference",
+                        format!(
+                            "the closed form of {} is {x} for this scene (it overflows): no error \
+                             can be measured against it",
+                            q.name()
+                        ),
+                    ));
+                }
                 values.insert(*q, v);
             }
             Known {
@@ -194,8 +204,11 @@ pub fn relative_distance(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Root mean square, scaled by the largest magnitude so that no square
-/// overflows or underflows.
+/// overflows or underflows; NaN when any term is NaN.
 pub fn rms(xs: impl Iterator<Item = f64> + Clone) -> f64 {
+    if xs.clone().any(f64::is_nan) {
+        return f64::NAN;
+    }
     let big = xs.clone().fold(0.0f64, |m, x| m.max(x.abs()));
     if big == 0.0 || !big.is_finite() {
         return big;

@@ -672,9 +672,22 @@ pub fn write_index(
     entries: &[(String, String, Summary)],
     crosscheck: &[Crosscheck],
     audits: &[String],
+    problems: &[String],
 ) -> Result<(), String> {
-    let mut md = String::from(
-        "# lightquad report\n\nEvery experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (1e-6 unless the experiment says otherwise); `not reached` means no budget got there.\n\n",
+    let mut md = String::from("# lightquad report\n\n");
+    if !problems.is_empty() {
+        let _ = writeln!(
+            md,
+            "**This report is incomplete**, and its rankings may be wrong:\n\n{}\n",
+            problems
+                .iter()
+                .map(|p| format!("- {p}"))
+                .collect::<Vec<_>>()
+                .join("\n")
+        );
+    }
+    md.push_str(
+        "Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (1e-6 unless the experiment says otherwise); `not reached` means no budget got there.\n\n",
     );
     for (name, description, summary) in entries {
         let _ = writeln!(md, "## [{name}]({name}/report.md)\n\n{description}\n");

@@ -171,6 +171,13 @@ fn shaped<F: Family>(
         let Some(m) = values.remove(q) else {
             return Err(format!("the {} family returned no {}", F::NAME, q.name()));
         };
+        if let Some(x) = m.value.iter().find(|x| !x.is_finite()) {
+            return Err(format!(
+                "the {} family computed a non-finite {} ({x}): the integrand overflowed or is undefined",
+                F::NAME,
+                q.name()
+            ));
+        }
         let want = F::channels(scene, *q);
         if m.value.len() != want || m.error.len() != want {
             return Err(format!(

@@ -210,6 +210,24 @@ macro_rules! registry {
             pub fn defaults() -> Vec<BaseRule> {
                 vec![$(BaseRule::$rule(<$rule>::default())),+]
             }
+
+            /// Reads `{"rule": "<name>", <parameters>}`; a fault is returned with
+            /// the path of its field below the rule (`rel_tol`) and what is wrong.
+            pub fn from_json(value: &serde_json::Value) -> Result<BaseRule, (String, String)> {
+                let mut params = value.as_object().cloned().unwrap_or_default();
+                let tag = params.remove("rule");
+                match tag.as_ref().and_then(|t| t.as_str()) {
+                    $(Some($name) => parameters::<$rule>(params).map(BaseRule::$rule),)+
+                    _ => Err((
+                        "rule".into(),
+                        format!(
+                            "{} is not a single rule: expected one of {}",
+                            tag.unwrap_or(serde_json::Value::Null),
+                            [$($name),+].join(", ")
+                        ),
+                    )),
+                }
+            }
         }
 
         impl Rule for BaseRule {
@@ -401,6 +419,30 @@ impl Rule for AnyRule {
             AnyRule::Product(r) => r.try_integrate(n, rng, f),
         }
     }
+}
+
+/// A rule's parameters (the object without its `"rule"`), with the path of a
+/// fault below the rule; a rule without parameters says so of any field.
+fn parameters<T: serde::de::DeserializeOwned>(
+    params: serde_json::Map<String, serde_json::Value>,
+) -> Result<T, (String, String)> {
+    let takes_none = serde_json::from_value::<T>(serde_json::Value::Null);
+    if let Ok(rule) = takes_none {
+        return match params.keys().next() {
+            None => Ok(rule),
+            Some(key) => Err((
+                key.clone(),
+                format!("unknown field `{key}`: this rule takes no parameters"),
+            )),
+        };
+    }
+    serde_path_to_error::deserialize(serde_json::Value::Object(params)).map_err(|e| {
+        let path = e.path().to_string();
+        (
+            if path == "." { String::new() } else { path },
+            e.inner().to_string(),
+        )
+    })
 }
 
 /// Splits `A,B` at the comma that is not inside parentheses.
