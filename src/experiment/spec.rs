@@ -38,6 +38,7 @@ pub struct ExperimentSpec<F: Family> {
     /// Repeats per (rule, budget): run time is their lower median; randomised
     /// rules get one independent stream each.
     #[serde(default = "default_repeats")]
+    #[schemars(range(min = 1, max = 1000))]
     pub repeats: usize,
     /// Seed of every random stream (each job derives its own from it).
     #[serde(default)]
@@ -62,7 +63,7 @@ fn default_targets() -> Vec<f64> {
 #[serde(untagged)]
 pub enum Budgets {
     /// An explicit list.
-    List(Vec<i64>),
+    List(#[schemars(inner(range(min = 1, max = 100_000_000)))] Vec<i64>),
     /// A geometric range.
     Range(BudgetRange),
 }
@@ -72,8 +73,10 @@ pub enum Budgets {
 #[serde(deny_unknown_fields)]
 pub struct BudgetRange {
     /// First budget.
+    #[schemars(range(min = 1, max = 100_000_000))]
     pub from: i64,
     /// Last budget (inclusive bound).
+    #[schemars(range(min = 1, max = 100_000_000))]
     pub to: i64,
     /// Ratio between consecutive budgets (> 1).
     pub factor: f64,
@@ -133,6 +136,7 @@ pub enum ReferenceSpec<Q> {
     Converged {
         /// Nodes per smooth piece (default 400).
         #[serde(default = "four_hundred")]
+        #[schemars(range(min = 2, max = 100_000))]
         n: usize,
     },
 }

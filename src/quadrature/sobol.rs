@@ -33,6 +33,7 @@ pub struct Sobol {
     /// Number of independent scrambles (>= 2) used for the standard error
     /// (default 8).
     #[serde(default = "Sobol::default_replicates")]
+    #[schemars(range(min = 2))]
     pub replicates: usize,
 }
 
