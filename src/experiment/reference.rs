@@ -45,39 +45,7 @@ pub fn known_values<F: Family>(
     hash: &str,
 ) -> Result<Option<Known<F::Quantity>>, SpecError> {
     Ok(Some(match &spec.reference {
-        ReferenceSpec::ClosedForm {} => {
-            let mut values = BTreeMap::new();
-            for q in &spec.quantities {
-                let Some(v) =
-                    F::closed_form(scene, *q).filter(|v| v.len() == F::channels(scene, *q))
-                else {
-                    return Err(SpecError::at(
-                        "reference",
-                        format!(
-                            "quantity {} has no closed form for this scene ({}): use {{\"type\": \"converged\"}}",
-                            q.name(),
-                            F::closed_forms_available()
-                        ),
-                    ));
-                };
-                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-                    return Err(SpecError::at(
-                        "reference",
-                        format!(
-                            "the closed form of {} is {x} for this scene (it overflows): no error \
-                             can be measured against it",
-                            q.name()
-                        ),
-                    ));
-                }
-                values.insert(*q, v);
-            }
-            Known {
-                values,
-                uncertainty: 0.0,
-                note: format!("closed forms of the {} family.", F::NAME),
-            }
-        }
+        ReferenceSpec::ClosedForm {} => closed_forms(spec, scene)?,
         ReferenceSpec::Value {
             values,
             uncertainty,
@@ -122,6 +90,44 @@ pub fn known_values<F: Family>(
             return Ok(None);
         }
     }))
+}
+
+/// The family's closed form of every quantity, each finite and of the
+/// quantity's channel count.
+fn closed_forms<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+) -> Result<Known<F::Quantity>, SpecError> {
+    let mut values = BTreeMap::new();
+    for q in &spec.quantities {
+        let Some(v) = F::closed_form(scene, *q).filter(|v| v.len() == F::channels(scene, *q))
+        else {
+            return Err(SpecError::at(
+                "reference",
+                format!(
+                    "quantity {} has no closed form for this scene ({}): use {{\"type\": \"converged\"}}",
+                    q.name(),
+                    F::closed_forms_available()
+                ),
+            ));
+        };
+        if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+            return Err(SpecError::at(
+                "reference",
+                format!(
+                    "the closed form of {} is {x} for this scene (it overflows): no error \
+                     can be measured against it",
+                    q.name()
+                ),
+            ));
+        }
+        values.insert(*q, v);
+    }
+    Ok(Known {
+        values,
+        uncertainty: 0.0,
+        note: format!("closed forms of the {} family.", F::NAME),
+    })
 }
 
 /// Reads a Mitsuba values file for an experiment whose file hashes to `hash`:
