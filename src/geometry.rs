@@ -100,7 +100,9 @@ impl Sphere {
     /// which cancels catastrophically for grazing rays and far origins
     /// (Haines et al., "Precision improvements for ray/sphere intersection",
     /// Ray Tracing Gems, 2019). The smaller-magnitude root comes from
-    /// `t_0 t_1 = |f|^2 - R^2 = (|f| - R)(|f| + R)`, not from a difference.
+    /// `t_0 t_1 = |f|^2 - R^2`, not from a difference, with the product formed
+    /// as `(|b| - root)(|b| + root)` where `|b| < R` and as `(|f| - R)(|f| + R)`
+    /// beyond: each is accurate where the other loses digits.
     ///
     /// Lengths are scaled by the power of two nearest below `max(R, |f|)`
     /// first (exactly), so radii up to 1e308 neither overflow in the products
@@ -123,7 +125,17 @@ impl Sphere {
         let root = ((r - h) * (r + h)).sqrt();
         // q has the sign of -b, so no cancellation in -b -+ root.
         let q = if b > 0.0 { -b - root } else { -b + root };
-        let c = (f.norm() - r) * (f.norm() + r);
+        // The product of the roots, |f|^2 - r^2 = b^2 - root^2, two ways: as
+        // (|b| - root)(|b| + root) its error is ~eps max(|b|, root)^2, as
+        // (|f| - r)(|f| + r) ~eps r^2. The first wins where |b| < r (a line
+        // that grazes the sphere, an origin near its surface: the shadow rays
+        // of a grazing eye ray), the second for far origins.
+        let c = if b.abs() < r {
+            (b.abs() - root) * (b.abs() + root)
+        } else {
+            let norm = f.norm();
+            (norm - r) * (norm + r)
+        };
         let (a, other) = if q != 0.0 { (q, c / q) } else { (root, -root) };
         Some((a.min(other) * scale, a.max(other) * scale))
     }
