@@ -44,6 +44,7 @@ fn lightquad_value(file: &Path, q: Quantity) -> (f64, f64) {
     .unwrap_or_else(|e| panic!("{e}"));
     match q {
         Quantity::Tau => (res.transmittance, res.log_transmittance),
+        Quantity::LnTau => (res.log_transmittance, res.log_transmittance),
         Quantity::Light => (res.light.map_or(0.0, |t| t.value), f64::NAN),
         Quantity::Emission => (res.emission.map_or(0.0, |t| t.value), f64::NAN),
         Quantity::Background => (res.background.map_or(0.0, |t| t.value), f64::NAN),
@@ -63,6 +64,7 @@ fn volume_scene(file: &Path) -> Built {
 fn quantity(name: &str) -> Quantity {
     match name {
         "tau" => Quantity::Tau,
+        "ln_tau" => Quantity::LnTau,
         "I_E" => Quantity::Emission,
         "I_B" => Quantity::Background,
         "I_L" => Quantity::Light,

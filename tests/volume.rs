@@ -634,3 +634,38 @@ fn grazing_shadow_rays_are_accurate_to_the_rounding_of_the_points() {
         }
     }
 }
+
+/// Regression (issue 9, item 3): ln tau is a quantity of its own, exact in
+/// log space where tau underflows. One Gaussian blob of width w and peak A
+/// on the ray's line: `int A e^{-t^2/(2 w^2)} dt = A w sqrt(2 pi)` over the
+/// line, here set to an optical depth of 1e5.
+#[test]
+fn ln_tau_is_reported_where_tau_underflows() {
+    use lightquad::family::{Family, Flag, Method};
+    use lightquad::volume::experiment::{Volume, VolumeQuantity};
+    use rand::SeedableRng;
+    let (w, depth) = (0.5f64, 1e5f64);
+    let amplitude = depth / (w * (2.0 * std::f64::consts::PI).sqrt());
+    let spec = serde_json::from_value(serde_json::json!({
+        "ray": { "origin": [-10.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0] },
+        "medium": { "type": "gaussian-blobs", "blobs": [{ "centre": [0.0, 0.0, 0.0], "amplitude": amplitude, "width": w }] }
+    }))
+    .expect("a volume scene");
+    let scene = Volume::build(&spec).expect("valid");
+    let method = Method::Rule(AnyRule::by_name("gauss-legendre").expect("known"));
+    let quantities = [VolumeQuantity::Tau, VolumeQuantity::LnTau];
+    let out = Volume::evaluate(
+        &scene,
+        &method,
+        64,
+        &mut rand_pcg::Pcg64::seed_from_u64(0),
+        &quantities,
+    )
+    .expect("finite");
+    let ln_tau = &out[&VolumeQuantity::LnTau];
+    assert!(rel(ln_tau.value[0], -depth) < 1e-12, "{ln_tau:?}");
+    assert!(ln_tau.error[0] < 1e-9 * depth, "{ln_tau:?}");
+    let tau = &out[&VolumeQuantity::Tau];
+    assert_eq!(tau.value[0], 0.0);
+    assert_eq!(tau.flags, [Flag::Underflow]);
+}

@@ -183,6 +183,10 @@ pub enum VolumeQuantity {
     /// V-tau over the looked-at part of the ray.
     #[serde(rename = "tau")]
     Tau,
+    /// `ln tau = -optical depth`: exact where `tau` underflows (optical
+    /// depths past ~745), with the optical depth's error estimate.
+    #[serde(rename = "ln_tau")]
+    LnTau,
     /// V-E.
     #[serde(rename = "I_E")]
     Emission,
@@ -201,6 +205,7 @@ impl family::Quantity for VolumeQuantity {
     fn name(&self) -> &'static str {
         match self {
             VolumeQuantity::Tau => "tau",
+            VolumeQuantity::LnTau => "ln_tau",
             VolumeQuantity::Emission => "I_E",
             VolumeQuantity::Background => "I_B",
             VolumeQuantity::Light => "I_L",
@@ -210,7 +215,7 @@ impl family::Quantity for VolumeQuantity {
 
     fn all() -> &'static [Self] {
         use VolumeQuantity::*;
-        &[Tau, Emission, Background, Light, Total]
+        &[Tau, LnTau, Emission, Background, Light, Total]
     }
 }
 
@@ -398,6 +403,11 @@ fn collect(res: &VolumeResult, quantities: &[VolumeQuantity]) -> Outcome<VolumeQ
                         tau
                     }
                 }
+                VolumeQuantity::LnTau => Measured::scalar(
+                    res.log_transmittance,
+                    res.optical_depth.error,
+                    res.optical_depth.evaluations,
+                ),
                 VolumeQuantity::Emission => term(res.emission),
                 VolumeQuantity::Background => term(res.background),
                 VolumeQuantity::Light => term(res.light),
@@ -428,10 +438,12 @@ fn total(res: &VolumeResult) -> Measured {
 fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
     let scene = &built.scene;
     let ray = scene.ray;
-    let tau = match &scene.medium {
-        None => 1.0,
-        Some(m) => (-scene.lambda * m.density_integral(&ray, scene.t_min, scene.t_max)?).exp(),
+    // `ln tau = -lambda int v_r dt` (V-tau), kept in log space.
+    let ln_tau = match &scene.medium {
+        None => 0.0,
+        Some(m) => -scene.lambda * m.density_integral(&ray, scene.t_min, scene.t_max)?,
     };
+    let tau = ln_tau.exp();
     // The constant sphere's chord inside the looked-at part, and whether that
     // part holds the whole chord (the light closed forms need it).
     let sphere = match built.sphere_kappa {
@@ -504,6 +516,7 @@ fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
     let background = scene.background.unwrap_or(0.0) * tau;
     match q {
         VolumeQuantity::Tau => Some(tau),
+        VolumeQuantity::LnTau => Some(ln_tau),
         VolumeQuantity::Background => Some(background),
         VolumeQuantity::Emission => emission(),
         VolumeQuantity::Light => light(),

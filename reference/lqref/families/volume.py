@@ -37,7 +37,7 @@ import numpy as np
 from ..mitsuba3 import point, require_mitsuba, vector
 from ..spec import SpecError, unit, vec3
 
-QUANTITIES = ("tau", "I_E", "I_B", "I_L", "I")
+QUANTITIES = ("tau", "ln_tau", "I_E", "I_B", "I_L", "I")
 MEDIUM_TYPES = ("constant-sphere", "gaussian-blobs", "linear-gradient", "voxel-grid")
 EXPRESSIBLE_MEDIA = ("constant-sphere", "voxel-grid")
 
@@ -142,6 +142,9 @@ def unsupported_reason(exp, quantity):
     """Why ``quantity`` is not computed for ``exp``, or None if it is."""
     if quantity == "I_E":
         return NO_EMISSION
+    if quantity == "ln_tau":
+        return ("not computed separately: the tau entry carries log_value, Mitsuba's ln tau "
+                "(float32 underflows where lightquad's ln tau stays exact)")
     if quantity == "I_B":
         return ("not computed by this harness: I_B = I_b * tau, use the tau value "
                 "(or add a function for it)")
