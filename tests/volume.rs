@@ -669,3 +669,32 @@ fn ln_tau_is_reported_where_tau_underflows() {
     assert_eq!(tau.value[0], 0.0);
     assert_eq!(tau.flags, [Flag::Underflow]);
 }
+
+/// Regression (issue 9, item 1): V-L with single scattering by the trapezoid
+/// rule converges at order 2 in n. The bundled v-l-single-scattering scene
+/// (height 0.2, kappa 1.5, light behind the eye) showed a slope of -1.04
+/// while a chord end read as outside the sphere. Against the closed form.
+#[test]
+fn trapezoid_single_scattering_converges_at_order_two() {
+    let sigma = 1.5f64;
+    let mut scene = sphere_scene(1.0, sigma, 1.0, 0.2);
+    scene.light = Some(DirectionalLight::new(-Vec3::x(), 2.0, Some(0.8)).expect("valid"));
+    let chord = 2.0 * (1.0f64 - 0.04).sqrt();
+    let want = exact::light_behind(sigma, chord, 2.0, Some(0.8));
+    let mut pts = Vec::new();
+    for n in [33usize, 65, 129, 257, 513, 1025] {
+        let res = evaluate(
+            &scene,
+            &lightquad::quadrature::Trapezoid,
+            n,
+            DepthScheme::Cumulative,
+            ShadowMethod::ClosedFormWhereAvailable,
+            &mut rng(0),
+        )
+        .expect("finite");
+        pts.push((n as f64, rel(res.light.expect("light").value, want)));
+    }
+    let order = lightquad::experiment::fit::fitted_order(&pts).expect("a slope");
+    eprintln!("trapezoid V-L slope against n: {order:.3} ({pts:?})");
+    assert!((order + 2.0).abs() < 0.1, "slope {order}");
+}

@@ -108,6 +108,24 @@ impl Segment {
         rng: &mut Rg,
         mut g: G,
     ) -> Result<Estimate<V>, QuadError> {
+        self.try_integrate_pieces(rule, n, rng, |t, _| g(t))
+    }
+
+    /// [`Segment::try_integrate`] with the integrand told which smooth piece
+    /// `t` belongs to (by the piece's midpoint), so it can evaluate that
+    /// piece's own smooth formula at the piece's ends.
+    pub fn try_integrate_pieces<
+        R: Rule,
+        Rg: rand::Rng + ?Sized,
+        V: Value,
+        G: FnMut(f64, f64) -> Result<V, QuadError>,
+    >(
+        &self,
+        rule: &R,
+        n: usize,
+        rng: &mut Rg,
+        mut g: G,
+    ) -> Result<Estimate<V>, QuadError> {
         let mut total: Option<Estimate<V>> = None;
         for (lo, hi) in self.pieces() {
             let piece = Segment {
@@ -115,7 +133,8 @@ impl Segment {
                 b: hi,
                 breaks: Vec::new(),
             };
-            let est = super::try_integrate_over(rule, &piece, n, rng, &mut g)?;
+            let mid = 0.5 * (lo + hi);
+            let est = super::try_integrate_over(rule, &piece, n, rng, |t| g(t, mid))?;
             total = Some(match total {
                 None => est,
                 Some(t) => t.combine(est),

@@ -41,6 +41,12 @@ impl Medium for ConstantSphere {
         }
     }
 
+    /// `kappa` on a piece inside the sphere, whatever side of the surface
+    /// rounding puts `p` on.
+    fn density_on(&self, _p: Vec3, inside: Vec3) -> f64 {
+        self.density(inside)
+    }
+
     fn support(&self, ray: &Ray, t_min: f64, t_max: f64) -> Vec<Segment> {
         self.sphere
             .clip(ray, t_min, t_max)

@@ -122,6 +122,17 @@ impl Medium for LinearGradient {
         }
     }
 
+    /// On the piece inside the sphere where the linear function is positive,
+    /// that function (clamped at 0 only against rounding at the zero
+    /// crossing); 0 on any other piece.
+    fn density_on(&self, p: Vec3, inside: Vec3) -> f64 {
+        if self.density(inside) > 0.0 {
+            self.linear(p).max(0.0)
+        } else {
+            0.0
+        }
+    }
+
     /// The sphere chord cut at the zero crossing of the linear function, on
     /// the side where it is positive: one linear piece, or none. The kink is an
     /// end of the support, so no piece contains it.

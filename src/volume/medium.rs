@@ -17,6 +17,16 @@ pub trait Medium: std::fmt::Debug + Send + Sync {
     /// The density `v_r(p) >= 0`.
     fn density(&self, p: Vec3) -> f64;
 
+    /// The density at `p` as the smooth field of the support piece that holds
+    /// `inside` (a point strictly inside the piece): the piece's own formula,
+    /// extended to and past its ends, so that a node at an end of the piece
+    /// (which rounding may put a hair outside a sphere or a box) reads the
+    /// one-sided limit, not the other side of a jump. Fields smooth
+    /// everywhere keep the default, `density(p)`.
+    fn density_on(&self, p: Vec3, _inside: Vec3) -> f64 {
+        self.density(p)
+    }
+
     /// The pieces of `[t_min, t_max]` along `ray` where the density can be
     /// non-zero, each cut at the points where the density is not smooth.
     /// Outside them the density is zero (or below 1e-30 of its peak, for

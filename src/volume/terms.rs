@@ -109,9 +109,11 @@ struct Counted<'a> {
 }
 
 impl Counted<'_> {
-    fn density(&self, ray: &Ray, t: f64) -> f64 {
+    /// The density at `t` on the smooth piece whose midpoint is `mid`: that
+    /// piece's own field up to and including its ends ([`Medium::density_on`]).
+    fn density(&self, ray: &Ray, t: f64, mid: f64) -> f64 {
         self.count.set(self.count.get() + 1);
-        self.medium.density(ray.at(t))
+        self.medium.density_on(ray.at(t), ray.at(mid))
     }
     fn take(&self) -> u64 {
         self.count.replace(0)
@@ -133,7 +135,9 @@ fn depth_by_quadrature<R: Rule, Rg: rand::Rng + ?Sized>(
         evaluations: 0,
     };
     for piece in medium.medium.support(ray, 0.0, f64::INFINITY) {
-        let est = piece.integrate(rule, n, rng, |t| lambda * medium.density(ray, t))?;
+        let est = piece.try_integrate_pieces(rule, n, rng, |t, mid| {
+            Ok(lambda * medium.density(ray, t, mid))
+        })?;
         total = total.combine(est);
     }
     Ok(total)
@@ -184,12 +188,13 @@ impl<R: Rule> DepthAlong<'_, R> {
         for b in inner.chain(std::iter::once(hi)) {
             let panels = ((b - a) / longest).ceil().max(1.0) as usize;
             let width = (b - a) / panels as f64;
+            let mid = 0.5 * (a + b);
             for j in 0..panels {
                 let p0 = a + width * j as f64;
                 let len = if j + 1 == panels { b - p0 } else { width };
                 let mut sum = 0.0;
                 for (u, w) in self.gap.u.iter().zip(&self.gap.w) {
-                    sum += w * self.medium.density(&self.ray, p0 + len * u);
+                    sum += w * self.medium.density(&self.ray, p0 + len * u, mid);
                 }
                 total += self.lambda * len * sum;
             }
@@ -211,7 +216,9 @@ impl<R: Rule> DepthAlong<'_, R> {
             DepthScheme::Nested => {
                 let part = piece.restrict(piece.start(), t)?;
                 Ok(part
-                    .integrate(self.rule, self.n, rng, |s| lambda * medium.density(&ray, s))?
+                    .try_integrate_pieces(self.rule, self.n, rng, |s, mid| {
+                        Ok(lambda * medium.density(&ray, s, mid))
+                    })?
                     .value)
             }
             DepthScheme::Cumulative => {
@@ -322,7 +329,9 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         evaluations: 0,
     };
     for piece in &pieces {
-        let est = piece.integrate(rule, n, rng, |t| scene.lambda * counted.density(&ray, t))?;
+        let est = piece.try_integrate_pieces(rule, n, rng, |t, mid| {
+            Ok(scene.lambda * counted.density(&ray, t, mid))
+        })?;
         piece_depths.push(est.value);
         depth = depth.combine(est);
     }
@@ -345,7 +354,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     });
 
     // V-E and V-L share the outer integral over the chord.
-    let outer = |h: &mut dyn FnMut(f64, &mut Rg) -> Result<f64, QuadError>,
+    let outer = |h: &mut dyn FnMut(f64, f64, &mut Rg) -> Result<f64, QuadError>,
                  rng: &mut Rg|
      -> Result<Estimate<f64>, QuadError> {
         let mut along = DepthAlong {
@@ -372,9 +381,9 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
                 // can use the caller's.
                 let mut outer_rng =
                     <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(rng.next_u64());
-                let est = sub.try_integrate(rule, n, &mut outer_rng, |t| {
+                let est = sub.try_integrate_pieces(rule, n, &mut outer_rng, |t, mid| {
                     let d = along.depth_to(&sub, t, rng)?;
-                    Ok((-(before + d)).exp() * h(t, rng)?)
+                    Ok((-(before + d)).exp() * h(t, mid, rng)?)
                 })?;
                 total = total.combine(est);
                 before += along.depth_to(&sub, sub.end(), rng)?;
@@ -386,7 +395,10 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     let emission = match scene.emission {
         None => None,
         Some(map) => {
-            let est = outer(&mut |t, _| Ok(map.at(counted.density(&ray, t))), rng)?;
+            let est = outer(
+                &mut |t, mid, _| Ok(map.at(counted.density(&ray, t, mid))),
+                rng,
+            )?;
             Some(Term {
                 id: "V-E",
                 value: est.value,
@@ -401,7 +413,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         Some(light) => {
             let lambda = scene.lambda;
             let est = outer(
-                &mut |t, rng| {
+                &mut |t, mid, rng| {
                     let p = ray.at(t);
                     let shadow_ray = Ray {
                         origin: p,
@@ -422,7 +434,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
                     let scattering = match light.albedo {
                         None => 1.0,
                         Some(albedo) => {
-                            albedo * lambda * counted.density(&ray, t)
+                            albedo * lambda * counted.density(&ray, t, mid)
                                 / (4.0 * std::f64::consts::PI)
                         }
                     };

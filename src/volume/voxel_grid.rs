@@ -46,6 +46,11 @@ pub struct VoxelGrid {
 }
 
 impl VoxelGrid {
+    /// True when `p` is in the closed box.
+    fn contains(&self, p: Vec3) -> bool {
+        (0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k])
+    }
+
     /// A grid over the box `[min, max]` with `resolution = [n_x, n_y, n_z]`
     /// voxels and `data[(z n_y + y) n_x + x]` the value at the centre of voxel
     /// `(x, y, z)`.
@@ -202,8 +207,19 @@ impl Medium for VoxelGrid {
 
     /// The trilinear reconstruction with edge clamping inside the box (faces
     /// included), 0 outside.
+    /// Inside the box, the interpolation at `p` moved onto the box: beyond a
+    /// face the clamped stencil is constant along its normal, so this is the
+    /// field's own extension there.
+    fn density_on(&self, p: Vec3, inside: Vec3) -> f64 {
+        if !self.contains(inside) {
+            return 0.0;
+        }
+        let clamped = Vec3::from_fn(|k, _| p[k].clamp(self.min[k], self.max[k]));
+        self.density(clamped)
+    }
+
     fn density(&self, p: Vec3) -> f64 {
-        if !(0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k]) {
+        if !self.contains(p) {
             return 0.0;
         }
         // Per axis: the two clamped indices and the weight of the upper one.
