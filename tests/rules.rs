@@ -474,3 +474,23 @@ fn an_integrand_error_propagates_through_every_rule() {
         }
     }
 }
+
+/// Adaptive Gauss–Kronrod spends at most its budget: a bisection costs two
+/// new G7-K15 panels (30 evaluations), and it stops before exceeding `n`
+/// (it spent about 2n when it counted pieces instead).
+#[test]
+fn gauss_kronrod_stays_within_its_budget() {
+    let rule = lightquad::quadrature::GaussKronrod::default();
+    for n in [15usize, 44, 45, 64, 1000, 65536] {
+        let est = rule
+            .integrate(n, &mut rng(0), |u: [f64; 1]| {
+                1.0 / (1e-4 + (u[0] - 0.3).powi(2))
+            })
+            .expect("finite");
+        assert!(
+            est.evaluations as usize <= n && est.evaluations as usize + 30 > n,
+            "n = {n}: {} evaluations",
+            est.evaluations
+        );
+    }
+}

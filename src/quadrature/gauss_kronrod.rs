@@ -5,7 +5,8 @@
 //! is QUADPACK's `r min(1, (200 |K - G| / r)^(3/2))`, `r` the Kronrod estimate
 //! of `int |f - K/h|`, never below `50 eps` times `int |f|`. The interval with
 //! the largest error is bisected until the total error meets the tolerance or
-//! the budget of `n` evaluations (15 per interval) is spent. With both
+//! the next bisection (two new panels, 30 evaluations) would pass the budget
+//! of `n` evaluations: `15 + 30 k <= n`. With both
 //! tolerances 0 (the default) the whole budget is used, which is what an
 //! error-against-cost sweep wants.
 
@@ -219,7 +220,6 @@ impl Rule for GaussKronrod {
             p[0] = u[0];
             f(p)
         };
-        let max_pieces = n / 15;
         let mut heap = BinaryHeap::new();
         heap.push(kronrod_piece(0.0, 1.0, &mut g)?);
         let mut evaluations = 15u64;
@@ -237,7 +237,8 @@ impl Rule for GaussKronrod {
         // re-summed (compensated) at the end, free of the running drift.
         let mut value = heap.peek().map_or(V::zero(), |p| p.value);
         let mut error = heap.peek().map_or(V::zero(), |p| p.error);
-        while heap.len() < max_pieces {
+        // A bisection costs two new panels, 30 evaluations: never past `n`.
+        while evaluations + 30 <= n as u64 {
             let target = self.abs_tol.max(self.rel_tol * value.max_abs());
             if error.max_abs() <= target {
                 break;
