@@ -1,6 +1,9 @@
 //! Weighted node sets on the unit interval and the one shared summation that
 //! turns (tensor products of) them into an integral.
 
+use std::cell::RefCell;
+use std::sync::Arc;
+
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::sum::Compensated;
@@ -139,6 +142,79 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
         companion: with_companion.then(|| acc_c.total()),
         evaluations,
     })
+}
+
+/// Largest number of points per axis of a composite rule (the node table
+/// takes 24 bytes a point).
+pub const MAX_POINTS: usize = 100_000_000;
+
+/// A composite Newton–Cotes rule (trapezoid, Simpson) as data: how many
+/// points per axis a budget gives, its node table, and its order.
+pub struct Composite {
+    /// Rule name, for errors and the node cache.
+    pub name: &'static str,
+    /// Fewest points per axis (the half-step companion needs them).
+    pub min_points: usize,
+    /// The largest usable point count `<= m` (odd, `4k + 1`, ...).
+    pub usable: fn(usize) -> usize,
+    /// The m-point rule on `[0, 1]` with its `2h` companion.
+    pub nodes: fn(usize) -> UnitNodes,
+    /// Order `p` of the error, `O(h^p)`, for Richardson's estimate.
+    pub order: i32,
+}
+
+impl Composite {
+    /// The rule's tensor product on `[0, 1]^D` with a budget of `n`
+    /// evaluations, and Richardson's error estimate.
+    pub fn integrate<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
+        &self,
+        n: usize,
+        f: F,
+    ) -> Result<Estimate<V>, QuadError> {
+        let m = super::per_axis::<D>(n, self.min_points, "n")?;
+        if m > MAX_POINTS {
+            return Err(QuadError::invalid(
+                "n",
+                n,
+                format!("at most {MAX_POINTS} {} points per axis", self.name),
+            ));
+        }
+        let nodes = self.cached((self.usable)(m));
+        Ok(richardson(product_sum([nodes.as_ref(); D], f)?, self.order))
+    }
+
+    /// The m-point node table, kept per thread for the last few `m`: inner
+    /// loops (nested optical depths, every graded piece) ask for the same
+    /// table again and again.
+    fn cached(&self, m: usize) -> Arc<UnitNodes> {
+        type Recent = Vec<(&'static str, usize, Arc<UnitNodes>)>;
+        thread_local! {
+            static RECENT: RefCell<Recent> = const { RefCell::new(Vec::new()) };
+        }
+        /// Rules kept per thread, and the largest kept (big tables are rare).
+        const KEPT: usize = 8;
+        const KEPT_MAX_POINTS: usize = 1 << 16;
+        let hit = RECENT.with(|r| {
+            r.borrow()
+                .iter()
+                .find(|(name, k, _)| *name == self.name && *k == m)
+                .map(|(_, _, nodes)| nodes.clone())
+        });
+        if let Some(nodes) = hit {
+            return nodes;
+        }
+        let nodes = Arc::new((self.nodes)(m));
+        if m <= KEPT_MAX_POINTS {
+            RECENT.with(|r| {
+                let mut r = r.borrow_mut();
+                if r.len() == KEPT {
+                    r.remove(0);
+                }
+                r.push((self.name, m, nodes.clone()));
+            });
+        }
+        nodes
+    }
 }
 
 /// A composite rule's sum as an estimate with Richardson's error estimate

@@ -105,19 +105,30 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
     }
 
     fn check(&self) -> Result<(), QuadError> {
-        for (field, rule) in [
-            ("outer", &self.outer as &dyn Facts),
-            ("inner", &self.inner as &dyn Facts),
-        ] {
-            if !rule.dims().contains(1) {
+        let factors = [
+            (
+                "outer",
+                self.outer.name(),
+                self.outer.dimensions(),
+                self.outer.check(),
+            ),
+            (
+                "inner",
+                self.inner.name(),
+                self.inner.dimensions(),
+                self.inner.check(),
+            ),
+        ];
+        for (field, name, dimensions, checked) in factors {
+            if !dimensions.contains(1) {
                 return Err(QuadError::invalid(
                     field,
-                    rule.rule_name(),
+                    name,
                     "a rule that integrates in one dimension",
                 ));
             }
             // A factor's parameter is named below the factor (`inner.replicates`).
-            rule.check_params().map_err(|e| match e {
+            checked.map_err(|e| match e {
                 QuadError::InvalidParameter {
                     name,
                     value,
@@ -178,25 +189,5 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
             error,
             evaluations: inner_evaluations,
         })
-    }
-}
-
-/// The facts of a factor that [`Product::check`] needs, object-safe (a
-/// [`Rule`] itself is not: its integration is generic).
-trait Facts {
-    fn dims(&self) -> Dimensions;
-    fn rule_name(&self) -> &'static str;
-    fn check_params(&self) -> Result<(), QuadError>;
-}
-
-impl<T: Rule> Facts for T {
-    fn dims(&self) -> Dimensions {
-        self.dimensions()
-    }
-    fn rule_name(&self) -> &'static str {
-        self.name()
-    }
-    fn check_params(&self) -> Result<(), QuadError> {
-        self.check()
     }
 }

@@ -11,12 +11,21 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::nodes::{UnitNodes, product_sum, richardson};
-use super::trapezoid::MAX_POINTS;
-use super::{Rule, per_axis};
+use super::Rule;
+use super::nodes::{Composite, UnitNodes};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
+
+/// Simpson's rule as a composite rule: `4k + 1` points (so the even points
+/// form the `2h` rule), order 4.
+const COMPOSITE: Composite = Composite {
+    name: "simpson",
+    min_points: 5,
+    usable: |m| m - (m - 1) % 4,
+    nodes: unit_nodes,
+    order: 4,
+};
 
 /// Composite Simpson rule (tensor product in D > 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
@@ -82,15 +91,6 @@ impl Rule for Simpson {
         _rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
-        let m = per_axis::<D>(n, 5, "n")?;
-        if m > MAX_POINTS {
-            return Err(QuadError::invalid(
-                "n",
-                n,
-                format!("at most {MAX_POINTS} Simpson points per axis"),
-            ));
-        }
-        let nodes = unit_nodes(m - (m - 1) % 4);
-        Ok(richardson(product_sum([&nodes; D], f)?, 4))
+        COMPOSITE.integrate(n, f)
     }
 }

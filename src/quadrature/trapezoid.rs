@@ -10,14 +10,22 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::nodes::{UnitNodes, product_sum, richardson};
-use super::{Rule, per_axis};
+use super::Rule;
+use super::nodes::{Composite, UnitNodes};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
 
-/// Largest number of points per axis (the node table takes 24 bytes a point).
-pub const MAX_POINTS: usize = 100_000_000;
+pub use super::nodes::MAX_POINTS;
+
+/// The trapezoid rule as a composite rule: odd point counts, order 2.
+const COMPOSITE: Composite = Composite {
+    name: "trapezoid",
+    min_points: 3,
+    usable: |m| if m % 2 == 0 { m - 1 } else { m },
+    nodes: unit_nodes,
+    order: 2,
+};
 
 /// Composite trapezoid rule (tensor product in D > 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
@@ -71,18 +79,6 @@ impl Rule for Trapezoid {
         _rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
-        let mut m = per_axis::<D>(n, 3, "n")?;
-        if m > MAX_POINTS {
-            return Err(QuadError::invalid(
-                "n",
-                n,
-                format!("at most {MAX_POINTS} trapezoid points per axis"),
-            ));
-        }
-        if m % 2 == 0 {
-            m -= 1;
-        }
-        let nodes = unit_nodes(m);
-        Ok(richardson(product_sum([&nodes; D], f)?, 2))
+        COMPOSITE.integrate(n, f)
     }
 }

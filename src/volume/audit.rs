@@ -60,8 +60,8 @@ pub fn markdown() -> String {
          Sphere of radius 1.5 at the origin, lambda kappa = 0.8, I_p = 1, light direction \
          d = (0.3, 0.8, -0.2)/|.|. `s` by quadrature is the shadow ray's optical depth \
          (64-node Gauss–Legendre) divided by lambda kappa. The printed radicand \
-         <p,d>^2 - <p,p><d,d> is never positive (Cauchy–Schwarz): NaN off the line through \
-         the centre (docs/EQUATIONS.md audit points 1 and 2).\n\n\
+         <p,d>^2 - <p,p><d,d> is never positive (Cauchy–Schwarz): the printed forms are undefined in \
+         real arithmetic off the line through the centre (docs/EQUATIONS.md audit points 1 and 2).\n\n\
          | point p | s printed | s corrected | s by quadrature | I_p printed | I_p corrected |\n\
          |---|---:|---:|---:|---:|---:|\n",
     );
@@ -88,15 +88,25 @@ pub fn markdown() -> String {
             }
             Some(total)
         });
+        // The printed forms are undefined in real arithmetic where their
+        // radicand is negative: say so, with the radicand, instead of NaN.
+        let radicand = p.dot(&d).powi(2) - p.dot(&p) * d.dot(&d);
+        let printed = |x: f64| {
+            if x.is_nan() {
+                format!("undefined: radicand {radicand:.3e} < 0")
+            } else {
+                format!("{x:.15}")
+            }
+        };
         out.push_str(&format!(
             "| ({:.2}, {:.2}, {:.2}) | {} | {:.15} | {} | {} | {:.15} |\n",
             p.x,
             p.y,
             p.z,
-            s_printed(p, d),
+            printed(s_printed(p, d)),
             s_corrected(p, d, r),
             s_quad.map_or("failed".into(), |s| format!("{s:.15}")),
-            light_printed(p, d, lk, 1.0),
+            printed(light_printed(p, d, lk, 1.0)),
             light_corrected(p, d, r, lk, 1.0),
         ));
     }
