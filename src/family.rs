@@ -253,6 +253,10 @@ pub enum Flag {
         #[serde(with = "json_f64::one")]
         parts: f64,
     },
+    /// The rule doubted its own error estimate: the differences it is built
+    /// from did not behave as the estimate assumes (algebraic instead of
+    /// geometric convergence, a jump or a kink in the integrand).
+    UnreliableEstimate,
 }
 
 impl std::fmt::Display for Flag {
@@ -262,6 +266,7 @@ impl std::fmt::Display for Flag {
             Flag::Cancellation { parts } => {
                 write!(f, "cancellation: |sum| < 1e-6 of its parts ({parts:.1e})")
             }
+            Flag::UnreliableEstimate => write!(f, "error estimate unreliable (rule's own check)"),
         }
     }
 }
@@ -309,7 +314,11 @@ impl<V: crate::value::Value> From<crate::estimate::Estimate<V>> for Measured {
             value: (0..V::CHANNELS).map(|c| e.value.channel(c)).collect(),
             error: (0..V::CHANNELS).map(|c| e.error.channel(c)).collect(),
             evaluations: e.evaluations,
-            flags: Vec::new(),
+            flags: if e.reliable {
+                Vec::new()
+            } else {
+                vec![Flag::UnreliableEstimate]
+            },
         }
     }
 }

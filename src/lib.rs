@@ -56,5 +56,5 @@ pub mod value;
 pub mod volume;
 
 pub use error::QuadError;
-pub use estimate::Estimate;
+pub use estimate::{ErrorKind, Estimate};
 pub use value::{Rgb, Value};

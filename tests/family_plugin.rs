@@ -132,11 +132,11 @@ impl Family for Poly {
                     let sum = (0..n).fold(lightquad::Rgb::zeros(), |s, i| {
                         s + moments(k, i as f64 / n as f64)
                     }) / n as f64;
-                    let e = lightquad::Estimate {
-                        value: sum,
-                        error: lightquad::Rgb::repeat(1.0 / n as f64),
-                        evaluations: n as u64,
-                    };
+                    let e = lightquad::Estimate::deterministic(
+                        sum,
+                        lightquad::Rgb::repeat(1.0 / n as f64),
+                        n as u64,
+                    );
                     let mut m = Measured::from(e);
                     if q == PolyQuantity::Moment {
                         m.value.truncate(1);

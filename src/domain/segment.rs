@@ -140,11 +140,7 @@ impl Segment {
                 Some(t) => t.combine(est),
             });
         }
-        Ok(total.unwrap_or(Estimate {
-            value: V::zero(),
-            error: V::zero(),
-            evaluations: 0,
-        }))
+        Ok(total.unwrap_or(Estimate::zero()))
     }
 }
 

@@ -268,10 +268,6 @@ impl Rule for GaussKronrod {
             evaluations += 30;
         }
         let (value, error) = totals(&heap);
-        Ok(Estimate {
-            value,
-            error,
-            evaluations,
-        })
+        Ok(Estimate::deterministic(value, error, evaluations))
     }
 }

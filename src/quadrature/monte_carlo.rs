@@ -117,10 +117,10 @@ impl Rule for MonteCarlo {
             }
             acc.add(y);
         }
-        Ok(Estimate {
-            value: acc.mean(),
-            error: acc.standard_error(),
-            evaluations: n as u64,
-        })
+        Ok(Estimate::random(
+            acc.mean(),
+            acc.standard_error(),
+            n as u64,
+        ))
     }
 }

@@ -223,13 +223,12 @@ impl Composite {
 pub fn richardson<V: Value>(sum: ProductSum<V>, order: i32) -> Estimate<V> {
     let coarse = sum.companion.unwrap_or(sum.value);
     let divisor = 2f64.powi(order) - 1.0;
-    Estimate {
-        value: sum.value,
-        error: sum
-            .value
+    Estimate::deterministic(
+        sum.value,
+        sum.value
             .zip(coarse, |fine, coarse| (fine - coarse).abs() / divisor),
-        evaluations: sum.evaluations,
-    }
+        sum.evaluations,
+    )
 }
 
 /// The error for a non-finite integrand value at unit-cube point `p`.

@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{Dimensions, Rule, per_axis};
 use crate::error::QuadError;
-use crate::estimate::Estimate;
+use crate::estimate::{ErrorKind, Estimate};
 use crate::value::Value;
 
 /// The iterated product of an `outer` rule (first coordinate) and an `inner`
@@ -167,6 +167,8 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
         // result is reproducible from the caller's rng state.
         let mut inner_rng = rand_pcg::Pcg64::seed_from_u64(rng.next_u64());
         let mut inner_evaluations = 0u64;
+        let mut inner_random = false;
+        let mut inner_reliable = true;
         let outer = self.outer.try_integrate(m, rng, |u: [f64; 1]| {
             let inner = self.inner.try_integrate(m, &mut inner_rng, |v: [f64; 1]| {
                 let mut p = [0.0; D];
@@ -175,19 +177,39 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
                 f(p)
             })?;
             inner_evaluations += inner.evaluations;
+            inner_random |= inner.kind == ErrorKind::StandardError;
+            inner_reliable &= inner.reliable;
             Ok(WithError {
                 value: inner.value,
                 error: inner.error,
             })
         })?;
-        // Total error: the outer rule's estimate for g plus the integrated
-        // inner estimates.
-        let error =
-            V::from_fn(|c| outer.error.value.channel(c) + outer.value.error.channel(c).abs());
+        // Total error. A random outer rule over random inner estimates: the
+        // spread of the inner values about their mean is part of the outer
+        // sample variance, so the outer standard error is the whole standard
+        // error. Otherwise the outer rule's estimate for g plus the integrated
+        // inner estimates (for a deterministic outer rule over random inner
+        // ones this adds standard errors linearly: conservative).
+        let random_outer = outer.kind == ErrorKind::StandardError;
+        let error = V::from_fn(|c| {
+            let inner = outer.value.error.channel(c).abs();
+            if random_outer && inner_random {
+                outer.error.value.channel(c)
+            } else {
+                outer.error.value.channel(c) + inner
+            }
+        });
+        let kind = if random_outer || inner_random {
+            ErrorKind::StandardError
+        } else {
+            ErrorKind::Deterministic
+        };
         Ok(Estimate {
             value: outer.value.value,
             error,
             evaluations: inner_evaluations,
+            kind,
+            reliable: outer.reliable && inner_reliable,
         })
     }
 }

@@ -191,10 +191,10 @@ impl Rule for Sobol {
             }
             means.add(sum.total().map(|s| s / per as f64));
         }
-        Ok(Estimate {
-            value: means.mean(),
-            error: means.standard_error(),
-            evaluations: (reps * per) as u64,
-        })
+        Ok(Estimate::random(
+            means.mean(),
+            means.standard_error(),
+            (reps * per) as u64,
+        ))
     }
 }

@@ -124,10 +124,10 @@ impl Rule for Stratified {
         } else {
             V::zero().map(|_| f64::INFINITY)
         };
-        Ok(Estimate {
-            value: sum.total().map(|s| s / nf),
-            error: variance_sum.map(|v| v.sqrt() / nf),
-            evaluations: cells as u64,
-        })
+        Ok(Estimate::random(
+            sum.total().map(|s| s / nf),
+            variance_sum.map(|v| v.sqrt() / nf),
+            cells as u64,
+        ))
     }
 }

@@ -16,6 +16,7 @@ use super::{
 };
 use crate::domain::Vec3;
 use crate::error::{QuadError, SpecError};
+use crate::estimate::Estimate;
 use crate::exact::volume as exact;
 use crate::family::{self, Family, Flag, Measured, Method, Outcome};
 use crate::geometry::Ray;
@@ -382,32 +383,27 @@ impl Family for Volume {
 /// The quantities asked for from one evaluation of the terms. A term the
 /// scene does not have is 0 at no cost.
 fn collect(res: &VolumeResult, quantities: &[VolumeQuantity]) -> Outcome<VolumeQuantity> {
-    let term = |t: Option<super::Term>| {
-        t.map_or(Measured::scalar(0.0, 0.0, 0), |t| {
-            Measured::scalar(t.value, t.error, t.evaluations)
-        })
-    };
+    let term = |t: Option<super::Term>| t.map_or(Measured::scalar(0.0, 0.0, 0), measured);
     quantities
         .iter()
         .map(|&q| {
             let m = match q {
                 VolumeQuantity::Tau => {
-                    let tau = Measured::scalar(
-                        res.transmittance,
-                        res.transmittance * res.optical_depth.error,
-                        res.optical_depth.evaluations,
-                    );
+                    let tau = measured(super::Term {
+                        value: res.transmittance,
+                        error: res.transmittance * res.optical_depth.error,
+                        ..res.optical_depth
+                    });
                     if res.underflow {
                         tau.flagged(Flag::Underflow)
                     } else {
                         tau
                     }
                 }
-                VolumeQuantity::LnTau => Measured::scalar(
-                    res.log_transmittance,
-                    res.optical_depth.error,
-                    res.optical_depth.evaluations,
-                ),
+                VolumeQuantity::LnTau => measured(super::Term {
+                    value: res.log_transmittance,
+                    ..res.optical_depth
+                }),
                 VolumeQuantity::Emission => term(res.emission),
                 VolumeQuantity::Background => term(res.background),
                 VolumeQuantity::Light => term(res.light),
@@ -418,15 +414,42 @@ fn collect(res: &VolumeResult, quantities: &[VolumeQuantity]) -> Outcome<VolumeQ
         .collect()
 }
 
+/// A term as a measured value, flagged when the rule doubted its estimate.
+fn measured(t: super::Term) -> Measured {
+    let m = Measured::scalar(t.value, t.error, t.evaluations);
+    if t.reliable {
+        m
+    } else {
+        m.flagged(Flag::UnreliableEstimate)
+    }
+}
+
 /// V-I with the errors and costs of its terms, flagged when the sum lost
-/// digits to cancellation.
+/// digits to cancellation. The terms' errors combine as their kinds do
+/// ([`Estimate::combine`]): independent standard errors in quadrature.
 fn total(res: &VolumeResult) -> Measured {
     let terms = [res.emission, res.background, res.light];
-    let error = terms.iter().flatten().map(|t| t.error).sum();
-    let evaluations =
-        res.optical_depth.evaluations + terms.iter().flatten().map(|t| t.evaluations).sum::<u64>();
+    let sum = terms
+        .iter()
+        .flatten()
+        .map(|t| Estimate {
+            value: t.value,
+            error: t.error,
+            evaluations: t.evaluations,
+            kind: t.kind,
+            reliable: t.reliable,
+        })
+        .fold(Estimate::zero(), Estimate::combine);
+    let evaluations = res.optical_depth.evaluations + sum.evaluations;
     let parts = terms.iter().flatten().map(|t| t.value.abs()).sum::<f64>();
-    let m = Measured::scalar(res.total, error, evaluations);
+    let m = measured(super::Term {
+        id: "V-I",
+        value: res.total,
+        error: sum.error,
+        evaluations,
+        kind: sum.kind,
+        reliable: sum.reliable,
+    });
     if parts > 0.0 && res.total.abs() < 1e-6 * parts {
         m.flagged(Flag::Cancellation { parts })
     } else {

@@ -28,7 +28,7 @@ use super::medium::Medium;
 use super::scene::VolumeScene;
 use crate::domain::Segment;
 use crate::error::QuadError;
-use crate::estimate::Estimate;
+use crate::estimate::{ErrorKind, Estimate};
 use crate::geometry::Ray;
 use crate::quadrature::Rule;
 use crate::quadrature::gauss_legendre::unit_nodes;
@@ -72,6 +72,36 @@ pub struct Term {
     pub error: f64,
     /// Density evaluations spent on this term.
     pub evaluations: u64,
+    /// Whether `error` is a deterministic estimate or a standard error.
+    pub kind: ErrorKind,
+    /// False when the rule doubted its error estimate.
+    pub reliable: bool,
+}
+
+impl Term {
+    /// A term from the rule's estimate, charged `evaluations`.
+    fn measured(id: &'static str, est: Estimate<f64>, evaluations: u64) -> Self {
+        Term {
+            id,
+            value: est.value,
+            error: est.error,
+            evaluations,
+            kind: est.kind,
+            reliable: est.reliable,
+        }
+    }
+
+    /// A term known without quadrature.
+    fn exact(id: &'static str, value: f64) -> Self {
+        Term {
+            id,
+            value,
+            error: 0.0,
+            evaluations: 0,
+            kind: ErrorKind::Deterministic,
+            reliable: true,
+        }
+    }
 }
 
 /// All terms along one eye ray.
@@ -129,11 +159,7 @@ fn depth_by_quadrature<R: Rule, Rg: rand::Rng + ?Sized>(
     n: usize,
     rng: &mut Rg,
 ) -> Result<Estimate<f64>, QuadError> {
-    let mut total = Estimate {
-        value: 0.0,
-        error: 0.0,
-        evaluations: 0,
-    };
+    let mut total = Estimate::zero();
     for piece in medium.medium.support(ray, 0.0, f64::INFINITY) {
         let est = piece.try_integrate_pieces(rule, n, rng, |t, mid| {
             Ok(lambda * medium.density(ray, t, mid))
@@ -283,24 +309,14 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
 
     // No medium: tau = 1 with no work at all; the background passes unchanged.
     let Some(medium) = scene.medium.as_deref() else {
-        let background = scene.background.map(|b| Term {
-            id: "V-B",
-            value: b,
-            error: 0.0,
-            evaluations: 0,
-        });
+        let background = scene.background.map(|b| Term::exact("V-B", b));
         if background.is_some() {
             evaluated.push("V-B");
         }
         evaluated.push("V-I");
         return Ok(VolumeResult {
             chord: None,
-            optical_depth: Term {
-                id: "V-tau",
-                value: 0.0,
-                error: 0.0,
-                evaluations: 0,
-            },
+            optical_depth: Term::exact("V-tau", 0.0),
             log_transmittance: 0.0,
             transmittance: 1.0,
             underflow: false,
@@ -323,11 +339,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
 
     // V-tau over the chord, piece by piece (kept per piece for V-E and V-L).
     let mut piece_depths = Vec::with_capacity(pieces.len());
-    let mut depth = Estimate {
-        value: 0.0,
-        error: 0.0,
-        evaluations: 0,
-    };
+    let mut depth = Estimate::zero();
     for piece in &pieces {
         let est = piece.try_integrate_pieces(rule, n, rng, |t, mid| {
             Ok(scene.lambda * counted.density(&ray, t, mid))
@@ -335,12 +347,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         piece_depths.push(est.value);
         depth = depth.combine(est);
     }
-    let optical_depth = Term {
-        id: "V-tau",
-        value: depth.value,
-        error: depth.error,
-        evaluations: counted.take(),
-    };
+    let optical_depth = Term::measured("V-tau", depth, counted.take());
     let log_transmittance = -depth.value;
     let transmittance = log_transmittance.exp();
     let underflow = transmittance < f64::MIN_POSITIVE;
@@ -351,6 +358,8 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         value: b * transmittance,
         error: b * transmittance * depth.error,
         evaluations: 0,
+        kind: depth.kind,
+        reliable: depth.reliable,
     });
 
     // V-E and V-L share the outer integral over the chord.
@@ -367,11 +376,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
             gap: unit_nodes(GAP_NODES)?,
             checkpoints: BTreeMap::new(),
         };
-        let mut total = Estimate {
-            value: 0.0,
-            error: 0.0,
-            evaluations: 0,
-        };
+        let mut total = Estimate::zero();
         // Optical depth from t_n to the start of the current sub-piece.
         let mut before = 0.0;
         for piece in &pieces {
@@ -399,12 +404,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
                 &mut |t, mid, _| Ok(map.at(counted.density(&ray, t, mid))),
                 rng,
             )?;
-            Some(Term {
-                id: "V-E",
-                value: est.value,
-                error: est.error,
-                evaluations: counted.take(),
-            })
+            Some(Term::measured("V-E", est, counted.take()))
         }
     };
 
@@ -442,12 +442,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
                 },
                 rng,
             )?;
-            Some(Term {
-                id: "V-L",
-                value: est.value,
-                error: est.error,
-                evaluations: counted.take(),
-            })
+            Some(Term::measured("V-L", est, counted.take()))
         }
     };
 

@@ -208,9 +208,9 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
         }
         walks.add(score);
     }
-    Ok(Estimate {
-        value: walks.mean(),
-        error: walks.standard_error(),
+    Ok(Estimate::random(
+        walks.mean(),
+        walks.standard_error(),
         evaluations,
-    })
+    ))
 }

@@ -334,10 +334,10 @@ impl Rule for GaussLegendre {
         } else {
             (V::zero().map(|_| f64::INFINITY), 0)
         };
-        Ok(Estimate {
-            value: main.value,
+        Ok(Estimate::deterministic(
+            main.value,
             error,
-            evaluations: main.evaluations + extra,
-        })
+            main.evaluations + extra,
+        ))
     }
 }
