@@ -459,7 +459,10 @@ fn total(res: &VolumeResult) -> Measured {
 
 /// The closed form of a quantity for this scene, when `exact` has one.
 fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
-    let scene = &built.scene;
+    // The chord from the middle of the medium's support, where its length
+    // keeps its digits (VolumeScene::anchored).
+    let (scene, _) = built.scene.anchored();
+    let scene = &scene;
     let ray = scene.ray;
     // `ln tau = -lambda int v_r dt` (V-tau), kept in log space.
     let ln_tau = match &scene.medium {

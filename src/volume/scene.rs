@@ -108,6 +108,39 @@ impl VolumeScene {
         }
     }
 
+    /// The same scene with its ray re-anchored at the middle `t*` of the
+    /// medium's support along it: origin `e + t* v`, looked-at part
+    /// `[t_min - t*, t_max - t*]`; returns `t*` with it (0 when there is no
+    /// medium or the ray misses it). Every term is an integral over the ray
+    /// and does not change. What changes is rounding: the points of a chord
+    /// far from the eye, `e + t v` with `|t|` large, carry an absolute error
+    /// of `eps |t|`, which for a grazing chord of length `L` is a relative
+    /// error of `eps |t| / L` in every depth measured from them (1e-8 at a
+    /// chord of 1e-7 three units away). From the re-anchored origin the
+    /// chord's parameters are `O(L)`, and so are their errors.
+    pub fn anchored(&self) -> (VolumeScene, f64) {
+        let support = self
+            .medium
+            .as_ref()
+            .map(|m| m.support(&self.ray, self.t_min, self.t_max))
+            .unwrap_or_default();
+        let (Some(first), Some(last)) = (support.first(), support.last()) else {
+            return (self.clone(), 0.0);
+        };
+        let t_star = 0.5 * (first.start() + last.end());
+        if !t_star.is_finite() || t_star == 0.0 {
+            return (self.clone(), 0.0);
+        }
+        let mut out = self.clone();
+        out.ray = Ray {
+            origin: self.ray.at(t_star),
+            dir: self.ray.dir,
+        };
+        out.t_min = self.t_min - t_star;
+        out.t_max = self.t_max - t_star;
+        (out, t_star)
+    }
+
     /// Checks the numbers a user supplies (`lambda >= 0`, `t_min <= t_max`,
     /// finite `I_b` and emission).
     pub fn validate(&self) -> Result<(), QuadError> {

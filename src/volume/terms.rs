@@ -304,6 +304,10 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     rng: &mut Rg,
 ) -> Result<VolumeResult, QuadError> {
     scene.validate()?;
+    // Parameters measured from the middle of the chord, so the points of a
+    // grazing chord far from the eye keep their digits (VolumeScene::anchored).
+    let (anchored, shift) = scene.anchored();
+    let scene = &anchored;
     let mut evaluated = vec!["V-tau"];
     let ray = scene.ray;
 
@@ -333,7 +337,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     };
     let pieces = medium.support(&ray, scene.t_min, scene.t_max);
     let chord = match (pieces.first(), pieces.last()) {
-        (Some(first), Some(last)) => Some((first.start(), last.end())),
+        (Some(first), Some(last)) => Some((first.start() + shift, last.end() + shift)),
         _ => None,
     };
 
