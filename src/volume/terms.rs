@@ -33,6 +33,7 @@ use crate::geometry::Ray;
 use crate::quadrature::Rule;
 use crate::quadrature::gauss_legendre::unit_nodes;
 use crate::quadrature::nodes::UnitNodes;
+use crate::sum::Compensated;
 
 /// How the optical depth `tau(t_n, t)` inside V-E and V-L is computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -180,8 +181,10 @@ struct DepthAlong<'a, R: Rule> {
     n: usize,
     /// The gap rule's nodes on [0, 1], fetched once per evaluation.
     gap: Arc<UnitNodes>,
-    /// Visited `t -> depth from the piece start` (cumulative scheme).
-    checkpoints: BTreeMap<Key, f64>,
+    /// Visited `t -> depth from the piece start` (cumulative scheme), each
+    /// depth carried with its rounding error (a compensated sum), so a chain
+    /// of `n` gaps does not accumulate `n` roundings.
+    checkpoints: BTreeMap<Key, Compensated<f64>>,
 }
 
 /// A parameter `t` ordered totally, as a map key.
@@ -202,31 +205,43 @@ impl Ord for Key {
 impl<R: Rule> DepthAlong<'_, R> {
     fn start_piece(&mut self, piece: &Segment) {
         self.checkpoints.clear();
-        self.checkpoints.insert(Key(piece.start()), 0.0);
+        self.checkpoints
+            .insert(Key(piece.start()), Compensated::new());
     }
 
     /// `lambda int_lo^hi v_r` with the gap rule on panels no longer than
-    /// `longest`, split at the piece's break points; no allocation.
-    fn gap_depth(&self, piece: &Segment, lo: f64, hi: f64, longest: f64) -> f64 {
-        let mut total = 0.0;
+    /// `longest`, split at the piece's break points, added to `total`
+    /// (compensated); no allocation.
+    fn add_gap_depth(
+        &self,
+        total: &mut Compensated<f64>,
+        piece: &Segment,
+        lo: f64,
+        hi: f64,
+        longest: f64,
+    ) {
         let mut a = lo;
         let inner = piece.breaks().iter().copied().filter(|&b| lo < b && b < hi);
         for b in inner.chain(std::iter::once(hi)) {
             let panels = ((b - a) / longest).ceil().max(1.0) as usize;
             let width = (b - a) / panels as f64;
             let mid = 0.5 * (a + b);
+            // Panel j is [p_j, p_{j+1}] with p_0 = a, p_panels = b and its
+            // length the difference of the ends as stored, so the lengths
+            // telescope to b - a: a chain of n gaps then carries no rounding
+            // of the intermediate ends (a random walk of eps |t| per gap).
+            let end = |j: usize| if j == panels { b } else { a + width * j as f64 };
             for j in 0..panels {
-                let p0 = a + width * j as f64;
-                let len = if j + 1 == panels { b - p0 } else { width };
+                let (p0, p1) = (end(j), end(j + 1));
+                let len = p1 - p0;
                 let mut sum = 0.0;
                 for (u, w) in self.gap.u.iter().zip(&self.gap.w) {
                     sum += w * self.medium.density(&self.ray, p0 + len * u, mid);
                 }
-                total += self.lambda * len * sum;
+                total.add(self.lambda * len * sum);
             }
             a = b;
         }
-        total
     }
 
     /// Depth from the start of `piece` to `t` (inside `piece`).
@@ -253,15 +268,15 @@ impl<R: Rule> DepthAlong<'_, R> {
                 // piece / n, the spacing of an ascending rule, so rules that
                 // visit nodes out of order (adaptive, Monte Carlo) get the same
                 // accuracy, at O(n log n) instead of O(n) panels.
-                let (t0, d0) = self
+                let (t0, mut d) = self
                     .checkpoints
                     .range(..=Key(t))
                     .next_back()
-                    .map_or((piece.start(), 0.0), |(k, d)| (k.0, *d));
+                    .map_or((piece.start(), Compensated::new()), |(k, d)| (k.0, *d));
                 let longest = (piece.end() - piece.start()) / self.n as f64;
-                let d = d0 + self.gap_depth(piece, t0, t, longest);
+                self.add_gap_depth(&mut d, piece, t0, t, longest);
                 self.checkpoints.insert(Key(t), d);
-                Ok(d)
+                Ok(d.total())
             }
         }
     }
@@ -382,7 +397,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         };
         let mut total = Estimate::zero();
         // Optical depth from t_n to the start of the current sub-piece.
-        let mut before = 0.0;
+        let mut before = Compensated::<f64>::new();
         for piece in &pieces {
             for sub in graded(medium, scene.lambda, &ray, piece) {
                 along.start_piece(&sub);
@@ -392,10 +407,10 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
                     <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(rng.next_u64());
                 let est = sub.try_integrate_pieces(rule, n, &mut outer_rng, |t, mid| {
                     let d = along.depth_to(&sub, t, rng)?;
-                    Ok((-(before + d)).exp() * h(t, mid, rng)?)
+                    Ok((-(before.total() + d)).exp() * h(t, mid, rng)?)
                 })?;
                 total = total.combine(est);
-                before += along.depth_to(&sub, sub.end(), rng)?;
+                before.add(along.depth_to(&sub, sub.end(), rng)?);
             }
         }
         Ok(total)
