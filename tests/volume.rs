@@ -737,3 +737,44 @@ fn cumulative_depth_error_does_not_grow_with_the_budget() {
         );
     }
 }
+
+/// Regression (issue 9, item 9): a constant emission map emits where the
+/// density is positive (`EmissionMap::Constant`), so a sphere of kappa 0 emits
+/// nothing; the closed form said `c L` and every rule was shown 100% wrong.
+/// With kappa > 0 and lambda = 0 (no extinction) the sphere emits `c L`.
+/// Against the hand values 0 and `c L` (unit sphere, ray through the centre).
+#[test]
+fn a_constant_emission_map_emits_only_where_the_density_is_positive() {
+    use lightquad::family::{Family, Method};
+    use lightquad::volume::experiment::{Volume, VolumeQuantity};
+    use rand::SeedableRng;
+    for (kappa, lambda, want) in [(0.0, 1.0, 0.0), (0.7, 0.0, 2.0 * 2.0), (0.7, 1e-300, 4.0)] {
+        let spec = serde_json::from_value(serde_json::json!({
+            "ray": { "origin": [-3.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0] },
+            "lambda": lambda,
+            "medium": { "type": "constant-sphere", "centre": [0.0, 0.0, 0.0], "radius": 1.0, "kappa": kappa },
+            "emission": { "type": "constant", "c": 2.0 }
+        }))
+        .expect("a volume scene");
+        let scene = Volume::build(&spec).expect("valid");
+        let closed = Volume::closed_form(&scene, VolumeQuantity::Emission).expect("a closed form");
+        assert!(
+            (closed[0] - want).abs() <= 1e-15 * want,
+            "kappa {kappa}: closed form {closed:?}, want {want}"
+        );
+        let method = Method::Rule(AnyRule::by_name("gauss-legendre").expect("known"));
+        let out = Volume::evaluate(
+            &scene,
+            &method,
+            16,
+            &mut rand_pcg::Pcg64::seed_from_u64(0),
+            &[VolumeQuantity::Emission],
+        )
+        .expect("finite");
+        let got = out[&VolumeQuantity::Emission].value[0];
+        assert!(
+            (got - want).abs() <= 1e-14 * want.max(1.0),
+            "kappa {kappa}: rule {got}, want {want}"
+        );
+    }
+}

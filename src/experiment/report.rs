@@ -415,7 +415,7 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
             continue;
         };
         let mut rows = rows(&page.rules, results, q, reference);
-        let accuracy = page.reference.accuracy;
+        let accuracy = page.reference.accuracy_of(q);
         for r in rows.iter_mut() {
             if accuracy > 0.0 && r.rel_error <= accuracy {
                 r.flags.push(RowFlag::AtReferenceAccuracy(accuracy));
@@ -535,7 +535,7 @@ fn orders_and_plots(
     rows: &[Row],
     md: &mut String,
 ) -> Result<Vec<(String, Option<f64>)>, String> {
-    let accuracy = page.reference.accuracy;
+    let accuracy = page.reference.accuracy_of(q);
     let _ = writeln!(
         md,
         "\n| rule | fitted slope of log error vs log evaluations (order p shows as -p) | {} |\n|---|---:|{}",

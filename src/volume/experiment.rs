@@ -20,7 +20,7 @@ use crate::estimate::Estimate;
 use crate::exact::volume as exact;
 use crate::family::{self, Family, Flag, Measured, Method, Outcome};
 use crate::geometry::Ray;
-use crate::quadrature::GaussLegendre;
+use crate::quadrature::GaussKronrod;
 
 /// The volume family.
 #[derive(Debug, Clone, Copy)]
@@ -346,21 +346,28 @@ impl Family for Volume {
          sphere; I_L for the constant sphere with the light along the ray"
     }
 
-    /// Gauss–Legendre without its error estimate, `n` nodes per graded piece,
-    /// cumulative depth, closed-form shadow rays where the medium has them.
+    /// Adaptive Gauss–Kronrod (relative tolerance 1e-13) with up to `n`
+    /// bisections per graded piece, cumulative depth, closed-form shadow rays
+    /// where the medium has them. Adaptive because the integrands of V-L are
+    /// not smooth everywhere a piece boundary could say: a shadow ray that
+    /// crosses an edge of a voxel grid's cells, or grazes a sphere, puts a
+    /// kink into `I_p(t)` at a `t` no break point knows, and a fixed
+    /// Gauss–Legendre rule converges there only algebraically (2.6e-9 between
+    /// 512 and 1024 nodes on the bundled voxel grid).
     fn converged(
         built: &Built,
         n: usize,
         quantities: &[VolumeQuantity],
     ) -> Result<Outcome<VolumeQuantity>, QuadError> {
-        let rule = GaussLegendre {
-            error_estimate: false,
+        let rule = GaussKronrod {
+            abs_tol: 0.0,
+            rel_tol: 1e-13,
         };
         let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
         let res = evaluate(
             &built.scene,
             &rule,
-            n,
+            15 + 30 * n,
             DepthScheme::Cumulative,
             ShadowMethod::ClosedFormWhereAvailable,
             &mut rng,
@@ -498,16 +505,10 @@ fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
             return Some(0.0);
         }
         let (sigma, chord, _) = sphere?;
-        let kappa = if scene.lambda > 0.0 {
-            sigma / scene.lambda
-        } else {
-            return None;
-        };
-        let c = match map {
-            EmissionMap::Constant(c) => c,
-            EmissionMap::Proportional(k) => k * kappa,
-        };
-        Some(exact::emission(sigma, chord, c))
+        let kappa = built.sphere_kappa?;
+        // `c(v)` on the chord, where `v = kappa` (a constant map emits only
+        // where the density is positive: nothing from a sphere of kappa 0).
+        Some(exact::emission(sigma, chord, map.at(kappa)))
     };
     let light = || -> Option<f64> {
         let Some(light) = scene.light else {
