@@ -375,7 +375,7 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
     }
     let unconverged: Vec<String> = accuracy
         .iter()
-        .filter(|(_, c)| !(**c <= goal))
+        .filter(|(_, c)| c.is_nan() || **c > goal)
         .map(|(q, c)| format!("{q} ({c:.1e})"))
         .collect();
     let verdict = if unconverged.is_empty() {
