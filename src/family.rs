@@ -287,6 +287,11 @@ pub struct Measured {
     /// Facts a report must show.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub flags: Vec<Flag>,
+    /// Wall time of this quantity's own evaluation, seconds: the runner
+    /// evaluates each quantity alone and times it, so a quantity's time to a
+    /// target is its own cost, not that of every quantity of the job.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seconds: Option<f64>,
 }
 
 impl Measured {
@@ -297,6 +302,7 @@ impl Measured {
             error: vec![error],
             evaluations,
             flags: Vec::new(),
+            seconds: None,
         }
     }
 
@@ -319,6 +325,7 @@ impl<V: crate::value::Value> From<crate::estimate::Estimate<V>> for Measured {
             } else {
                 vec![Flag::UnreliableEstimate]
             },
+            seconds: None,
         }
     }
 }

@@ -223,6 +223,12 @@ fn results(out: &Path, name: &str) -> Vec<String> {
             if let Some(o) = v.as_object_mut() {
                 o.remove("seconds");
                 o.remove("machine");
+                // Each quantity's own time.
+                if let Some(qs) = o.get_mut("quantities").and_then(|q| q.as_object_mut()) {
+                    for m in qs.values_mut().filter_map(|m| m.as_object_mut()) {
+                        m.remove("seconds");
+                    }
+                }
             }
             v.to_string()
         })

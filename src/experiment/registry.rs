@@ -122,6 +122,11 @@ fn page<'a, F: Family>(
         seed: spec.seed,
         settings: F::settings(&spec.scene),
         quantities: spec.quantities.iter().map(Quantity::name).collect(),
+        dimensions: spec
+            .quantities
+            .iter()
+            .map(|&q| F::dimension(&exp.scene, q))
+            .collect(),
         rules,
         targets: &spec.targets,
         reference,

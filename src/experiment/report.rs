@@ -41,6 +41,8 @@ pub struct Page<'a> {
     pub settings: String,
     /// The quantities, in the file's order.
     pub quantities: Vec<&'static str>,
+    /// Each quantity's dimension (a budget of n is n^(1/D) nodes per axis).
+    pub dimensions: Vec<usize>,
     /// The rules and estimators, in the file's order.
     pub rules: Vec<RuleInfo>,
     /// Target relative errors.
@@ -183,7 +185,18 @@ fn row(
     if let Some(f) = jobs.iter().find_map(|j| j.failure.clone()) {
         flags.push(RowFlag::Failed(f));
     }
-    let seconds = median(jobs.iter().map(|j| j.seconds).collect());
+    // The quantity's own time where the job timed it alone (older results
+    // files: the job's).
+    let seconds = median(
+        jobs.iter()
+            .map(|j| {
+                j.quantities
+                    .get(q)
+                    .and_then(|m| m.seconds)
+                    .unwrap_or(j.seconds)
+            })
+            .collect(),
+    );
     let measured: Vec<_> = jobs.iter().filter_map(|j| j.quantities.get(q)).collect();
     if measured.is_empty() {
         // Every job of this row failed: keep the row, so the failure shows.
@@ -287,17 +300,50 @@ fn channel(v: &[f64], c: usize) -> f64 {
     v.get(c).copied().unwrap_or(f64::NAN)
 }
 
-/// The fitted order (error against evaluations) of one rule's rows.
-pub fn order(rows: &[&Row]) -> Option<f64> {
-    let pts: Vec<(f64, f64)> = rows
+/// What a fitted slope is measured against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Against {
+    /// The budget per axis, `n^(1/D)` for a D-dimensional quantity (nodes or
+    /// samples per piece): a rule of order p shows as -p whatever an
+    /// evaluation costs and whatever the dimension.
+    Budget {
+        /// The quantity's dimension D.
+        dimension: usize,
+    },
+    /// The evaluations spent: the cost (nested depth makes it ~n^2, so an
+    /// order-2 rule shows as -1 there).
+    Evaluations,
+}
+
+/// Rows an order is fitted through: the largest budgets above the floor (an
+/// order is an asymptotic property; the smallest budgets are often not yet
+/// in the asymptotic range).
+pub const FIT_ROWS: usize = 4;
+
+/// The fitted slope of log error against log `against` of one rule's rows,
+/// through the last [`FIT_ROWS`] rows whose error is above both the rounding
+/// floor and ten times the reference's own accuracy (`floor`); None below
+/// three such rows.
+pub fn order(rows: &[&Row], against: Against, floor: f64) -> Option<f64> {
+    let mut pts: Vec<(f64, f64)> = rows
         .iter()
-        .filter(|r| r.rel_error > 100.0 * FLOOR)
-        .map(|r| (r.evaluations, r.rel_error))
+        .filter(|r| r.rel_error > (100.0 * FLOOR).max(10.0 * floor))
+        .map(|r| {
+            let x = match against {
+                Against::Budget { dimension } => {
+                    (r.budget as f64).powf(1.0 / dimension.max(1) as f64)
+                }
+                Against::Evaluations => r.evaluations,
+            };
+            (x, r.rel_error)
+        })
         .collect();
     if pts.len() < 3 {
         return None;
     }
-    fitted_order(&pts)
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let tail = pts.len().saturating_sub(FIT_ROWS);
+    fitted_order(&pts[tail..])
 }
 
 /// The least median time among rows whose error meets `target`.
@@ -326,7 +372,22 @@ fn plot(
     title: &str,
     x_label: &str,
     series: &[(String, Vec<(f64, f64)>)],
+    floor: f64,
 ) -> Result<(), String> {
+    // Errors at or below `floor` (exact zeros, the rounding floor, the
+    // reference's own accuracy) are not resolved: they are drawn on a dashed
+    // floor line as open markers, not as numbers on the axis.
+    let series: Vec<(String, Vec<(f64, f64)>)> = series
+        .iter()
+        .map(|(name, s)| {
+            let kept = s.iter().filter(|(_, y)| !y.is_nan());
+            (
+                name.clone(),
+                kept.map(|&(x, y)| (x, y.max(floor))).collect(),
+            )
+        })
+        .collect();
+    let series = &series;
     let pts: Vec<(f64, f64)> = series.iter().flat_map(|s| s.1.iter().copied()).collect();
     if pts.is_empty() {
         return Ok(());
@@ -375,7 +436,15 @@ fn plot(
         chart
             .draw_series(
                 s.iter()
+                    .filter(|&&(_, y)| y > floor)
                     .map(|&(x, y)| Circle::new((x, y), 3, colour.filled())),
+            )
+            .map_err(|e| e.to_string())?;
+        chart
+            .draw_series(
+                s.iter()
+                    .filter(|&&(_, y)| y <= floor)
+                    .map(|&(x, y)| Circle::new((x, y), 5, colour.stroke_width(2))),
             )
             .map_err(|e| e.to_string())?;
         let y = 60 + 24 * i as i32;
@@ -389,12 +458,55 @@ fn plot(
             .draw(&Text::new(name.clone(), (42, y - 8), ("sans-serif", 14)))
             .map_err(|e| e.to_string())?;
     }
+    if pts.iter().any(|&(_, y)| y <= floor) {
+        let grey = RGBColor(110, 110, 110);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x0, floor), (x1, floor)],
+                6,
+                4,
+                grey.stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?;
+        let y = 60 + 24 * series.len() as i32 + 12;
+        right
+            .draw(&Circle::new((21, y), 5, grey.stroke_width(2)))
+            .map_err(|e| e.to_string())?;
+        right
+            .draw(&Text::new(
+                format!("error at or below {floor:.0e} (not resolved:"),
+                (42, y - 8),
+                ("sans-serif", 14),
+            ))
+            .map_err(|e| e.to_string())?;
+        right
+            .draw(&Text::new(
+                "exact, rounding, or the reference's accuracy)",
+                (42, y + 10),
+                ("sans-serif", 14),
+            ))
+            .map_err(|e| e.to_string())?;
+    }
     root.present().map_err(|e| e.to_string())
 }
 
 /// Per-experiment summary for the index: per quantity, in the file's order,
 /// each rule's time to the middle target (None: not reached).
-pub type Summary = Vec<(&'static str, Vec<(String, Option<f64>)>)>;
+pub type Summary = Vec<(&'static str, Vec<Ranked>)>;
+
+/// One rule in the index's ranking of a quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ranked {
+    /// The rule's label.
+    pub label: String,
+    /// Its time to the middle target (None: not reached).
+    pub seconds: Option<f64>,
+    /// Its error is unresolved (exact, or at the reference's accuracy)
+    /// already at its smallest budget: the integrand is within what the rule
+    /// integrates exactly, so its rank says nothing about its speed on
+    /// integrands in general.
+    pub exact_from_start: bool,
+}
 
 /// Writes `report.md`, the SVG plots and `results.csv` of one experiment.
 pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Result<Summary, String> {
@@ -457,10 +569,9 @@ fn header(page: &Page, results: &[JobResult]) -> String {
         format!(" Equations: {}.", page.equations.join(", "))
     };
     let shared = if page.quantities.len() > 1 {
-        format!(
-            " A job evaluates all {} quantities together: its time is theirs together.",
-            page.quantities.len()
-        )
+        " Each quantity is evaluated and timed on its own (a job evaluates only the terms that \
+         quantity needs), so its times are its own cost."
+            .to_string()
     } else {
         String::new()
     };
@@ -499,7 +610,7 @@ fn header(page: &Page, results: &[JobResult]) -> String {
 /// The table of one quantity: a row per (rule, budget).
 fn table(page: &Page, rows: &[Row]) -> String {
     let mut md = String::from(
-        "| rule | n | value | true error (relative; absolute where the reference is 0) | estimated error (same) | evaluations | median time (s) | flags |\n\
+        "| rule | n | value (mean over repeats) | true error (root mean square over repeats; relative, absolute where the reference is 0) | estimated error (mean over repeats, same scale; a standard error for random rules) | evaluations (mean) | median time (s) | flags |\n\
          |---|---:|---:|---:|---:|---:|---:|---|\n",
     );
     for r in rows {
@@ -534,11 +645,25 @@ fn orders_and_plots(
     q: &str,
     rows: &[Row],
     md: &mut String,
-) -> Result<Vec<(String, Option<f64>)>, String> {
+) -> Result<Vec<Ranked>, String> {
     let accuracy = page.reference.accuracy_of(q);
+    let dimension = page
+        .quantities
+        .iter()
+        .position(|x| *x == q)
+        .and_then(|i| page.dimensions.get(i).copied())
+        .unwrap_or(1);
+    // Below this an error is not resolved: f64 rounding, or the reference's
+    // own accuracy.
+    let floor = accuracy.max(1e-16);
     let _ = writeln!(
         md,
-        "\n| rule | fitted slope of log error vs log evaluations (order p shows as -p) | {} |\n|---|---:|{}",
+        "\n| rule | fitted slope of log error vs log n{} (order p shows as -p; the largest {FIT_ROWS} budgets above the floor) | fitted slope vs log evaluations (the cost) | {} |\n|---|---:|---:|{}",
+        if dimension > 1 {
+            format!("^(1/{dimension}), the nodes per axis,")
+        } else {
+            String::new()
+        },
         page.targets
             .iter()
             .map(|t| format!("time to {t:.0e} (s)"))
@@ -568,17 +693,27 @@ fn orders_and_plots(
                 (false, Some(s)) => format!("{s:.2e}"),
             })
             .collect();
-        let order = order(&mine).map_or("—".into(), |o| format!("{o:.2}"));
-        let _ = writeln!(md, "| {label} | {order} | {} |", times.join(" | "));
-        ranking.push((label.clone(), reach(middle)));
-        // Errors at exactly 0 are drawn at 1e-17; NaN (failed) rows are dropped.
-        let err = |r: &&Row| {
-            if r.rel_error.is_nan() {
-                f64::NAN
-            } else {
-                r.rel_error.max(1e-17)
-            }
-        };
+        let slope =
+            |against| order(&mine, against, accuracy).map_or("—".into(), |o| format!("{o:.2}"));
+        let _ = writeln!(
+            md,
+            "| {label} | {} | {} | {} |",
+            slope(Against::Budget { dimension }),
+            slope(Against::Evaluations),
+            times.join(" | ")
+        );
+        let first = mine
+            .iter()
+            .filter(|r| !r.rel_error.is_nan())
+            .min_by_key(|r| r.budget);
+        ranking.push(Ranked {
+            label: label.clone(),
+            seconds: reach(middle),
+            exact_from_start: first.is_some_and(|r| r.rel_error <= floor.max(1e-14)),
+        });
+        // NaN (failed) rows are dropped; the plot puts unresolved errors on
+        // its floor line.
+        let err = |r: &&Row| r.rel_error;
         by_time.push((
             label.clone(),
             mine.iter().map(|r| (r.seconds.max(1e-9), err(r))).collect(),
@@ -596,12 +731,14 @@ fn orders_and_plots(
         &format!("{}: {q} error against time", page.name),
         "median run time (s)",
         &by_time,
+        floor,
     )?;
     plot(
         &dir.join(format!("{base}-n.svg")),
         &format!("{}: {q} error against evaluations", page.name),
         "evaluations",
         &by_n,
+        floor,
     )?;
     let _ = writeln!(
         md,
@@ -693,17 +830,24 @@ pub fn write_index(
         let _ = writeln!(md, "## [{name}]({name}/report.md)\n\n{description}\n");
         for (q, ranking) in summary {
             let mut ranked = ranking.clone();
-            ranked.sort_by(|a, b| match (a.1, b.1) {
+            ranked.sort_by(|a, b| match (a.seconds, b.seconds) {
                 (Some(x), Some(y)) => x.total_cmp(&y),
                 (Some(_), None) => std::cmp::Ordering::Less,
                 (None, Some(_)) => std::cmp::Ordering::Greater,
-                (None, None) => a.0.cmp(&b.0),
+                (None, None) => a.label.cmp(&b.label),
             });
             let list: Vec<String> = ranked
                 .iter()
-                .map(|(r, t)| match t {
-                    Some(t) => format!("{r} ({t:.1e} s)"),
-                    None => format!("{r} (not reached)"),
+                .map(|r| {
+                    let exact = if r.exact_from_start {
+                        ", exact from its first budget: the integrand is in its exact class"
+                    } else {
+                        ""
+                    };
+                    match r.seconds {
+                        Some(t) => format!("{} ({t:.1e} s{exact})", r.label),
+                        None => format!("{} (not reached{exact})", r.label),
+                    }
                 })
                 .collect();
             let _ = writeln!(md, "- {q}: {}", list.join(", "));

@@ -144,14 +144,36 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         ));
         return out;
     };
-    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-    let start = Instant::now();
-    let outcome = F::evaluate(&exp.scene, method, budget, &mut rng, &spec.quantities);
-    out.seconds = start.elapsed().as_secs_f64();
-    match outcome
-        .map_err(|e| e.to_string())
-        .and_then(|values| shaped::<F>(&exp.scene, &spec.quantities, values))
-    {
+    // Each quantity is evaluated alone, from the job's seed, and timed alone:
+    // its time to a target is then its own cost (a family computes only what
+    // the asked-for quantities need).
+    let mut outcome = crate::family::Outcome::new();
+    for q in &spec.quantities {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let start = Instant::now();
+        let result = F::evaluate(
+            &exp.scene,
+            method,
+            budget,
+            &mut rng,
+            std::slice::from_ref(q),
+        );
+        let seconds = start.elapsed().as_secs_f64();
+        out.seconds += seconds;
+        match result {
+            Ok(values) => {
+                for (k, mut m) in values {
+                    m.seconds = Some(seconds);
+                    outcome.insert(k, m);
+                }
+            }
+            Err(e) => {
+                out.failure = Some(format!("{}: {e}", q.name()));
+                return out;
+            }
+        }
+    }
+    match shaped::<F>(&exp.scene, &spec.quantities, outcome) {
         Ok(values) => out.quantities = values,
         Err(e) => out.failure = Some(e),
     }

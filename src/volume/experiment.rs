@@ -314,7 +314,8 @@ impl Family for Volume {
     ) -> Result<Outcome<VolumeQuantity>, QuadError> {
         match method {
             Method::Rule(rule) => {
-                let res = evaluate(&built.scene, rule, budget, built.scheme, built.shadow, rng)?;
+                let scene = needed(&built.scene, quantities);
+                let res = evaluate(&scene, rule, budget, built.scheme, built.shadow, rng)?;
                 Ok(collect(&res, quantities))
             }
             Method::Estimator(tracker) => {
@@ -385,6 +386,28 @@ impl Family for Volume {
     fn audit() -> Option<String> {
         Some(super::audit::markdown())
     }
+}
+
+/// The scene with only the terms `quantities` need (every term feeds V-I;
+/// V-tau is always evaluated): asking for tau alone costs no emission or
+/// light integral.
+fn needed(scene: &VolumeScene, quantities: &[VolumeQuantity]) -> VolumeScene {
+    let wants = |q: VolumeQuantity| {
+        quantities
+            .iter()
+            .any(|&x| x == q || x == VolumeQuantity::Total)
+    };
+    let mut out = scene.clone();
+    if !wants(VolumeQuantity::Emission) {
+        out.emission = None;
+    }
+    if !wants(VolumeQuantity::Background) {
+        out.background = None;
+    }
+    if !wants(VolumeQuantity::Light) {
+        out.light = None;
+    }
+    out
 }
 
 /// The quantities asked for from one evaluation of the terms. A term the
