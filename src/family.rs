@@ -257,6 +257,14 @@ pub enum Flag {
     /// from did not behave as the estimate assumes (algebraic instead of
     /// geometric convergence, a jump or a kink in the integrand).
     UnreliableEstimate,
+    /// Every walk of a tracking estimator scored alike: the sample variance
+    /// is 0, which says nothing about outcomes not yet seen, so the error is
+    /// a Wilson-type bound (`W(n) D`, [`crate::volume::tracking::Tracked`])
+    /// that still reads as one standard error, not a sample standard error.
+    AllWalksAlike {
+        /// The number of walks.
+        walks: u64,
+    },
 }
 
 impl std::fmt::Display for Flag {
@@ -267,6 +275,10 @@ impl std::fmt::Display for Flag {
                 write!(f, "cancellation: |sum| < 1e-6 of its parts ({parts:.1e})")
             }
             Flag::UnreliableEstimate => write!(f, "error estimate unreliable (rule's own check)"),
+            Flag::AllWalksAlike { walks } => write!(
+                f,
+                "all {walks} walks scored alike: error is a Wilson half-width / 1.96, not a sample SE"
+            ),
         }
     }
 }

@@ -140,7 +140,7 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
         "family",
         "missing: expected one of calibration, volume",
     );
-    // A tracking estimator estimates tau only: asking it for I_E is refused
+    // Ratio tracking estimates transmittance only: asking it for I_E is refused
     // at `check`, not a row of NaN in the report.
     rejected(
         &VALID.replace(
@@ -148,7 +148,7 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
             "{ \"rule\": \"ratio-tracking\" }",
         ),
         "rules[1]",
-        "estimator `ratio-tracking` estimates only tau, but quantities[1] is I_E",
+        "estimator `ratio-tracking` estimates only tau, I_B, but quantities[1] is I_E",
     );
     // A 2-D product rule cannot integrate along a ray segment.
     rejected(

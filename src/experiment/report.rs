@@ -104,7 +104,9 @@ the root mean square over channels of error / standard error above 4); \
 `estimate off by more than 10x` (a deterministic error estimate, above the rounding floor); \
 `error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
 parts); `underflows: log space` (the value is below the smallest f64; its logarithm is exact: ask for `ln_tau`); \
-`at the reference's accuracy` (the error is not resolved by the reference).";
+`at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
+scored alike` (a tracking estimate with zero sample variance: its error is a Wilson half-width \
+/ 1.96, not a sample standard error).";
 
 /// One row of a report table: a rule at one budget, aggregated over repeats.
 #[derive(Debug, Clone, PartialEq)]

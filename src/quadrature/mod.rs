@@ -21,7 +21,7 @@
 //! | `gauss-kronrod` | adaptive Gauss–Kronrod G7–K15 (D = 1) | embedded G7 |
 //! | `monte-carlo` | plain Monte Carlo | standard error |
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
-//! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles |
+//! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles, times t_{R-1}(0.975)/1.96 |
 //! | `product` | iterated 2-D rule from any two 1-D rules (`AnyRule::by_name("product(A,B)")` in the library) | outer estimate + integrated inner estimates |
 
 pub mod nodes;

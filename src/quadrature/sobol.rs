@@ -14,6 +14,13 @@
 //! each give the estimate (their mean) and its standard error (spread of the
 //! eight means / sqrt 8). For smooth integrands the error falls like
 //! `N^(-3/2)` up to log factors.
+//!
+//! A standard error from `R` means has `R - 1` degrees of freedom, so
+//! `+- 1.96` of it is a Student-t interval of only ~91% at `R = 8`
+//! (measured: 89-92% coverage of V-E over 1000 repeats). The reported error
+//! is therefore the standard error times `t_{R-1}(0.975) / 1.96` (1.21 at
+//! `R = 8`): `value +- 1.96 error` is the 95% t interval, and the error still
+//! reads as one standard error.
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -114,7 +121,7 @@ impl Rule for Sobol {
     }
 
     fn about(&self) -> &'static str {
-        "Owen-scrambled Sobol' points (1-D and 2-D), independent scrambles (default 8); standard error"
+        "Owen-scrambled Sobol' points (1-D and 2-D), independent scrambles (default 8); standard error over scrambles, Student-t scaled"
     }
 
     /// One point per scramble.
@@ -191,10 +198,21 @@ impl Rule for Sobol {
             }
             means.add(sum.total().map(|s| s / per as f64));
         }
+        let t = student_t_factor(reps)?;
         Ok(Estimate::random(
             means.mean(),
-            means.standard_error(),
+            means.standard_error().map(|e| e * t),
             (reps * per) as u64,
         ))
     }
+}
+
+/// `t_{R-1}(0.975) / 1.96`: the factor that makes `+- 1.96` standard errors
+/// from `R` independent means the two-sided 95% Student-t interval.
+fn student_t_factor(replicates: usize) -> Result<f64, QuadError> {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    let dof = (replicates - 1) as f64;
+    let t = StudentsT::new(0.0, 1.0, dof)
+        .map_err(|e| QuadError::invalid("replicates", replicates, format!("an integer >= 2 ({e})")))?;
+    Ok(t.inverse_cdf(0.975) / 1.96)
 }

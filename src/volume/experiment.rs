@@ -8,7 +8,7 @@ use std::sync::Arc;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::tracking::{Extinction, Tracker, transmittance};
+use super::tracking::{Extinction, Tracked, Tracker, Wanted, radiance, transmittance};
 use super::{
     ConstantSphere, DepthScheme, DirectionalLight, EmissionMap, GaussianBlob, GaussianBlobs,
     Medium, ShadowMethod, VolumeResult, VolumeScene, evaluate, linear_gradient::LinearGradient,
@@ -227,11 +227,14 @@ impl family::Estimator for Tracker {
     fn about(&self) -> &'static str {
         match self {
             Tracker::Delta => {
-                "delta (Woodcock) tracking of tau, per-span majorants; standard error"
+                "delta (Woodcock) tracking, per-span majorants: tau, I_B, and I_E, I_L, I as a \
+                 renderer does (emission and light at tentative collisions, shadow rays by ratio \
+                 tracking); standard error (Wilson for tau)"
             }
-            Tracker::Ratio => "ratio tracking of tau, per-span majorants; standard error",
+            Tracker::Ratio => "ratio tracking of tau (and I_B), per-span majorants; standard error",
             Tracker::ResidualRatio => {
-                "residual ratio tracking of tau with a per-span control extinction; standard error"
+                "residual ratio tracking of tau (and I_B) with a per-span control extinction; \
+                 standard error"
             }
         }
     }
@@ -301,8 +304,16 @@ impl Family for Volume {
         1
     }
 
-    fn estimates(_: &Tracker) -> &'static [VolumeQuantity] {
-        &[VolumeQuantity::Tau]
+    /// Delta tracking estimates every term a renderer's walk scores
+    /// ([`super::tracking::radiance`]); ratio and residual ratio tracking
+    /// estimate transmittance only, so `tau` and `I_B = I_b tau`. None
+    /// estimates `ln_tau` (the logarithm of a mean is biased).
+    fn estimates(tracker: &Tracker) -> &'static [VolumeQuantity] {
+        use VolumeQuantity::*;
+        match tracker {
+            Tracker::Delta => &[Tau, Background, Emission, Light, Total],
+            Tracker::Ratio | Tracker::ResidualRatio => &[Tau, Background],
+        }
     }
 
     fn evaluate(
@@ -318,23 +329,7 @@ impl Family for Volume {
                 let res = evaluate(&scene, rule, budget, built.scheme, built.shadow, rng)?;
                 Ok(collect(&res, quantities))
             }
-            Method::Estimator(tracker) => {
-                let scene = &built.scene;
-                let est = match scene.medium.as_deref() {
-                    // No medium: tau = 1 with no work.
-                    None => Measured::scalar(1.0, 0.0, 0),
-                    Some(medium) => {
-                        let sigma = Extinction {
-                            medium,
-                            lambda: scene.lambda,
-                        };
-                        let (t0, t1) = (scene.t_min, scene.t_max);
-                        let e = transmittance(*tracker, sigma, &scene.ray, t0, t1, budget, rng)?;
-                        Measured::scalar(e.value, e.error, e.evaluations)
-                    }
-                };
-                Ok([(VolumeQuantity::Tau, est)].into_iter().collect())
-            }
+            Method::Estimator(tracker) => estimate(built, *tracker, budget, rng, quantities),
         }
     }
 
@@ -408,6 +403,106 @@ fn needed(scene: &VolumeScene, quantities: &[VolumeQuantity]) -> VolumeScene {
         out.light = None;
     }
     out
+}
+
+/// `quantities` by `tracker` with `budget` walks: `tau` and `I_B` from
+/// [`transmittance`] alone, anything else from one set of delta-tracking
+/// walks ([`radiance`]); a quantity the tracker does not estimate is an error
+/// (validation refuses it first, [`Volume::estimates`]).
+fn estimate(
+    built: &Built,
+    tracker: Tracker,
+    budget: usize,
+    rng: &mut rand_pcg::Pcg64,
+    quantities: &[VolumeQuantity],
+) -> Result<Outcome<VolumeQuantity>, QuadError> {
+    let can = <Volume as Family>::estimates(&tracker);
+    if let Some(q) = quantities.iter().find(|q| !can.contains(q)) {
+        let names: Vec<_> = can.iter().map(family::Quantity::name).collect();
+        return Err(QuadError::invalid(
+            "quantity",
+            family::Quantity::name(q),
+            format!("one of {} for {}", names.join(", "), tracker.name()),
+        ));
+    }
+    let scene = &built.scene;
+    let background = scene.background.unwrap_or(0.0);
+    let only_tau = quantities
+        .iter()
+        .all(|q| matches!(q, VolumeQuantity::Tau | VolumeQuantity::Background));
+    let out: Vec<(VolumeQuantity, Tracked)> = if only_tau {
+        let tau = match scene.medium.as_deref() {
+            // No medium: tau = 1 with no work.
+            None => Tracked {
+                value: 1.0,
+                error: 0.0,
+                evaluations: 0,
+                walks: budget as u64,
+                all_alike: false,
+            },
+            Some(medium) => {
+                let sigma = Extinction {
+                    medium,
+                    lambda: scene.lambda,
+                };
+                let (t0, t1) = (scene.t_min, scene.t_max);
+                transmittance(tracker, sigma, &scene.ray, t0, t1, budget, rng)?
+            }
+        };
+        quantities
+            .iter()
+            .map(|&q| {
+                let s = if q == VolumeQuantity::Background {
+                    background
+                } else {
+                    1.0
+                };
+                let t = Tracked {
+                    value: s * tau.value,
+                    error: s * tau.error,
+                    ..tau
+                };
+                (q, t)
+            })
+            .collect()
+    } else {
+        let wanted = Wanted {
+            emission: quantities
+                .iter()
+                .any(|q| matches!(q, VolumeQuantity::Emission | VolumeQuantity::Total)),
+            light: quantities
+                .iter()
+                .any(|q| matches!(q, VolumeQuantity::Light | VolumeQuantity::Total)),
+        };
+        let r = radiance(scene, built.shadow, wanted, budget, rng)?;
+        quantities
+            .iter()
+            .filter_map(|&q| {
+                let t = match q {
+                    VolumeQuantity::Tau => r.tau,
+                    VolumeQuantity::Background => r.background,
+                    VolumeQuantity::Emission => r.emission,
+                    VolumeQuantity::Light => r.light,
+                    VolumeQuantity::Total => r.total,
+                    // Refused above.
+                    VolumeQuantity::LnTau => return None,
+                };
+                Some((q, t))
+            })
+            .collect()
+    };
+    Ok(out
+        .into_iter()
+        .map(|(q, t)| {
+            let m = Measured::scalar(t.value, t.error, t.evaluations);
+            let m = if t.all_alike {
+                m.flagged(Flag::AllWalksAlike { walks: t.walks })
+            } else {
+                m
+            };
+            (q, m)
+        })
+        .collect())
 }
 
 /// The quantities asked for from one evaluation of the terms. A term the

@@ -1,7 +1,7 @@
 //! Volume rendering with a directional light (docs/EQUATIONS.md, V-tau .. V-I;
 //! seeds/000): media as density fields, the terms along an eye ray with any
 //! rule, closed forms in [`crate::exact`], the document's printed formulas in
-//! [`audit`], and the stochastic transmittance estimators renderers use.
+//! [`audit`], and the stochastic estimators renderers use (tracking).
 
 pub mod audit;
 pub mod constant_sphere;

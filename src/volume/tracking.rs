@@ -16,14 +16,38 @@
 //!
 //! Every smooth piece is cut into 16 spans, each with its own majorant (and
 //! control); the per-walk scores of the spans multiply.
+//!
+//! [`radiance`] extends delta tracking from `tau` to V-E, V-B, V-L and V-I
+//! the way a renderer estimates them (free-flight sampling against the
+//! majorant, emission and next-event light at the tentative collisions, the
+//! shadow ray's transmittance by ratio tracking); see there for the estimator
+//! and why it is unbiased.
+//!
+//! **Errors.** A tracking estimate's error is the standard error of its walks,
+//! except where that is known to mislead:
+//! - delta tracking's `tau` scores are 0 or 1: the error is the half-width
+//!   of the Wilson score interval at `z = 1.96`, divided by 1.96 (so
+//!   `value +- 1.96 error` is an interval as wide as Wilson's and the error
+//!   still reads as one standard error: it is the ordinary standard error up
+//!   to O(1/n) once `k` and `n - k` are large, and stays honest at `k = 0`
+//!   or `k = n`, where the sample standard error is 0);
+//! - any estimate whose walks all scored alike (zero sample variance, which
+//!   says nothing about outcomes not yet seen) carries `W(n) D`, with
+//!   `W(n) = z / (2 (n + z^2))` the Wilson half-width at `k = 0` divided by
+//!   `z` (an outcome not seen in `n` walks has a probability of order
+//!   `z^2 / (2 n)` or less) and `D` the largest change one unseen outcome
+//!   makes to a walk's score (see [`Tracked::all_alike`]), and is flagged.
 
 use rand::RngExt;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+use std::f64::consts::PI;
+
 use super::medium::Medium;
+use super::scene::VolumeScene;
+use super::terms::ShadowMethod;
 use crate::error::QuadError;
-use crate::estimate::Estimate;
 use crate::geometry::Ray;
 use crate::quadrature::monte_carlo::Welford;
 
@@ -33,10 +57,16 @@ use crate::quadrature::monte_carlo::Welford;
 struct Span {
     a: f64,
     b: f64,
+    /// `lambda` times the medium's density bound on the span.
     bar: f64,
+    /// The medium's density bound on the span (`bar / lambda`).
+    v_bar: f64,
     control: f64,
     majorant: f64,
 }
+
+/// The `z` of the two-sided 95% intervals the errors stand for.
+const Z: f64 = 1.96;
 
 /// Tentative collisions allowed per walk and span before tracking gives up
 /// (its cost grows with the majorant's optical depth).
@@ -78,23 +108,104 @@ pub struct Extinction<'a> {
     pub lambda: f64,
 }
 
-/// Estimates `tau(t0, t1)` along `ray` with `n` walks: the estimate, its
-/// standard error and the density evaluations spent.
-pub fn transmittance<Rg: rand::Rng + ?Sized>(
-    tracker: Tracker,
-    sigma: Extinction,
-    ray: &Ray,
-    t0: f64,
-    t1: f64,
-    n: usize,
-    rng: &mut Rg,
-) -> Result<Estimate<f64>, QuadError> {
-    if !(sigma.lambda.is_finite() && sigma.lambda >= 0.0) {
-        return Err(QuadError::invalid(
-            "lambda",
-            sigma.lambda,
-            "a finite number >= 0",
-        ));
+/// A tracking estimate: the mean of `walks` walks and its error (see the
+/// module documentation), with the density evaluations spent.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tracked {
+    /// The mean score.
+    pub value: f64,
+    /// One standard error, or its honest substitute (module documentation):
+    /// the Wilson half-width over 1.96 for 0/1 scores, `W(n) D` when every
+    /// walk scored alike.
+    pub error: f64,
+    /// Density evaluations spent (shared by every quantity of one set of walks).
+    pub evaluations: u64,
+    /// The number of walks.
+    pub walks: u64,
+    /// True when every walk scored the same: the sample variance is 0 and
+    /// `error` is the bound `W(n) D`, where `D` bounds how far one unseen
+    /// outcome moves a score: `max(x, 1 - x)` for a transmittance `x` (scores
+    /// of delta and ratio tracking lie in [0, 1], and a score in [0, 1]
+    /// equals 1 with probability at most its mean, so at the ends the bound
+    /// is the binomial one; residual ratio tracking's scores may pass 1, and
+    /// there it is a heuristic); for V-E, V-L and V-I the larger of `|x|`
+    /// and one tentative collision's largest score.
+    pub all_alike: bool,
+}
+
+/// `W(n) = z / (2 (n + z^2))`: the half-width of the Wilson score interval
+/// for 0 successes in `n` trials, `z^2 / (2 (n + z^2))`, divided by `z`.
+fn wilson_unseen(n: u64) -> f64 {
+    let n = n as f64;
+    Z / (2.0 * (n + Z * Z))
+}
+
+/// The error of `k` successes in `n` 0/1 trials: the half-width of the
+/// Wilson score interval, `z/(n + z^2) sqrt(k (n - k)/n + z^2/4)`, divided
+/// by `z`. Up to O(1/n) it is the standard error `sqrt(p (1 - p) / n)` once
+/// `k` and `n - k` are large; at `k = 0` or `k = n` it is `W(n)`, not 0.
+pub fn wilson_error(k: u64, n: u64) -> f64 {
+    let (k, n) = (k as f64, n as f64);
+    (k * (n - k) / n + 0.25 * Z * Z).sqrt() / (n + Z * Z)
+}
+
+/// Walk scores summed as the tracking errors need them.
+#[derive(Debug, Clone, Default)]
+struct Scores {
+    walks: Welford<f64>,
+    first: Option<f64>,
+    alike: bool,
+}
+
+impl Scores {
+    fn add(&mut self, x: f64) {
+        match self.first {
+            None => {
+                self.first = Some(x);
+                self.alike = true;
+            }
+            Some(f) => self.alike &= f == x,
+        }
+        self.walks.add(x);
+    }
+
+    /// The mean with its standard error; when every walk scored alike, the
+    /// bound `W(n) D` with `D = spread(x)` instead.
+    fn tracked(&self, evaluations: u64, spread: impl Fn(f64) -> f64) -> Tracked {
+        let (n, x) = (self.walks.count(), self.walks.mean());
+        let error = if self.alike {
+            wilson_unseen(n) * spread(x)
+        } else {
+            self.walks.standard_error()
+        };
+        Tracked {
+            value: x,
+            error,
+            evaluations,
+            walks: n,
+            all_alike: self.alike,
+        }
+    }
+
+    /// The mean of 0/1 scores with the Wilson error.
+    fn binary(&self, evaluations: u64) -> Tracked {
+        let n = self.walks.count();
+        let x = self.walks.mean();
+        let k = (x * n as f64).round() as u64;
+        Tracked {
+            value: x,
+            error: wilson_error(k, n),
+            evaluations,
+            walks: n,
+            all_alike: self.alike,
+        }
+    }
+}
+
+/// Checks the common arguments of the estimators.
+fn check(lambda: f64, t0: f64, t1: f64, n: usize) -> Result<(), QuadError> {
+    if !(lambda.is_finite() && lambda >= 0.0) {
+        return Err(QuadError::invalid("lambda", lambda, "a finite number >= 0"));
     }
     if t0.is_nan() || t1.is_nan() || t1 < t0 {
         return Err(QuadError::invalid(
@@ -110,13 +221,24 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
             "at least 2 walks (a standard error needs two)",
         ));
     }
-    let Extinction { medium, lambda } = sigma;
-    // Each smooth piece is cut into SPANS equal spans with a majorant of their
-    // own (tight majorants mean few tentative collisions); residual ratio
-    // tracking also gets a control extinction per span, the span's mean from a
-    // 4-point Gauss–Legendre rule, computed once for all walks.
+    Ok(())
+}
+
+/// The spans of `[t0, t1]` along `ray`: each smooth piece is cut into SPANS
+/// equal spans with a majorant of their own (tight majorants mean few
+/// tentative collisions); residual ratio tracking also gets a control
+/// extinction per span, the span's mean from a 4-point Gauss–Legendre rule,
+/// computed once for all walks (its evaluations are added to `evaluations`).
+fn spans(
+    tracker: Tracker,
+    sigma: Extinction,
+    ray: &Ray,
+    t0: f64,
+    t1: f64,
+    evaluations: &mut u64,
+) -> Result<Vec<Span>, QuadError> {
     const SPANS: usize = 16;
-    let mut evaluations = 0u64;
+    let Extinction { medium, lambda } = sigma;
     let mut spans: Vec<Span> = Vec::new();
     for piece in medium.support(ray, t0, t1) {
         let (a, b) = (piece.start(), piece.end());
@@ -124,7 +246,8 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
         for i in 0..SPANS {
             let s0 = a + width * i as f64;
             let s1 = if i + 1 == SPANS { b } else { s0 + width };
-            let bar = lambda * medium.max_density(ray, s0, s1);
+            let v_bar = medium.max_density(ray, s0, s1);
+            let bar = lambda * v_bar;
             if !bar.is_finite() {
                 return Err(QuadError::invalid(
                     "majorant",
@@ -135,7 +258,7 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
             let control = match tracker {
                 Tracker::ResidualRatio => {
                     let gl = crate::quadrature::gauss_legendre::unit_nodes(4)?;
-                    evaluations += 4;
+                    *evaluations += 4;
                     let mean: f64 =
                         gl.u.iter()
                             .zip(&gl.w)
@@ -155,62 +278,338 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
                 a: s0,
                 b: s1,
                 bar,
+                v_bar,
                 control,
                 majorant,
             });
         }
     }
-    let mut walks = Welford::<f64>::default();
-    for _ in 0..n {
-        let mut score = 1.0;
-        for span in &spans {
-            if span.control > 0.0 {
-                score *= (-span.control * (span.b - span.a)).exp();
+    Ok(spans)
+}
+
+/// The error returned when a walk needs more than [`MAX_COLLISIONS`]
+/// tentative collisions on one span.
+fn too_deep(span: &Span) -> QuadError {
+    QuadError::invalid(
+        "optical depth",
+        span.majorant * (span.b - span.a),
+        format!(
+            "at most {MAX_COLLISIONS} tentative collisions per walk and span: \
+             the majorant's optical depth is too large for tracking"
+        ),
+    )
+}
+
+/// One walk's transmittance score over `spans` (module documentation).
+fn walk<Rg: rand::Rng + ?Sized>(
+    tracker: Tracker,
+    sigma: Extinction,
+    ray: &Ray,
+    spans: &[Span],
+    evaluations: &mut u64,
+    rng: &mut Rg,
+) -> Result<f64, QuadError> {
+    let Extinction { medium, lambda } = sigma;
+    let mut score = 1.0;
+    for span in spans {
+        if span.control > 0.0 {
+            score *= (-span.control * (span.b - span.a)).exp();
+        }
+        if span.majorant <= 0.0 {
+            continue;
+        }
+        let mut t = span.a;
+        let mut collisions = 0u64;
+        loop {
+            // Free flight: -ln(1 - xi) / majorant, xi in [0, 1).
+            t -= (-rng.random::<f64>()).ln_1p() / span.majorant;
+            if t >= span.b {
+                break;
             }
-            if span.majorant <= 0.0 {
+            *evaluations += 1;
+            collisions += 1;
+            if collisions > MAX_COLLISIONS {
+                return Err(too_deep(span));
+            }
+            let sigma = lambda * medium.density(ray.at(t));
+            match tracker {
+                Tracker::Delta => {
+                    if rng.random::<f64>() < sigma / span.bar {
+                        score = 0.0;
+                        break;
+                    }
+                }
+                Tracker::Ratio => score *= 1.0 - sigma / span.bar,
+                Tracker::ResidualRatio => score *= 1.0 - (sigma - span.control) / span.majorant,
+            }
+        }
+        if score == 0.0 {
+            break;
+        }
+    }
+    Ok(score)
+}
+
+/// Estimates `tau(t0, t1)` along `ray` with `n` walks: the estimate, its
+/// error (module documentation) and the density evaluations spent.
+pub fn transmittance<Rg: rand::Rng + ?Sized>(
+    tracker: Tracker,
+    sigma: Extinction,
+    ray: &Ray,
+    t0: f64,
+    t1: f64,
+    n: usize,
+    rng: &mut Rg,
+) -> Result<Tracked, QuadError> {
+    check(sigma.lambda, t0, t1, n)?;
+    let mut evaluations = 0u64;
+    let spans = spans(tracker, sigma, ray, t0, t1, &mut evaluations)?;
+    let mut scores = Scores::default();
+    for _ in 0..n {
+        scores.add(walk(tracker, sigma, ray, &spans, &mut evaluations, rng)?);
+    }
+    Ok(match tracker {
+        Tracker::Delta => scores.binary(evaluations),
+        // Scores in [0, 1] (residual ratio: a heuristic, see Tracked::all_alike).
+        Tracker::Ratio | Tracker::ResidualRatio => scores.tracked(evaluations, |x| x.max(1.0 - x)),
+    })
+}
+
+/// What [`radiance`] scores besides `tau`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Wanted {
+    /// V-E.
+    pub emission: bool,
+    /// V-L.
+    pub light: bool,
+}
+
+/// The quantities of one set of delta-tracking walks along the eye ray, each
+/// with the evaluations of all of them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Radiance {
+    /// V-tau over the looked-at part.
+    pub tau: Tracked,
+    /// V-B: `I_b` times each walk's `tau` score.
+    pub background: Tracked,
+    /// V-E (0 with no error when not wanted or the scene does not emit).
+    pub emission: Tracked,
+    /// V-L (0 with no error when not wanted or the scene has no light).
+    pub light: Tracked,
+    /// V-I: each walk's V-E + V-B + V-L scores summed, so the error holds
+    /// their covariance.
+    pub total: Tracked,
+}
+
+/// Estimates V-tau, V-B, V-E, V-L and V-I along the eye ray of `scene` with
+/// `n` delta-tracking walks, the way a renderer does (pbrt-v4's volumetric
+/// path tracer, restricted to single scattering toward the light):
+///
+/// A walk draws tentative collisions `t_i` at the piecewise-constant rate
+/// `mu` (the span's majorant `sigma_bar`; `1 / span length` on a span whose
+/// majorant is 0) and stops at the first that is real (probability
+/// `sigma(t_i) / mu`). At every tentative collision before it stops, the
+/// stopping one included, it scores
+///
+/// `[c(v(t_i)) + I_p^(t_i) s(t_i)] / mu(t_i)`,
+///
+/// with `c` the emission map, `s = albedo sigma / (4 pi)` (V-L with single
+/// scattering) or 1 (V-L as printed), and `I_p^(t)` the light reaching
+/// `r(t)` (V-Lp): `I_p exp(-lambda int v)` along the shadow ray in closed
+/// form where `shadow` allows and the medium has one, else `I_p` times one
+/// ratio-tracking walk of the shadow ray (an unbiased estimate of its
+/// transmittance, drawn independently of the eye walk).
+///
+/// Unbiased: the tentative collisions are a Poisson process of rate `mu`,
+/// and the walk is still going at `t` exactly when no real collision fell
+/// in `[t_n, t)`, which has probability `tau(t_n, t)` (real collisions are
+/// the thinned process of rate `sigma`). So the expected sum is
+/// `int mu(t) tau(t_n, t) [c + I_p(t) s] / mu dt = I_E + I_L` (V-E, V-L),
+/// for every `mu > 0` with `mu >= sigma`, also where `sigma = 0` (where a
+/// collision estimator `c / sigma` at the real collision would be undefined
+/// and miss the emission). With `s = albedo sigma / (4 pi)` this is the
+/// expectation, over the real/null choice, of the renderer's next-event
+/// estimate at real collisions (`albedo I_p^ / (4 pi)` with probability
+/// `sigma / mu`); the emission part is pbrt-v4's `sigma_a L_e / sigma_maj` at
+/// every majorant event. A walk that leaves the looked-at part scores
+/// `tau = 1` and `I_b` for V-B.
+pub fn radiance<Rg: rand::Rng + ?Sized>(
+    scene: &VolumeScene,
+    shadow: ShadowMethod,
+    wanted: Wanted,
+    n: usize,
+    rng: &mut Rg,
+) -> Result<Radiance, QuadError> {
+    scene.validate()?;
+    let (t0, t1) = (scene.t_min, scene.t_max);
+    check(scene.lambda, t0, t1, n)?;
+    let lambda = scene.lambda;
+    let ray = scene.ray;
+    let background = scene.background.unwrap_or(0.0);
+    let emission = scene.emission.filter(|_| wanted.emission);
+    let light = scene.light.filter(|_| wanted.light);
+    let Some(medium) = scene.medium.as_deref() else {
+        // No medium: tau = 1, I_B = I_b, no emission and no scattering.
+        let exact = |value: f64| Tracked {
+            value,
+            error: 0.0,
+            evaluations: 0,
+            walks: n as u64,
+            all_alike: false,
+        };
+        return Ok(Radiance {
+            tau: exact(1.0),
+            background: exact(background),
+            emission: exact(0.0),
+            light: exact(0.0),
+            total: exact(background),
+        });
+    };
+    let sigma = Extinction { medium, lambda };
+    let mut evaluations = 0u64;
+    let spans = spans(Tracker::Delta, sigma, &ray, t0, t1, &mut evaluations)?;
+    let scoring = emission.is_some() || light.is_some();
+
+    // The largest score one tentative collision can add on a span, for the
+    // bound of Tracked::all_alike: |c| at the density bound (c is monotone in
+    // v) and I_p s at the density bound, over the rate.
+    let rate = |span: &Span| {
+        if span.bar > 0.0 {
+            span.bar
+        } else {
+            1.0 / (span.b - span.a)
+        }
+    };
+    let mut one_emission: f64 = 0.0;
+    let mut one_light: f64 = 0.0;
+    for span in &spans {
+        if let Some(map) = emission {
+            one_emission = one_emission.max(map.at(span.v_bar).abs() / rate(span));
+        }
+        if let Some(l) = light {
+            let s = l.albedo.map_or(1.0, |a| a * span.bar / (4.0 * PI));
+            one_light = one_light.max(l.intensity * s / rate(span));
+        }
+    }
+
+    let (mut tau_s, mut bg_s, mut em_s, mut li_s, mut tot_s) = (
+        Scores::default(),
+        Scores::default(),
+        Scores::default(),
+        Scores::default(),
+        Scores::default(),
+    );
+    for _ in 0..n {
+        let (mut alive, mut em, mut li) = (true, 0.0, 0.0);
+        'spans: for span in &spans {
+            // Spans without extinction are crossed without tentative
+            // collisions unless emission or light is scored on them.
+            if span.bar <= 0.0 && !scoring {
                 continue;
             }
+            let mu = rate(span);
             let mut t = span.a;
             let mut collisions = 0u64;
             loop {
-                // Free flight: -ln(1 - xi) / majorant, xi in [0, 1).
-                t -= (-rng.random::<f64>()).ln_1p() / span.majorant;
+                // Free flight: -ln(1 - xi) / mu, xi in [0, 1).
+                t -= (-rng.random::<f64>()).ln_1p() / mu;
                 if t >= span.b {
                     break;
                 }
                 evaluations += 1;
                 collisions += 1;
                 if collisions > MAX_COLLISIONS {
-                    return Err(QuadError::invalid(
-                        "optical depth",
-                        span.majorant * (span.b - span.a),
-                        format!(
-                            "at most {MAX_COLLISIONS} tentative collisions per walk and span: \
-                             the majorant's optical depth is too large for tracking"
-                        ),
-                    ));
+                    return Err(too_deep(span));
                 }
-                let sigma = lambda * medium.density(ray.at(t));
-                match tracker {
-                    Tracker::Delta => {
-                        if rng.random::<f64>() < sigma / span.bar {
-                            score = 0.0;
-                            break;
+                let p = ray.at(t);
+                let v = medium.density(p);
+                let sigma_t = lambda * v;
+                if let Some(map) = emission {
+                    em += map.at(v) / mu;
+                }
+                if let Some(l) = light {
+                    let shadow_ray = Ray {
+                        origin: p,
+                        dir: l.toward_light,
+                    };
+                    let closed = match shadow {
+                        ShadowMethod::ClosedFormWhereAvailable => {
+                            medium.density_integral(&shadow_ray, 0.0, f64::INFINITY)
                         }
-                    }
-                    Tracker::Ratio => score *= 1.0 - sigma / span.bar,
-                    Tracker::ResidualRatio => score *= 1.0 - (sigma - span.control) / span.majorant,
+                        ShadowMethod::Quadrature => None,
+                    };
+                    let shadow_tau = match closed {
+                        Some(integral) => (-lambda * integral).exp(),
+                        None => {
+                            let mut evals = 0;
+                            let s = spans_of_shadow(sigma, &shadow_ray, &mut evals)?;
+                            let tau =
+                                walk(Tracker::Ratio, sigma, &shadow_ray, &s, &mut evals, rng)?;
+                            evaluations += evals;
+                            tau
+                        }
+                    };
+                    let s = l.albedo.map_or(1.0, |a| a * sigma_t / (4.0 * PI));
+                    li += l.intensity * shadow_tau * s / mu;
                 }
-            }
-            if score == 0.0 {
-                break;
+                if rng.random::<f64>() < sigma_t / mu {
+                    alive = false;
+                    break 'spans;
+                }
             }
         }
-        walks.add(score);
+        let tau = if alive { 1.0 } else { 0.0 };
+        tau_s.add(tau);
+        bg_s.add(background * tau);
+        em_s.add(em);
+        li_s.add(li);
+        tot_s.add(em + background * tau + li);
     }
-    Ok(Estimate::random(
-        walks.mean(),
-        walks.standard_error(),
+    let tau = tau_s.binary(evaluations);
+    let scaled = |t: Tracked, s: f64| Tracked {
+        value: t.value * s,
+        error: t.error * s,
+        ..t
+    };
+    // An unseen outcome moves a V-E, V-L or V-I score by at most the larger
+    // of its own size and one tentative collision's largest score (plus I_b
+    // for the escape or not of V-I).
+    let unseen = |one: f64| move |x: f64| x.abs().max(one);
+    // A term the scene lacks (or that was not asked for) is exactly 0.
+    let term = |present: bool, scores: &Scores, one: f64| {
+        if present {
+            scores.tracked(evaluations, unseen(one))
+        } else {
+            Tracked {
+                value: 0.0,
+                error: 0.0,
+                evaluations,
+                walks: n as u64,
+                all_alike: false,
+            }
+        }
+    };
+    Ok(Radiance {
+        tau,
+        background: scaled(tau, background),
+        emission: term(emission.is_some(), &em_s, one_emission),
+        light: term(light.is_some(), &li_s, one_light),
+        total: tot_s.tracked(evaluations, unseen(one_emission + one_light + background)),
+    })
+}
+
+/// The ratio-tracking spans of a shadow ray from its origin to infinity.
+fn spans_of_shadow(
+    sigma: Extinction,
+    shadow_ray: &Ray,
+    evaluations: &mut u64,
+) -> Result<Vec<Span>, QuadError> {
+    spans(
+        Tracker::Ratio,
+        sigma,
+        shadow_ray,
+        0.0,
+        f64::INFINITY,
         evaluations,
-    ))
+    )
 }
