@@ -409,6 +409,9 @@ fn plot(
         (10f64.powf(a), 10f64.powf(b))
     };
     let (x0, x1) = decades(x0, x1);
+    // A decade below the floor line, so it is not drawn on the axis.
+    let at_floor = pts.iter().any(|&(_, y)| y <= floor);
+    let y0 = if at_floor { y0.min(floor / 10.0) } else { y0 };
     let (y0, y1) = decades(y0, y1);
     // The legend panel is wide enough for a product label of two rule names.
     let root = SVGBackend::new(path, (1020, 520)).into_drawing_area();
