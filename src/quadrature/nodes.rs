@@ -42,6 +42,11 @@ pub struct ProductSum<V: Value> {
     pub value: V,
     /// The same sum with the companion weights, when every axis has them.
     pub companion: Option<V>,
+    /// `sum_i |prod_d w_{i_d} f(u_i)|`, the scale of the sum's rounding error:
+    /// a difference of two rules below a small multiple of `eps` times it is
+    /// rounding, not truncation. A plain sum: its own `n eps` relative error
+    /// does not matter for a scale.
+    pub magnitude: V,
     /// Integrand evaluations.
     pub evaluations: u64,
 }
@@ -57,11 +62,13 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
     let with_companion = axes.iter().all(|a| a.companion.is_some());
     let mut acc = Compensated::<V>::new();
     let mut acc_c = Compensated::<V>::new();
+    let mut magnitude = V::zero();
     let mut evaluations = 0u64;
     if axes.iter().any(|a| a.is_empty()) {
         return Ok(ProductSum {
             value: V::zero(),
             companion: with_companion.then(V::zero),
+            magnitude,
             evaluations,
         });
     }
@@ -79,7 +86,9 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
                     if !y.all_finite() {
                         return Err(non_finite(&p, &y));
                     }
-                    acc.add(y.map(|v| v * w));
+                    let wy = y.map(|v| v * w);
+                    acc.add(wy);
+                    magnitude = magnitude.zip(wy, |m, v| m + v.abs());
                 }
             }
             Some(companion) => {
@@ -89,7 +98,9 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
                     if !y.all_finite() {
                         return Err(non_finite(&p, &y));
                     }
-                    acc.add(y.map(|v| v * w));
+                    let wy = y.map(|v| v * w);
+                    acc.add(wy);
+                    magnitude = magnitude.zip(wy, |m, v| m + v.abs());
                     acc_c.add(y.map(|v| v * c));
                 }
             }
@@ -114,7 +125,9 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
             if !y.all_finite() {
                 return Err(non_finite(&p, &y));
             }
-            acc.add(y.map(|v| v * w));
+            let wy = y.map(|v| v * w);
+            acc.add(wy);
+            magnitude = magnitude.zip(wy, |m, v| m + v.abs());
             if with_companion {
                 acc_c.add(y.map(|v| v * wc));
             }
@@ -125,6 +138,7 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
                     return Ok(ProductSum {
                         value: acc.total(),
                         companion: with_companion.then(|| acc_c.total()),
+                        magnitude,
                         evaluations,
                     });
                 }
@@ -140,6 +154,7 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
     Ok(ProductSum {
         value: acc.total(),
         companion: with_companion.then(|| acc_c.total()),
+        magnitude,
         evaluations,
     })
 }
