@@ -234,6 +234,7 @@ fn shared_unit_nodes(n: usize) -> Result<Arc<UnitNodes>, QuadError> {
         u,
         w,
         companion: None,
+        companion4: None,
     });
     if let Ok(mut c) = cache.lock() {
         let cached: usize = c.values().map(|v| v.len()).sum();
@@ -308,7 +309,7 @@ const ROUNDING_ULPS: f64 = 128.0;
 /// (their sums agree), and an oscillating error can, rarely, repeat itself
 /// across the four orders (about 0.7% of random jump and kink positions at
 /// 33 to 8193 nodes leave the estimate below a tenth of the error, against
-/// 1.3% for the consecutive orders); no test on these four sums tells either apart
+/// 2.2% for the consecutive orders); no test on these four sums tells either apart
 /// from convergence without doubting smooth integrands too.
 ///
 /// The consecutive orders `m-1, m-2` of [`tail_estimate`] cannot see
