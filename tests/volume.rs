@@ -431,8 +431,9 @@ fn a_scene_evaluates_only_the_terms_it_has() {
     .expect("finite");
     assert!(res.emission.is_none() && res.light.is_none() && res.background.is_none());
     assert_eq!(res.evaluated, vec!["V-tau", "V-I"]);
-    // Gauss–Legendre spends m + (m-1) + (m-2) with its error estimate.
-    assert_eq!(res.optical_depth.evaluations, 50 + 49 + 48);
+    // Gauss–Legendre spends m + (m-1) + (m-2) + ceil(m/2) with its error
+    // estimate.
+    assert_eq!(res.optical_depth.evaluations, 50 + 49 + 48 + 25);
 }
 
 #[test]

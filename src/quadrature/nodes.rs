@@ -21,6 +21,9 @@ pub struct UnitNodes {
     /// Weights of a lower-order companion rule on the same nodes (zero where
     /// the companion has no node), when the rule has one.
     pub companion: Option<Vec<f64>>,
+    /// Weights of the companion's own companion (a composite rule's `4h`
+    /// rule), when the node set nests it.
+    pub companion4: Option<Vec<f64>>,
 }
 
 impl UnitNodes {
@@ -42,6 +45,13 @@ pub struct ProductSum<V: Value> {
     pub value: V,
     /// The same sum with the companion weights, when every axis has them.
     pub companion: Option<V>,
+    /// The same sum with the `companion4` weights, when every axis has them.
+    pub companion4: Option<V>,
+    /// `sum_i |prod_d w_{i_d} f(u_i)|`, the scale of the sum's rounding error:
+    /// a difference of two rules below a small multiple of `eps` times it is
+    /// rounding, not truncation. A plain sum: its own `n eps` relative error
+    /// does not matter for a scale.
+    pub magnitude: V,
     /// Integrand evaluations.
     pub evaluations: u64,
 }
@@ -55,13 +65,18 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
     mut f: F,
 ) -> Result<ProductSum<V>, QuadError> {
     let with_companion = axes.iter().all(|a| a.companion.is_some());
+    let with_companion4 = axes.iter().all(|a| a.companion4.is_some());
     let mut acc = Compensated::<V>::new();
     let mut acc_c = Compensated::<V>::new();
+    let mut acc_c4 = Compensated::<V>::new();
+    let mut magnitude = V::zero();
     let mut evaluations = 0u64;
     if axes.iter().any(|a| a.is_empty()) {
         return Ok(ProductSum {
             value: V::zero(),
             companion: with_companion.then(V::zero),
+            companion4: with_companion4.then(V::zero),
+            magnitude,
             evaluations,
         });
     }
@@ -79,18 +94,32 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
                     if !y.all_finite() {
                         return Err(non_finite(&p, &y));
                     }
-                    acc.add(y.map(|v| v * w));
+                    let wy = y.map(|v| v * w);
+                    acc.add(wy);
+                    magnitude = magnitude.zip(wy, |m, v| m + v.abs());
                 }
             }
             Some(companion) => {
-                for ((&u, &w), &c) in a.u.iter().zip(&a.w).zip(companion) {
+                // The 4h weights, or zeros summed into a total nobody reads.
+                let none = [0.0];
+                let (c4, stride) = match a.companion4.as_deref() {
+                    Some(c4) => (c4, 1),
+                    None => (&none[..], 0),
+                };
+                for (i, ((&u, &w), &c)) in a.u.iter().zip(&a.w).zip(companion).enumerate() {
                     p[0] = u;
                     let y = f(p)?;
                     if !y.all_finite() {
                         return Err(non_finite(&p, &y));
                     }
-                    acc.add(y.map(|v| v * w));
+                    let wy = y.map(|v| v * w);
+                    acc.add(wy);
+                    magnitude = magnitude.zip(wy, |m, v| m + v.abs());
                     acc_c.add(y.map(|v| v * c));
+                    let c4 = c4[i * stride];
+                    if c4 != 0.0 {
+                        acc_c4.add(y.map(|v| v * c4));
+                    }
                 }
             }
         }
@@ -102,11 +131,15 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
             let mut p = [0.0; D];
             let mut w = 1.0;
             let mut wc = 1.0;
+            let mut wc4 = 1.0;
             for d in 0..D {
                 p[d] = axes[d].u[idx[d]];
                 w *= axes[d].w[idx[d]];
                 if with_companion {
                     wc *= axes[d].companion.as_ref().map_or(0.0, |c| c[idx[d]]);
+                }
+                if with_companion4 {
+                    wc4 *= axes[d].companion4.as_ref().map_or(0.0, |c| c[idx[d]]);
                 }
             }
             let y = f(p)?;
@@ -114,9 +147,14 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
             if !y.all_finite() {
                 return Err(non_finite(&p, &y));
             }
-            acc.add(y.map(|v| v * w));
+            let wy = y.map(|v| v * w);
+            acc.add(wy);
+            magnitude = magnitude.zip(wy, |m, v| m + v.abs());
             if with_companion {
                 acc_c.add(y.map(|v| v * wc));
+            }
+            if with_companion4 && wc4 != 0.0 {
+                acc_c4.add(y.map(|v| v * wc4));
             }
             // Advance the odometer, last axis fastest.
             let mut d = D;
@@ -125,6 +163,8 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
                     return Ok(ProductSum {
                         value: acc.total(),
                         companion: with_companion.then(|| acc_c.total()),
+                        companion4: with_companion4.then(|| acc_c4.total()),
+                        magnitude,
                         evaluations,
                     });
                 }
@@ -140,6 +180,8 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
     Ok(ProductSum {
         value: acc.total(),
         companion: with_companion.then(|| acc_c.total()),
+        companion4: with_companion4.then(|| acc_c4.total()),
+        magnitude,
         evaluations,
     })
 }
@@ -217,18 +259,45 @@ impl Composite {
     }
 }
 
-/// A composite rule's sum as an estimate with Richardson's error estimate
-/// `|Q_h - Q_2h| / (2^p - 1)` for a rule of order `p`, the `2h` rule being the
-/// companion on the same nodes (free: no extra evaluation).
+/// A composite rule's sum as an estimate with Richardson's error estimate for
+/// a rule of order `p`, checked against the order the differences show.
+///
+/// With `d = Q_h - Q_2h` (the companion: no extra evaluation) Richardson's
+/// estimate is `|d| / (2^p - 1)`: right when the error is `C h^p`. A jump,
+/// kink or endpoint singularity lowers the order (`O(h)` for a jump), and
+/// then dividing by `2^p - 1` (15 for Simpson) under-states the error. When
+/// the node set also nests the `4h` rule (`companion4`), the observed ratio
+/// `rho = (Q_2h - Q_4h) / d` (`2^p` for order `p`) decides:
+///
+/// - `rho > 3/2`: the differences shrink geometrically by `rho` per halving,
+///   so the error of `Q_h` is `|d| / (min(rho, 2^p) - 1)`: Richardson's
+///   estimate when the order is at least `p`, larger when the observed order
+///   `log2(rho)` is lower.
+/// - otherwise (no convergence pattern: a sign change, as the error of a
+///   jump between nodes oscillates with `h`, or differences that do not
+///   shrink): `max(|d|, |Q_2h - Q_4h|)`, the larger of the two differences
+///   undivided.
+///
+/// Without the `4h` rule only `|d| / (2^p - 1)` is available.
 pub fn richardson<V: Value>(sum: ProductSum<V>, order: i32) -> Estimate<V> {
     let coarse = sum.companion.unwrap_or(sum.value);
-    let divisor = 2f64.powi(order) - 1.0;
-    Estimate::deterministic(
-        sum.value,
-        sum.value
-            .zip(coarse, |fine, coarse| (fine - coarse).abs() / divisor),
-        sum.evaluations,
-    )
+    let full = 2f64.powi(order);
+    let error = match sum.companion4 {
+        None => sum
+            .value
+            .zip(coarse, |fine, coarse| (fine - coarse).abs() / (full - 1.0)),
+        Some(coarser) => V::from_fn(|c| {
+            let d = sum.value.channel(c) - coarse.channel(c);
+            let d2 = coarse.channel(c) - coarser.channel(c);
+            let rho = d2 / d;
+            if rho > 1.5 {
+                d.abs() / (rho.min(full) - 1.0)
+            } else {
+                d.abs().max(d2.abs())
+            }
+        }),
+    };
+    Estimate::deterministic(sum.value, error, sum.evaluations)
 }
 
 /// The error for a non-finite integrand value at unit-cube point `p`.

@@ -55,7 +55,8 @@ fn weights(m: usize, h: f64, stride: usize) -> Vec<f64> {
 }
 
 /// The m-point Simpson rule on `[0, 1]` (m odd, >= 3), with the `2h` companion
-/// (a Simpson rule itself when `m = 4k + 1`, which the rule uses).
+/// (a Simpson rule itself when `m = 4k + 1`, which the rule uses), and the
+/// `4h` Simpson rule when `m = 8k + 1`.
 pub fn unit_nodes(m: usize) -> UnitNodes {
     let intervals = (m - 1) as f64;
     let h = 1.0 / intervals;
@@ -63,6 +64,8 @@ pub fn unit_nodes(m: usize) -> UnitNodes {
         u: (0..m).map(|i| i as f64 / intervals).collect(),
         w: weights(m, h, 1),
         companion: Some(weights(m, h, 2)),
+        // The 4h Simpson rule on every fourth point, when the points nest it.
+        companion4: (m % 8 == 1).then(|| weights(m, h, 4)),
     }
 }
 

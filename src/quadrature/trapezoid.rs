@@ -32,7 +32,8 @@ const COMPOSITE: Composite = Composite {
 #[serde(deny_unknown_fields)]
 pub struct Trapezoid;
 
-/// The m-point trapezoid rule on `[0, 1]` (m odd, >= 3) with the `2h` companion.
+/// The m-point trapezoid rule on `[0, 1]` (m odd, >= 3) with the `2h`
+/// companion, and the `4h` rule when `m = 4k + 1`.
 pub fn unit_nodes(m: usize) -> UnitNodes {
     let intervals = (m - 1) as f64;
     let h = 1.0 / intervals;
@@ -47,10 +48,21 @@ pub fn unit_nodes(m: usize) -> UnitNodes {
             _ => 2.0 * h,
         })
         .collect();
+    // The 4h rule on every fourth point, when the points nest it.
+    let companion4 = (m % 4 == 1).then(|| {
+        (0..m)
+            .map(|i| match i {
+                _ if i % 4 != 0 => 0.0,
+                _ if i == 0 || i == m - 1 => 2.0 * h,
+                _ => 4.0 * h,
+            })
+            .collect()
+    });
     UnitNodes {
         u,
         w,
         companion: Some(companion),
+        companion4,
     }
 }
 
