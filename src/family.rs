@@ -424,6 +424,12 @@ pub trait Family: Sized + Send + Sync + 'static {
     fn audit() -> Option<String> {
         None
     }
+
+    /// A section of one experiment's report on its own scene (for instance the
+    /// document's printed formulas evaluated in it), as Markdown, if any.
+    fn scene_audit(_scene: &Self::Scene) -> Option<String> {
+        None
+    }
 }
 
 /// Serde for floats in results files that keeps the non-finite ones: JSON has

@@ -81,6 +81,7 @@ fn built(scene: VolumeScene, scheme: DepthScheme, shadow: ShadowMethod) -> Built
         scheme,
         shadow,
         sphere_kappa: None,
+        printed: None,
     }
 }
 

@@ -779,3 +779,81 @@ fn a_constant_emission_map_emits_only_where_the_density_is_positive() {
         );
     }
 }
+
+/// Issue 9, item 12: the printed formulas are runnable. Unit sphere at the
+/// origin, eye ray along +x at height h from x = -3, light straight behind
+/// the eye (d = -x), sigma = lambda kappa. On the chord, x in [-a, a] with
+/// a = sqrt(1 - h^2), the printed radicand is <p,d>^2 - <p,p> = -h^2 < 0
+/// everywhere, so in real arithmetic the printed I_L is undefined; with the
+/// printed exponent `z = sigma <p,d> + root = -sigma x + root`:
+/// - clamped root 0: `I_L = int_{-a}^{a} e^{-sigma (x + a)} e^{-sigma x} dx
+///   = (e^{sigma a} - e^{-3 sigma a}) / (2 sigma)`;
+/// - principal complex root `i h`: the same times `e^{i h}`;
+/// - corrected: `(1 - e^{-4 sigma a}) / (2 sigma)` (light behind the eye);
+/// - printed I_B: `e^{-2 sigma a} I_b - 2 sigma a`, corrected `e^{-2 sigma a} I_b`.
+#[test]
+fn printed_formulas_evaluate_to_their_closed_forms_in_every_arithmetic() {
+    use lightquad::family::Family;
+    use lightquad::volume::experiment::Volume;
+    use lightquad::volume::printed::{self, Printed, Sphere};
+    let (h, kappa, lambda, b) = (0.3f64, 0.8, 1.25, 0.5);
+    let spec = serde_json::from_value(serde_json::json!({
+        "ray": { "origin": [-3.0, h, 0.0], "direction": [1.0, 0.0, 0.0] },
+        "lambda": lambda,
+        "medium": { "type": "constant-sphere", "centre": [0.0, 0.0, 0.0], "radius": 1.0, "kappa": kappa },
+        "background": b,
+        "light": { "toward_light": [-1.0, 0.0, 0.0], "intensity": 1.0 },
+        "printed": ["s", "exponent", "background"]
+    }))
+    .expect("a volume scene");
+    let built = Volume::build(&spec).expect("valid");
+    let sigma = lambda * kappa;
+    let a = (1.0 - h * h).sqrt();
+    let clamped = ((sigma * a).exp() - (-3.0 * sigma * a).exp()) / (2.0 * sigma);
+    let corrected = -(-4.0 * sigma * a).exp_m1() / (2.0 * sigma);
+    let (scene, _) = built.scene.anchored();
+    let sphere = Sphere {
+        centre: Vec3::zeros(),
+        radius: 1.0,
+        kappa,
+    };
+    let all = [Printed::S, Printed::Exponent, Printed::Background];
+    let chord = (-a, a);
+    let v = printed::evaluate(&scene, &sphere, &all, chord).expect("evaluates");
+    let l = v.light.expect("I_L");
+    assert_eq!(l.real, None);
+    assert_eq!(l.negative_share, 1.0);
+    assert!(
+        rel(l.clamped, clamped) < 1e-12,
+        "{} vs {clamped}",
+        l.clamped
+    );
+    assert!(
+        rel(l.complex.0, clamped * h.cos()) < 1e-12,
+        "{:?}",
+        l.complex
+    );
+    assert!(
+        rel(l.complex.1, clamped * h.sin()) < 1e-12,
+        "{:?}",
+        l.complex
+    );
+    assert!(
+        rel(l.corrected, corrected) < 1e-12,
+        "{} vs {corrected}",
+        l.corrected
+    );
+    let (pb, cb) = v.background.expect("I_B");
+    assert!(rel(pb, (-2.0 * sigma * a).exp() * b - 2.0 * sigma * a) < 1e-14);
+    assert!(rel(cb, (-2.0 * sigma * a).exp() * b) < 1e-14);
+    // The report section shows them; a scene without a light cannot ask for s.
+    let section = Volume::scene_audit(&built).expect("a section");
+    assert!(
+        section.contains("undefined: radicand < 0 on 100.0% of the chord"),
+        "{section}"
+    );
+    let mut no_light = spec.clone();
+    no_light.light = None;
+    let err = Volume::build(&no_light).expect_err("refused").to_string();
+    assert!(err.contains("scene.printed[0]"), "{err}");
+}

@@ -131,6 +131,7 @@ fn page<'a, F: Family>(
         targets: &spec.targets,
         reference,
         crosscheck,
+        scene_audit: F::scene_audit(&exp.scene),
     }
 }
 

@@ -51,6 +51,8 @@ pub struct Page<'a> {
     pub reference: &'a Reference,
     /// The Mitsuba comparison rows (may be empty).
     pub crosscheck: &'a [Crosscheck],
+    /// The family's section on this scene (e.g. printed formulas), if any.
+    pub scene_audit: Option<String>,
 }
 
 /// A rule or estimator as a report sees it.
@@ -516,6 +518,9 @@ pub struct Ranked {
 /// Writes `report.md`, the SVG plots and `results.csv` of one experiment.
 pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Result<Summary, String> {
     let mut md = header(page, results);
+    if let Some(audit) = &page.scene_audit {
+        let _ = writeln!(md, "{audit}");
+    }
     let mut summary = Summary::new();
     for &q in &page.quantities {
         let Some(reference) = page.reference.values.get(q) else {

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+use super::printed::{self, Printed};
 use super::tracking::{Extinction, Tracked, Tracker, Wanted, radiance, transmittance};
 use super::{
     ConstantSphere, DepthScheme, DirectionalLight, EmissionMap, GaussianBlob, GaussianBlobs,
@@ -59,6 +60,11 @@ pub struct SceneSpec {
     /// The directional light, if any.
     #[serde(default)]
     pub light: Option<LightSpec>,
+    /// Audit points of docs/EQUATIONS.md whose printed forms the report
+    /// evaluates in this scene beside the corrected ones (constant sphere
+    /// only; `s` and `exponent` need a light, `background` a background).
+    #[serde(default)]
+    pub printed: Vec<Printed>,
 }
 
 /// A ray `e + t v`.
@@ -261,6 +267,8 @@ pub struct Built {
     pub shadow: ShadowMethod,
     /// `kappa` of a constant-sphere medium (its closed forms need it).
     pub sphere_kappa: Option<f64>,
+    /// The constant sphere, and the printed forms to evaluate in it.
+    pub printed: Option<(printed::Sphere, Vec<Printed>)>,
 }
 
 impl Family for Volume {
@@ -291,7 +299,18 @@ impl Family for Volume {
                 Some(MediumSpec::ConstantSphere { kappa, .. }) => Some(kappa),
                 _ => None,
             },
+            printed: printed_forms(spec)?,
         })
+    }
+
+    fn scene_audit(built: &Built) -> Option<String> {
+        let (sphere, forms) = built.printed.as_ref()?;
+        let (scene, _) = built.scene.anchored();
+        let chord = scene.medium.as_ref().and_then(|m| {
+            let pieces = m.support(&scene.ray, scene.t_min, scene.t_max);
+            Some((pieces.first()?.start(), pieces.last()?.end()))
+        });
+        Some(printed::section(&scene, sphere, forms, chord))
     }
 
     /// Every volume integral is along a ray segment.
@@ -727,6 +746,49 @@ fn medium(spec: &MediumSpec) -> Result<Arc<dyn Medium>, SpecError> {
 }
 
 /// Builds the scene, naming the path of any bad number.
+/// The printed forms an experiment asks for, checked against its scene.
+fn printed_forms(spec: &SceneSpec) -> Result<Option<(printed::Sphere, Vec<Printed>)>, SpecError> {
+    if spec.printed.is_empty() {
+        return Ok(None);
+    }
+    let Some(MediumSpec::ConstantSphere {
+        centre,
+        radius,
+        kappa,
+    }) = spec.medium
+    else {
+        return Err(SpecError::at(
+            "scene.printed",
+            "the printed formulas are written for a constant-density sphere: give a \
+             constant-sphere medium, or leave printed out"
+                .to_string(),
+        ));
+    };
+    for (i, p) in spec.printed.iter().enumerate() {
+        let missing = match p {
+            Printed::S | Printed::Exponent if spec.light.is_none() => Some("a light"),
+            Printed::Background if spec.background.is_none() => Some("a background"),
+            _ => None,
+        };
+        if let Some(what) = missing {
+            return Err(SpecError::at(
+                format!("scene.printed[{i}]"),
+                format!(
+                    "{p:?} is a printed form of a term the scene does not have: give it {what}"
+                ),
+            ));
+        }
+    }
+    Ok(Some((
+        printed::Sphere {
+            centre: Vec3::new(centre[0], centre[1], centre[2]),
+            radius,
+            kappa,
+        },
+        spec.printed.clone(),
+    )))
+}
+
 fn scene(s: &SceneSpec) -> Result<VolumeScene, SpecError> {
     let ray = Ray::new(vec3(s.ray.origin), vec3(s.ray.direction))
         .map_err(|e| SpecError::from_quad("scene.ray", e))?;

@@ -9,6 +9,7 @@ pub mod experiment;
 pub mod gaussian_blobs;
 pub mod linear_gradient;
 pub mod medium;
+pub mod printed;
 pub mod scene;
 pub mod terms;
 pub mod tracking;
