@@ -482,3 +482,56 @@ fn transfer_table_interpolates_linearly_and_clamps_at_the_ends() {
     }
     assert_eq!(t.at(0.0), 0.0);
 }
+
+/// A 1-D voxel grid (4 voxels over x in [-1, 1], values 0.2, 1.0, 1.4, 0.5
+/// at the centres -0.75, -0.25, 0.25, 0.75, held constant in the half-voxel
+/// margins) read through the table [`POINTS`], nothing absorbing, the ray
+/// along x: `I_E = int_{-1}^{1} c(v(x)) dx` with `v` linear between the
+/// centres. Its knot crossings (bracketed: the grid has no closed form for
+/// them) are found here by inverting each linear piece by hand; the
+/// reference is an adaptive Simpson cut at the centres and those crossings.
+/// With the cuts, `c(v(x))` is linear on every piece, so 2 Gauss–Legendre
+/// nodes per piece are exact up to rounding.
+#[test]
+fn transfer_table_on_a_voxel_grid_brackets_its_knots() {
+    let xs = [-0.75, -0.25, 0.25, 0.75];
+    let vs = [0.2, 1.0, 1.4, 0.5];
+    let grid = lightquad::volume::VoxelGrid::new(
+        Vec3::new(-1.0, -1.0, -1.0),
+        Vec3::new(1.0, 1.0, 1.0),
+        [4, 1, 1],
+        vs.to_vec(),
+    )
+    .expect("valid grid");
+    let mut scene = VolumeScene::new(ray([-3.0, 0.1, 0.2], [1.0, 0.0, 0.0]));
+    scene.medium = Some(Arc::new(grid));
+    scene.lambda = 0.0;
+    scene.emission = Some(EmissionMap::Table(
+        TransferTable::new(POINTS.to_vec()).expect("valid table"),
+    ));
+    let v = |x: f64| {
+        if x <= xs[0] {
+            return vs[0];
+        }
+        if x >= xs[3] {
+            return vs[3];
+        }
+        let i = xs.iter().rposition(|&c| c <= x).expect("inside");
+        let i = i.min(2);
+        vs[i] + (vs[i + 1] - vs[i]) * (x - xs[i]) / (xs[i + 1] - xs[i])
+    };
+    let mut cuts = vec![-1.0, 1.0];
+    cuts.extend(xs);
+    for i in 0..3 {
+        for (vk, _) in POINTS {
+            let u = (vk - vs[i]) / (vs[i + 1] - vs[i]);
+            if 0.0 < u && u < 1.0 {
+                cuts.push(xs[i] + u * (xs[i + 1] - xs[i]));
+            }
+        }
+    }
+    cuts.sort_by(f64::total_cmp);
+    let reference = simpson_pieces(&|x| c_by_hand(v(x)), &cuts, 1e-17);
+    let got = i_e(&scene, &gl(), 2);
+    assert!(rel(got, reference) < 1e-13, "{got} vs {reference}");
+}

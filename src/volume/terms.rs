@@ -76,7 +76,9 @@ pub struct Term {
     /// the cumulative scheme; for a Monte Carlo rule in the nested scheme the
     /// noisy inner depth also biases `exp(-depth)` slightly, by Jensen).
     pub error: f64,
-    /// Density evaluations spent on this term.
+    /// Density evaluations spent on this term; for V-E also the evaluations
+    /// of an emission field, and those spent bracketing a transfer table's
+    /// knot crossings where the medium has no closed form for them.
     pub evaluations: u64,
     /// Whether `error` is a deterministic estimate or a standard error.
     pub kind: ErrorKind,
