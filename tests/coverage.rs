@@ -82,6 +82,7 @@ fn built(scene: VolumeScene, scheme: DepthScheme, shadow: ShadowMethod) -> Built
         shadow,
         sphere_kappa: None,
         printed: None,
+        field_sphere_value: None,
     }
 }
 

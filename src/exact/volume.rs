@@ -49,6 +49,37 @@ pub fn emission(sigma: f64, chord: f64, c: f64) -> f64 {
     -c * (-sigma * chord).exp_m1() / sigma
 }
 
+/// V-E with an emission field of its own, constant `c` on `[e0, e1]`, seen
+/// through an extinction constant `sigma` on `[a, b]` and 0 elsewhere along
+/// the ray (two spheres of constant value: the density's chord and the
+/// field's). The optical depth from the start of the ray to `t` is
+/// `sigma |[a, min(t, b)]|`, so `[e0, e1]` splits into three parts:
+///
+/// - before `a`, `tau = 1`: `c |[e0, e1] ∩ (-inf, a]|`;
+/// - `[lo, hi] = [e0, e1] ∩ [a, b]`: `c int_lo^hi e^{-sigma (t - a)} dt =
+///   c e^{-sigma (lo - a)} (1 - e^{-sigma (hi - lo)}) / sigma` (`expm1`, and
+///   `c (hi - lo)` at `sigma = 0`);
+/// - after `b`, `tau = e^{-sigma (b - a)}`: `c e^{-sigma (b - a)} |[e0, e1] ∩ [b, inf)|`.
+pub fn emission_field_interval(
+    sigma: f64,
+    (a, b): (f64, f64),
+    c: f64,
+    (e0, e1): (f64, f64),
+) -> f64 {
+    let len = |lo: f64, hi: f64| (hi - lo).max(0.0);
+    let before = len(e0, e1.min(a));
+    let (lo, hi) = (e0.max(a), e1.min(b));
+    let inside = if hi <= lo {
+        0.0
+    } else if sigma == 0.0 {
+        hi - lo
+    } else {
+        (-sigma * (lo - a)).exp() * -(-sigma * (hi - lo)).exp_m1() / sigma
+    };
+    let after = (-sigma * (b - a)).exp() * len(e0.max(b), e1);
+    c * (before + inside + after)
+}
+
 /// The single-scattering factor of V-L: `albedo sigma / (4 pi)`, or 1 for the
 /// document's reduced form (`albedo = None`).
 fn scattering(sigma: f64, albedo: Option<f64>) -> f64 {

@@ -55,6 +55,19 @@ impl Medium for ConstantSphere {
             .collect()
     }
 
+    /// None: the density is constant on the chord, it crosses no level
+    /// inside it.
+    fn level_crossings(
+        &self,
+        _ray: &Ray,
+        _lo: f64,
+        _hi: f64,
+        _inside: Vec3,
+        _level: f64,
+    ) -> Option<Vec<f64>> {
+        Some(Vec::new())
+    }
+
     fn max_density(&self, _ray: &Ray, _t0: f64, _t1: f64) -> f64 {
         self.kappa
     }

@@ -12,8 +12,8 @@ use super::printed::{self, Printed};
 use super::tracking::{Extinction, Tracked, Tracker, Wanted, radiance, transmittance};
 use super::{
     ConstantSphere, DepthScheme, DirectionalLight, EmissionMap, GaussianBlob, GaussianBlobs,
-    Medium, ShadowMethod, VolumeResult, VolumeScene, evaluate, linear_gradient::LinearGradient,
-    voxel_grid::VoxelGrid,
+    Medium, ShadowMethod, TransferTable, VolumeResult, VolumeScene, evaluate,
+    linear_gradient::LinearGradient, voxel_grid::VoxelGrid,
 };
 use crate::domain::Vec3;
 use crate::error::{QuadError, SpecError};
@@ -131,11 +131,11 @@ pub struct BlobSpec {
     pub width: f64,
 }
 
-/// The emission map `c(v)`.
+/// The emission of V-E: a map `c(v)` of the density, or a field of its own.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum EmissionSpec {
-    /// `c(v) = c` inside the medium.
+    /// `c(v) = c` inside the medium (where the density is positive).
     Constant {
         /// The constant.
         c: f64,
@@ -144,6 +144,23 @@ pub enum EmissionSpec {
     Proportional {
         /// The factor.
         k: f64,
+    },
+    /// A transfer function: `c(v)` piecewise linear through `points`
+    /// `[[v0, c0], [v1, c1], ..]` (at least 2; `v` at least 0 and strictly
+    /// increasing; `c` finite, at least 0), held at `c0` below `v0` and at the
+    /// last `c` above the last `v`, and 0 where the density is 0 (a medium
+    /// emits where its density is positive).
+    Table {
+        /// The points `[v, c]`.
+        points: Vec<[f64; 2]>,
+    },
+    /// An emission field of its own, `Le(p)`, independent of the density:
+    /// `I_E = int tau(t_0, t) Le(r(t)) dt`, also where the density is 0.
+    Field {
+        /// The field's shape and values, written as a medium (`Le` is its
+        /// density): `constant-sphere`, `gaussian-blobs`, `linear-gradient`
+        /// or `voxel-grid`.
+        field: MediumSpec,
     },
 }
 
@@ -269,6 +286,9 @@ pub struct Built {
     pub sphere_kappa: Option<f64>,
     /// The constant sphere, and the printed forms to evaluate in it.
     pub printed: Option<(printed::Sphere, Vec<Printed>)>,
+    /// The value of an emission field that is a constant sphere (its closed
+    /// form needs it).
+    pub field_sphere_value: Option<f64>,
 }
 
 impl Family for Volume {
@@ -300,6 +320,12 @@ impl Family for Volume {
                 _ => None,
             },
             printed: printed_forms(spec)?,
+            field_sphere_value: match &spec.emission {
+                Some(EmissionSpec::Field {
+                    field: MediumSpec::ConstantSphere { kappa, .. },
+                }) => Some(*kappa),
+                _ => None,
+            },
         })
     }
 
@@ -358,7 +384,9 @@ impl Family for Volume {
 
     fn closed_forms_available() -> &'static str {
         "closed forms: tau for the constant sphere, blobs and gradient; I_E for the constant \
-         sphere; I_L for the constant sphere with the light along the ray"
+         sphere (constant, proportional or table emission), for an emission field that is a \
+         constant sphere seen through a constant sphere, and for any emission field with a \
+         closed-form line integral where nothing absorbs; I_L for the constant sphere with the light along the ray"
     }
 
     /// Adaptive Gauss–Kronrod (relative tolerance 1e-13) with up to `n`
@@ -635,16 +663,38 @@ fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
         _ => None,
     };
     let emission = || -> Option<f64> {
-        let Some(map) = scene.emission else {
+        let Some(map) = &scene.emission else {
             return Some(0.0);
         };
+        if let EmissionMap::Field(field) = map {
+            // Nothing absorbs along the ray (ln tau = 0 exactly): I_E is the
+            // field's line integral.
+            if ln_tau == 0.0 {
+                return field.density_integral(&ray, scene.t_min, scene.t_max);
+            }
+            // A constant-sphere field through a constant-sphere medium: a
+            // constant on one interval seen through a constant extinction on
+            // another (exact::emission_field_interval).
+            let c = built.field_sphere_value?;
+            let chord = |m: &dyn Medium| {
+                m.support(&ray, scene.t_min, scene.t_max)
+                    .first()
+                    .map(|s| (s.start(), s.end()))
+            };
+            let Some(emits) = chord(field.as_ref()) else {
+                return Some(0.0);
+            };
+            let (sigma, _, _) = sphere?;
+            let absorbs = chord(scene.medium.as_deref()?)?;
+            return Some(exact::emission_field_interval(sigma, absorbs, c, emits));
+        }
         if scene.medium.is_none() {
             return Some(0.0);
         }
         let (sigma, chord, _) = sphere?;
         let kappa = built.sphere_kappa?;
-        // `c(v)` on the chord, where `v = kappa` (a constant map emits only
-        // where the density is positive: nothing from a sphere of kappa 0).
+        // `c(v)` on the chord, where `v = kappa` (a map of the density emits
+        // only where it is positive: nothing from a sphere of kappa 0).
         Some(exact::emission(sigma, chord, map.at(kappa)))
     };
     let light = || -> Option<f64> {
@@ -700,8 +750,8 @@ fn finite(path: &str, x: f64, accepted: &str) -> Result<f64, SpecError> {
     }
 }
 
-fn medium(spec: &MediumSpec) -> Result<Arc<dyn Medium>, SpecError> {
-    let at = "scene.medium";
+/// The medium (or emission field) of `spec`, errors anchored at `at`.
+fn medium(spec: &MediumSpec, at: &str) -> Result<Arc<dyn Medium>, SpecError> {
     Ok(match spec {
         MediumSpec::ConstantSphere {
             centre,
@@ -814,19 +864,30 @@ fn scene(s: &SceneSpec) -> Result<VolumeScene, SpecError> {
         }
         scene.lambda = l;
     }
-    scene.medium = s.medium.as_ref().map(medium).transpose()?;
-    scene.emission = match s.emission {
+    scene.medium = s
+        .medium
+        .as_ref()
+        .map(|m| medium(m, "scene.medium"))
+        .transpose()?;
+    scene.emission = match &s.emission {
         None => None,
         Some(EmissionSpec::Constant { c }) => Some(EmissionMap::Constant(finite(
             "scene.emission.c",
-            c,
+            *c,
             "a finite number",
         )?)),
         Some(EmissionSpec::Proportional { k }) => Some(EmissionMap::Proportional(finite(
             "scene.emission.k",
-            k,
+            *k,
             "a finite number",
         )?)),
+        Some(EmissionSpec::Table { points }) => Some(EmissionMap::Table(
+            TransferTable::new(points.iter().map(|p| (p[0], p[1])).collect())
+                .map_err(|e| SpecError::from_quad("scene.emission", e))?,
+        )),
+        Some(EmissionSpec::Field { field }) => {
+            Some(EmissionMap::Field(medium(field, "scene.emission.field")?))
+        }
     };
     if let Some(b) = s.background {
         if !(b.is_finite() && b >= 0.0) {

@@ -143,6 +143,26 @@ impl Medium for LinearGradient {
             .collect()
     }
 
+    /// On the positive piece the density is `gamma + beta (t - t_c)`, so it
+    /// crosses `level` once, at `t = t_c + (level - gamma) / beta`, when that
+    /// lies inside `(lo, hi)`; never when `beta = 0`. A piece of zero density
+    /// crosses no positive level.
+    fn level_crossings(
+        &self,
+        ray: &Ray,
+        lo: f64,
+        hi: f64,
+        inside: Vec3,
+        level: f64,
+    ) -> Option<Vec<f64>> {
+        let f = self.along(ray);
+        if self.density(inside) <= 0.0 || f.beta == 0.0 {
+            return Some(Vec::new());
+        }
+        let t = f.t_c + (level - f.gamma) / f.beta;
+        Some((lo < t && t < hi).then_some(t).into_iter().collect())
+    }
+
     /// The larger value of the linear function at the two ends of the chord
     /// inside `[t0, t1]` (a linear function peaks at an end), clamped at 0,
     /// plus a rounding margin `16 eps (|b| + |g| (|c| + 2R))` so that the

@@ -37,6 +37,23 @@ pub trait Medium: std::fmt::Debug + Send + Sync {
     /// delta and ratio tracking).
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64;
 
+    /// The parameters `t` strictly inside `(lo, hi)` where the density crosses
+    /// `level`, in closed form, when the medium can invert its density along
+    /// a smooth piece `[lo, hi]` of its support (`inside` a point strictly
+    /// inside the piece, as for [`Medium::density_on`]). `None`: no closed
+    /// form, the caller brackets the crossings numerically. Used to cut V-E
+    /// where a transfer function's knots put kinks into `c(v(t))`.
+    fn level_crossings(
+        &self,
+        _ray: &Ray,
+        _lo: f64,
+        _hi: f64,
+        _inside: Vec3,
+        _level: f64,
+    ) -> Option<Vec<f64>> {
+        None
+    }
+
     /// `int_{t0}^{t1} v_r(ray(t)) dt` in closed form, when the medium has one.
     fn density_integral(&self, _ray: &Ray, _t0: f64, _t1: f64) -> Option<f64> {
         None

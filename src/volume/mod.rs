@@ -19,6 +19,6 @@ pub use constant_sphere::ConstantSphere;
 pub use gaussian_blobs::{GaussianBlob, GaussianBlobs};
 pub use linear_gradient::LinearGradient;
 pub use medium::Medium;
-pub use scene::{DirectionalLight, EmissionMap, VolumeScene};
+pub use scene::{DirectionalLight, EmissionMap, TransferTable, VolumeScene};
 pub use terms::{DepthScheme, ShadowMethod, Term, VolumeResult, evaluate};
 pub use voxel_grid::VoxelGrid;

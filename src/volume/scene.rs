@@ -9,29 +9,163 @@ use crate::domain::Vec3;
 use crate::error::QuadError;
 use crate::geometry::{Ray, normalize};
 
-/// `c(v)`: emitted radiance per unit length as a function of the density.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The emission of V-E: `c(v)`, emitted radiance per unit length as a
+/// function of the density, or an emission field `Le(p)` of its own.
+///
+/// Convention for the maps of the density (`Constant`, `Table`): a medium
+/// emits where its density is positive, so `c(0) = 0` whatever the map says
+/// at `0+`. Quadrature applies it per smooth piece of the ray
+/// ([`EmissionMap::on_piece`]): on a piece whose density is positive inside
+/// (at its midpoint) the map's formula for `v > 0` is used up to and
+/// including the piece's ends, so an end node where the density reaches 0
+/// reads the one-sided limit, not the jump; a piece of zero density emits
+/// nothing. (Every medium here is either positive in a piece's interior or
+/// zero on all of it.)
+#[derive(Debug, Clone)]
 pub enum EmissionMap {
     /// `c(v) = c0` where `v > 0`, 0 elsewhere.
     Constant(f64),
     /// `c(v) = k v`.
     Proportional(f64),
+    /// A transfer function: `c(v)` piecewise linear through a table, held at
+    /// its end values outside it, 0 where `v = 0` ([`TransferTable`]).
+    Table(TransferTable),
+    /// An emission field of its own (pbrt's media take `Le` apart from
+    /// `sigma`): `I_E = int tau(t_0, t) Le(r(t)) dt` with `Le` the field's
+    /// "density", emitting wherever it is positive, also where the medium's
+    /// density is zero (there `tau` is the transmittance up to that point).
+    Field(Arc<dyn Medium>),
 }
 
 impl EmissionMap {
-    /// `c(v)`.
+    /// `c(v)` of a map of the density; 0 for [`EmissionMap::Field`], which
+    /// does not depend on the density.
     #[inline]
     pub fn at(&self, v: f64) -> f64 {
-        match *self {
+        self.on_piece(v, v > 0.0)
+    }
+
+    /// `c(v)` at a node of a smooth piece whose density is positive inside
+    /// (`emitting`) or zero on all of it: on an emitting piece the map's
+    /// formula for `v > 0`, extended to the piece's ends (see the type's
+    /// convention); on a piece of zero density 0 (`k v` for `Proportional`,
+    /// which is continuous). 0 for [`EmissionMap::Field`].
+    #[inline]
+    pub fn on_piece(&self, v: f64, emitting: bool) -> f64 {
+        match self {
             EmissionMap::Constant(c0) => {
-                if v > 0.0 {
-                    c0
+                if emitting {
+                    *c0
                 } else {
                     0.0
                 }
             }
             EmissionMap::Proportional(k) => k * v,
+            EmissionMap::Table(table) => {
+                if emitting {
+                    table.positive(v)
+                } else {
+                    0.0
+                }
+            }
+            EmissionMap::Field(_) => 0.0,
         }
+    }
+}
+
+/// A transfer function `c(v)` as volume renderers give it: points
+/// `(v_0, c_0), .., (v_m, c_m)` with `0 <= v_0 < v_1 < .. < v_m`, `c_i >= 0`
+/// finite, `m >= 1`;
+///
+/// `c(v) = c_i + (c_{i+1} - c_i) (v - v_i) / (v_{i+1} - v_i)` for
+/// `v_i <= v <= v_{i+1}`, `c(v) = c_0` for `0 < v < v_0`, `c(v) = c_m` for
+/// `v > v_m` (clamped at the end values, as a 1-D texture lookup with clamp
+/// addressing does), and `c(0) = 0` (a medium emits where its density is
+/// positive). `c(v(t))` has a kink wherever the density along the ray crosses
+/// a knot `v_i`; V-E cuts its pieces there.
+///
+/// Negative `c` is refused: `c` is emitted radiance, and a negative value
+/// would be absorption, which belongs to `sigma`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransferTable {
+    points: Arc<[(f64, f64)]>,
+}
+
+impl TransferTable {
+    /// A table; errors name the faulty entry (`points[2][0]` for the `v` of
+    /// the third point, `points[2][1]` for its `c`, `points` for too few).
+    pub fn new(points: Vec<(f64, f64)>) -> Result<Self, QuadError> {
+        if points.len() < 2 {
+            return Err(QuadError::invalid(
+                "points",
+                format!("{} point(s)", points.len()),
+                "at least 2 points [v, c]",
+            ));
+        }
+        for (i, &(v, c)) in points.iter().enumerate() {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(QuadError::invalid(
+                    format!("points[{i}][0]"),
+                    v,
+                    "a finite density v >= 0",
+                ));
+            }
+            if i > 0 && v <= points[i - 1].0 {
+                return Err(QuadError::invalid(
+                    format!("points[{i}][0]"),
+                    v,
+                    format!(
+                        "a density > points[{}][0] = {} (v strictly increasing)",
+                        i - 1,
+                        points[i - 1].0
+                    ),
+                ));
+            }
+            if !(c.is_finite() && c >= 0.0) {
+                return Err(QuadError::invalid(
+                    format!("points[{i}][1]"),
+                    c,
+                    "a finite emitted radiance c >= 0",
+                ));
+            }
+        }
+        Ok(TransferTable {
+            points: points.into(),
+        })
+    }
+
+    /// The points `(v_i, c_i)`.
+    pub fn points(&self) -> &[(f64, f64)] {
+        &self.points
+    }
+
+    /// The knots `v_i` where `c` can have a kink, those `> 0` (a density of
+    /// 0 lies at an end of a piece, never inside one).
+    pub fn knots(&self) -> impl Iterator<Item = f64> + '_ {
+        self.points.iter().map(|p| p.0).filter(|&v| v > 0.0)
+    }
+
+    /// `c(v)`: 0 where `v <= 0`, else [`TransferTable::positive`].
+    pub fn at(&self, v: f64) -> f64 {
+        if v > 0.0 { self.positive(v) } else { 0.0 }
+    }
+
+    /// The table's formula for `v > 0` at any `v` (clamped at the ends,
+    /// linear between the knots), without the cut at `v = 0`.
+    pub fn positive(&self, v: f64) -> f64 {
+        let p = &self.points;
+        let (first, last) = (p[0], p[p.len() - 1]);
+        if v.is_nan() || v <= first.0 {
+            return first.1;
+        }
+        if v >= last.0 {
+            return last.1;
+        }
+        // The segment [v_i, v_{i+1}] holding v: the first knot above v is i+1.
+        let i = p.partition_point(|q| q.0 <= v) - 1;
+        let ((v0, c0), (v1, c1)) = (p[i], p[i + 1]);
+        let u = (v - v0) / (v1 - v0);
+        c0 + (c1 - c0) * u
     }
 }
 
@@ -109,7 +243,7 @@ impl VolumeScene {
     }
 
     /// The same scene with its ray re-anchored at the middle `t*` of the
-    /// medium's support along it: origin `e + t* v`, looked-at part
+    /// medium's support along it (with an emission field's support): origin `e + t* v`, looked-at part
     /// `[t_min - t*, t_max - t*]`; returns `t*` with it (0 when there is no
     /// medium or the ray misses it). Every term is an integral over the ray
     /// and does not change. What changes is rounding: the points of a chord
@@ -119,15 +253,24 @@ impl VolumeScene {
     /// chord of 1e-7 three units away). From the re-anchored origin the
     /// chord's parameters are `O(L)`, and so are their errors.
     pub fn anchored(&self) -> (VolumeScene, f64) {
-        let support = self
-            .medium
-            .as_ref()
-            .map(|m| m.support(&self.ray, self.t_min, self.t_max))
-            .unwrap_or_default();
-        let (Some(first), Some(last)) = (support.first(), support.last()) else {
-            return (self.clone(), 0.0);
+        // Where anything lies along the ray: the medium's support and an
+        // emission field's.
+        let field = match &self.emission {
+            Some(EmissionMap::Field(f)) => Some(f),
+            _ => None,
         };
-        let t_star = 0.5 * (first.start() + last.end());
+        let (first, last) = self
+            .medium
+            .iter()
+            .chain(field)
+            .flat_map(|m| m.support(&self.ray, self.t_min, self.t_max))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+                (lo.min(s.start()), hi.max(s.end()))
+            });
+        if first > last {
+            return (self.clone(), 0.0);
+        }
+        let t_star = 0.5 * (first + last);
         if !t_star.is_finite() || t_star == 0.0 {
             return (self.clone(), 0.0);
         }
@@ -180,7 +323,7 @@ impl VolumeScene {
                 ));
             }
         }
-        match self.emission {
+        match &self.emission {
             Some(EmissionMap::Constant(c)) | Some(EmissionMap::Proportional(c))
                 if !c.is_finite() =>
             {

@@ -4,7 +4,12 @@
 //! - V-tau: `tau(t0, t1) = exp(-int_{t0}^{t1} sigma dt)`, reported in log space
 //!   (`ln tau = -optical depth`) so an optical depth of 1e5 stays exact where
 //!   `tau` itself underflows to 0.
-//! - V-E: `I_E = int_{t_n}^{t_f} tau(t_n, t) c(v_r(r(t))) dt`.
+//! - V-E: `I_E = int_{t_n}^{t_f} tau(t_n, t) c(v_r(r(t))) dt`, or with an
+//!   emission field of its own `I_E = int tau(t_0, t) Le(r(t)) dt` over the
+//!   union of the medium's and the field's supports. Its pieces are cut where
+//!   `c(v(t))` is not smooth: at the crossings of a transfer table's knots by
+//!   the density (in closed form where the medium inverts its density, else
+//!   bracketed), and at the field's own support ends and break points.
 //! - V-B: `I_B = tau(t_n, t_f) I_b`.
 //! - V-Lp: `I_p(t) = I_p exp(-int_0^{s(t)} sigma(r(t) + s d) ds)`, the shadow
 //!   ray's optical depth in closed form where the medium has one, else by
@@ -25,8 +30,8 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::medium::Medium;
-use super::scene::VolumeScene;
-use crate::domain::Segment;
+use super::scene::{EmissionMap, VolumeScene};
+use crate::domain::{Segment, Vec3};
 use crate::error::QuadError;
 use crate::estimate::{ErrorKind, Estimate};
 use crate::geometry::Ray;
@@ -71,7 +76,9 @@ pub struct Term {
     /// the cumulative scheme; for a Monte Carlo rule in the nested scheme the
     /// noisy inner depth also biases `exp(-depth)` slightly, by Jensen).
     pub error: f64,
-    /// Density evaluations spent on this term.
+    /// Density evaluations spent on this term; for V-E also the evaluations
+    /// of an emission field, and those spent bracketing a transfer table's
+    /// knot crossings where the medium has no closed form for them.
     pub evaluations: u64,
     /// Whether `error` is a deterministic estimate or a standard error.
     pub kind: ErrorKind,
@@ -282,6 +289,155 @@ impl<R: Rule> DepthAlong<'_, R> {
     }
 }
 
+/// No medium, for an emission field in a scene without one: zero density
+/// everywhere, so `tau = 1` along the whole ray.
+#[derive(Debug)]
+struct Vacuum;
+
+impl Medium for Vacuum {
+    fn name(&self) -> &'static str {
+        "vacuum"
+    }
+    fn density(&self, _p: Vec3) -> f64 {
+        0.0
+    }
+    fn support(&self, _ray: &Ray, _t_min: f64, _t_max: f64) -> Vec<Segment> {
+        Vec::new()
+    }
+    fn max_density(&self, _ray: &Ray, _t0: f64, _t1: f64) -> f64 {
+        0.0
+    }
+}
+
+/// Equispaced samples per smooth piece when a knot crossing has to be
+/// bracketed: two crossings of one level closer than `1/SCAN` of the piece
+/// (the density touching a knot value and turning back) can fall between two
+/// samples and go uncut.
+const SCAN: usize = 64;
+
+/// The parameters strictly inside `(lo, hi)` where `f` crosses one of
+/// `levels`: a sign change of `f - level` between two of `SCAN + 1`
+/// equispaced samples is bisected until the bracket cannot shrink in f64 (a
+/// sample equal to the level is a crossing itself). Robust for any continuous
+/// `f`; costs `SCAN + 1` evaluations plus ~60 per crossing.
+fn bracket_crossings(f: &dyn Fn(f64) -> f64, lo: f64, hi: f64, levels: &[f64]) -> Vec<f64> {
+    let at = |j: usize| {
+        if j == SCAN {
+            hi
+        } else {
+            lo + (hi - lo) * j as f64 / SCAN as f64
+        }
+    };
+    let samples: Vec<(f64, f64)> = (0..=SCAN).map(|j| (at(j), f(at(j)))).collect();
+    let mut out = Vec::new();
+    for &level in levels {
+        for (j, w) in samples.windows(2).enumerate() {
+            let ((mut a, fa), (mut b, fb)) = (w[0], w[1]);
+            let (ga, gb) = (fa - level, fb - level);
+            if ga == 0.0 && j > 0 {
+                out.push(a);
+                continue;
+            }
+            let sign = ga * gb;
+            if sign.is_nan() || sign >= 0.0 {
+                continue;
+            }
+            // Keep f(a) - level and f(b) - level of opposite signs.
+            let rising = ga < 0.0;
+            loop {
+                let m = 0.5 * (a + b);
+                if !(a < m && m < b) {
+                    break;
+                }
+                let gm = f(m) - level;
+                if gm == 0.0 {
+                    (a, b) = (m, m);
+                    break;
+                }
+                if (gm < 0.0) == rising {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            out.push(0.5 * (a + b));
+        }
+    }
+    out.retain(|&t| lo < t && t < hi);
+    out
+}
+
+/// The pieces of V-E with a transfer table: each support piece also cut
+/// where the density crosses a knot of the table, where `c(v(t))` has a
+/// kink. The medium's closed-form crossings where it has them
+/// ([`Medium::level_crossings`]), else bracketed on each smooth piece.
+fn cut_at_knots(
+    medium: &Counted,
+    ray: &Ray,
+    pieces: &[Segment],
+    knots: &[f64],
+) -> Result<Vec<Segment>, QuadError> {
+    let mut out = Vec::with_capacity(pieces.len());
+    for piece in pieces {
+        let mut breaks = piece.breaks().to_vec();
+        for (lo, hi) in piece.pieces() {
+            let mid = 0.5 * (lo + hi);
+            let inside = ray.at(mid);
+            let closed: Option<Vec<f64>> = knots
+                .iter()
+                .map(|&k| medium.medium.level_crossings(ray, lo, hi, inside, k))
+                .collect::<Option<Vec<Vec<f64>>>>()
+                .map(|v| v.concat());
+            match closed {
+                Some(ts) => breaks.extend(ts.into_iter().filter(|&t| lo < t && t < hi)),
+                None => breaks.extend(bracket_crossings(
+                    &|t| medium.density(ray, t, mid),
+                    lo,
+                    hi,
+                    knots,
+                )),
+            }
+        }
+        out.push(Segment::with_breaks(piece.start(), piece.end(), breaks)?);
+    }
+    Ok(out)
+}
+
+/// The pieces of V-E with an emission field: the union of the medium's and
+/// the field's supports, each union piece cut at every end and break point of
+/// either, so on every smooth piece both the density and `Le` are smooth.
+fn union_pieces(a: &[Segment], b: &[Segment]) -> Result<Vec<Segment>, QuadError> {
+    let mut spans: Vec<(f64, f64)> = a.iter().chain(b).map(|s| (s.start(), s.end())).collect();
+    spans.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut merged: Vec<(f64, f64)> = Vec::new();
+    for (lo, hi) in spans {
+        match merged.last_mut() {
+            Some(last) if lo <= last.1 => last.1 = last.1.max(hi),
+            _ => merged.push((lo, hi)),
+        }
+    }
+    let points: Vec<f64> = a
+        .iter()
+        .chain(b)
+        .flat_map(|s| {
+            [s.start(), s.end()]
+                .into_iter()
+                .chain(s.breaks().iter().copied())
+        })
+        .collect();
+    merged
+        .into_iter()
+        .map(|(lo, hi)| {
+            let inner = points
+                .iter()
+                .copied()
+                .filter(|&t| lo < t && t < hi)
+                .collect();
+            Segment::with_breaks(lo, hi, inner)
+        })
+        .collect()
+}
+
 /// The outer integration pieces of V-E and V-L: each support piece is cut at
 /// optical depths 1, 2, 4, 8, ... from its start (measured with the majorant),
 /// so the boundary layer `tau(t_n, t) = e^{-sigma (t - t_n)}` of a thick medium
@@ -326,25 +482,36 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     let mut evaluated = vec!["V-tau"];
     let ray = scene.ray;
 
+    // An emission field of its own, if the scene has one.
+    let field = match &scene.emission {
+        Some(EmissionMap::Field(f)) => Some(f.as_ref()),
+        _ => None,
+    };
     // No medium: tau = 1 with no work at all; the background passes unchanged.
-    let Some(medium) = scene.medium.as_deref() else {
-        let background = scene.background.map(|b| Term::exact("V-B", b));
-        if background.is_some() {
-            evaluated.push("V-B");
+    // With an emission field, V-E is still integrated, through a vacuum.
+    let has_medium = scene.medium.is_some();
+    let medium: &dyn Medium = match (scene.medium.as_deref(), field) {
+        (Some(m), _) => m,
+        (None, Some(_)) => &Vacuum,
+        (None, None) => {
+            let background = scene.background.map(|b| Term::exact("V-B", b));
+            if background.is_some() {
+                evaluated.push("V-B");
+            }
+            evaluated.push("V-I");
+            return Ok(VolumeResult {
+                chord: None,
+                optical_depth: Term::exact("V-tau", 0.0),
+                log_transmittance: 0.0,
+                transmittance: 1.0,
+                underflow: false,
+                emission: None,
+                background,
+                light: None,
+                total: background.map_or(0.0, |b| b.value),
+                evaluated,
+            });
         }
-        evaluated.push("V-I");
-        return Ok(VolumeResult {
-            chord: None,
-            optical_depth: Term::exact("V-tau", 0.0),
-            log_transmittance: 0.0,
-            transmittance: 1.0,
-            underflow: false,
-            emission: None,
-            background,
-            light: None,
-            total: background.map_or(0.0, |b| b.value),
-            evaluated,
-        });
     };
     let counted = Counted {
         medium,
@@ -382,7 +549,8 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     });
 
     // V-E and V-L share the outer integral over the chord.
-    let outer = |h: &mut dyn FnMut(f64, f64, &mut Rg) -> Result<f64, QuadError>,
+    let outer = |pieces: &[Segment],
+                 h: &mut dyn FnMut(f64, f64, &mut Rg) -> Result<f64, QuadError>,
                  rng: &mut Rg|
      -> Result<Estimate<f64>, QuadError> {
         let mut along = DepthAlong {
@@ -398,7 +566,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         let mut total = Estimate::zero();
         // Optical depth from t_n to the start of the current sub-piece.
         let mut before = Compensated::<f64>::new();
-        for piece in &pieces {
+        for piece in pieces {
             for sub in graded(medium, scene.lambda, &ray, piece) {
                 along.start_piece(&sub);
                 // The outer rule's own rng stream is derived so the inner calls
@@ -416,22 +584,59 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         Ok(total)
     };
 
-    let emission = match scene.emission {
+    let emission = match &scene.emission {
         None => None,
         Some(map) => {
+            let field_counted = field.map(|f| Counted {
+                medium: f,
+                count: Cell::new(0),
+            });
+            // The pieces of V-E: where c(v(t)) or Le(r(t)) is smooth.
+            let emission_pieces = match (map, &field_counted) {
+                (_, Some(f)) => {
+                    union_pieces(&pieces, &f.medium.support(&ray, scene.t_min, scene.t_max))?
+                }
+                (EmissionMap::Table(table), None) => {
+                    let knots: Vec<f64> = table.knots().collect();
+                    cut_at_knots(&counted, &ray, &pieces, &knots)?
+                }
+                _ => pieces.clone(),
+            };
+            // Whether the piece with midpoint `mid` has positive density (the
+            // convention of EmissionMap::on_piece), remembered per piece.
+            let mut piece_emits: Option<(f64, bool)> = None;
             let est = outer(
-                &mut |t, mid, _| Ok(map.at(counted.density(&ray, t, mid))),
+                &emission_pieces,
+                &mut |t, mid, _| {
+                    if let Some(f) = &field_counted {
+                        return Ok(f.density(&ray, t, mid));
+                    }
+                    let v = counted.density(&ray, t, mid);
+                    if let EmissionMap::Proportional(k) = map {
+                        return Ok(k * v);
+                    }
+                    let emitting = match piece_emits {
+                        Some((m, e)) if m == mid => e,
+                        _ => {
+                            let e = counted.density(&ray, mid, mid) > 0.0;
+                            piece_emits = Some((mid, e));
+                            e
+                        }
+                    };
+                    Ok(map.on_piece(v, emitting))
+                },
                 rng,
             )?;
-            Some(Term::measured("V-E", est, counted.take()))
+            let evaluations = counted.take() + field_counted.as_ref().map_or(0, Counted::take);
+            Some(Term::measured("V-E", est, evaluations))
         }
     };
 
     let light = match scene.light {
-        None => None,
-        Some(light) => {
+        Some(light) if has_medium => {
             let lambda = scene.lambda;
             let est = outer(
+                &pieces,
                 &mut |t, mid, rng| {
                     let p = ray.at(t);
                     let shadow_ray = Ray {
@@ -463,6 +668,8 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
             )?;
             Some(Term::measured("V-L", est, counted.take()))
         }
+        // No light, or no medium to scatter it.
+        _ => None,
     };
 
     for term in [&emission, &background, &light].into_iter().flatten() {

@@ -45,7 +45,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 use super::medium::Medium;
-use super::scene::VolumeScene;
+use super::scene::{EmissionMap, VolumeScene};
 use super::terms::ShadowMethod;
 use crate::error::QuadError;
 use crate::geometry::Ray;
@@ -446,7 +446,18 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
     let lambda = scene.lambda;
     let ray = scene.ray;
     let background = scene.background.unwrap_or(0.0);
-    let emission = scene.emission.filter(|_| wanted.emission);
+    let emission = scene.emission.as_ref().filter(|_| wanted.emission);
+    // Collisions score c(v) of the density they happen at; an emission field
+    // of its own (which may emit where the medium does not) is not a map of
+    // the density, and walks confined to the medium would miss it.
+    if let Some(EmissionMap::Field(_)) = emission {
+        return Err(QuadError::invalid(
+            "emission",
+            "field",
+            "a map of the density (constant, proportional, table) for delta tracking, which \
+             scores c(v) at its collisions; integrate an emission field with a quadrature rule",
+        ));
+    }
     let light = scene.light.filter(|_| wanted.light);
     let Some(medium) = scene.medium.as_deref() else {
         // No medium: tau = 1, I_B = I_b, no emission and no scattering.
@@ -471,8 +482,9 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
     let scoring = emission.is_some() || light.is_some();
 
     // The largest score one tentative collision can add on a span, for the
-    // bound of Tracked::all_alike: |c| at the density bound (c is monotone in
-    // v) and I_p s at the density bound, over the rate.
+    // bound of Tracked::all_alike: |c| at the density bound (constant and
+    // proportional maps are monotone in v; a table's largest value bounds it
+    // anywhere) and I_p s at the density bound, over the rate.
     let rate = |span: &Span| {
         if span.bar > 0.0 {
             span.bar
@@ -484,7 +496,13 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
     let mut one_light: f64 = 0.0;
     for span in &spans {
         if let Some(map) = emission {
-            one_emission = one_emission.max(map.at(span.v_bar).abs() / rate(span));
+            let c = match map {
+                EmissionMap::Table(table) => {
+                    table.points().iter().map(|p| p.1.abs()).fold(0.0, f64::max)
+                }
+                _ => map.at(span.v_bar).abs(),
+            };
+            one_emission = one_emission.max(c / rate(span));
         }
         if let Some(l) = light {
             let s = l.albedo.map_or(1.0, |a| a * span.bar / (4.0 * PI));
