@@ -68,6 +68,10 @@ impl Medium for ConstantSphere {
         Some(Vec::new())
     }
 
+    fn centre(&self) -> Option<Vec3> {
+        Some(self.sphere.centre)
+    }
+
     fn max_density(&self, _ray: &Ray, _t0: f64, _t1: f64) -> f64 {
         self.kappa
     }

@@ -472,7 +472,10 @@ fn estimate(
             format!("one of {} for {}", names.join(", "), tracker.name()),
         ));
     }
-    let scene = &built.scene;
+    // Measured from the middle of the medium, as the quadrature terms are
+    // (VolumeScene::anchored).
+    let (anchored, _) = built.scene.anchored();
+    let scene = &anchored;
     let background = scene.background.unwrap_or(0.0);
     let only_tau = quantities
         .iter()
@@ -612,7 +615,9 @@ fn total(res: &VolumeResult) -> Measured {
             reliable: t.reliable,
         })
         .fold(Estimate::zero(), Estimate::combine);
-    let evaluations = res.optical_depth.evaluations + sum.evaluations;
+    // V-B reuses tau's evaluations: count them once.
+    let shared = res.background.map_or(0, |b| b.evaluations);
+    let evaluations = res.optical_depth.evaluations + sum.evaluations - shared;
     let parts = terms.iter().flatten().map(|t| t.value.abs()).sum::<f64>();
     let m = measured(super::Term {
         id: "V-I",

@@ -19,6 +19,10 @@ use crate::geometry::{Ray, require_finite_vec};
 /// Support radius in widths.
 const CUTOFF_WIDTHS: f64 = 12.0;
 
+/// A blob whose width times this is below the length of its piece is cut
+/// around its peak (see `support`).
+const NARROW: f64 = 64.0;
+
 /// One blob.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GaussianBlob {
@@ -101,13 +105,37 @@ impl Medium for GaussianBlobs {
                 _ => merged.push((a, b)),
             }
         }
+        // A blob much narrower than the piece it lies in is a spike that a
+        // rule's nodes (an adaptive rule's first panel included) can step
+        // over entirely: cut the piece at the blob's peak along the ray and
+        // at 2 and 8 widths either side, so each spike gets pieces of its
+        // own scale. (Along a line the blob is a Gaussian in t of the same
+        // width: |r(t) - c|^2 = (t - t_c)^2 + b^2.)
         merged
             .into_iter()
-            .filter_map(|(a, b)| Segment::new(a, b).ok())
+            .filter_map(|(a, b)| {
+                let cuts = self
+                    .blobs
+                    .iter()
+                    .filter(|blob| blob.width * NARROW < b - a)
+                    .flat_map(|blob| {
+                        let t_c = (blob.centre - ray.origin).dot(&ray.dir);
+                        [-8.0, -2.0, 0.0, 2.0, 8.0].map(|k| t_c + k * blob.width)
+                    })
+                    .filter(|&t| a < t && t < b)
+                    .collect();
+                Segment::with_breaks(a, b, cuts).ok()
+            })
             .collect()
     }
 
     /// The sum of each blob's largest value on the chord.
+    /// The mean of the blobs' centres.
+    fn centre(&self) -> Option<Vec3> {
+        let n = self.blobs.len();
+        (n > 0).then(|| self.blobs.iter().map(|b| b.centre).sum::<Vec3>() / n as f64)
+    }
+
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
         self.blobs
             .iter()

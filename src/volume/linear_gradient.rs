@@ -167,6 +167,10 @@ impl Medium for LinearGradient {
     /// inside `[t0, t1]` (a linear function peaks at an end), clamped at 0,
     /// plus a rounding margin `16 eps (|b| + |g| (|c| + 2R))` so that the
     /// computed density never exceeds it; 0 where the ray misses the sphere.
+    fn centre(&self) -> Option<Vec3> {
+        Some(self.sphere.centre)
+    }
+
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
         let Some((a, b)) = self.sphere.clip(ray, t0, t1) else {
             return 0.0;

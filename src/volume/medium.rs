@@ -37,6 +37,14 @@ pub trait Medium: std::fmt::Debug + Send + Sync {
     /// delta and ratio tracking).
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64;
 
+    /// A point the medium lies around (its centre), if it has one: the
+    /// scene re-anchors a ray at its closest approach to it before asking for
+    /// the support, so a ray from very far away (`|e| = 1e16`, where one ulp
+    /// of `t` is longer than the chord) still finds the medium.
+    fn centre(&self) -> Option<crate::domain::Vec3> {
+        None
+    }
+
     /// The parameters `t` strictly inside `(lo, hi)` where the density crosses
     /// `level`, in closed form, when the medium can invert its density along
     /// a smooth piece `[lo, hi]` of its support (`inside` a point strictly

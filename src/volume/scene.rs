@@ -253,8 +253,42 @@ impl VolumeScene {
     /// chord of 1e-7 three units away). From the re-anchored origin the
     /// chord's parameters are `O(L)`, and so are their errors.
     pub fn anchored(&self) -> (VolumeScene, f64) {
-        // Where anything lies along the ray: the medium's support and an
-        // emission field's.
+        // First at the closest approach to the medium's centre, so that a
+        // far origin does not round the chord away; then at the middle of the
+        // support as seen from there.
+        let field = match &self.emission {
+            Some(EmissionMap::Field(f)) => Some(f),
+            _ => None,
+        };
+        let near = self
+            .medium
+            .iter()
+            .chain(field)
+            .find_map(|m| m.centre())
+            .map(|c| (c - self.ray.origin).dot(&self.ray.dir))
+            .filter(|t| t.is_finite() && *t != 0.0);
+        let Some(t_near) = near else {
+            return self.anchored_at_support();
+        };
+        let (near_scene, _) = self.shifted(t_near);
+        let (out, t_star) = near_scene.anchored_at_support();
+        (out, t_near + t_star)
+    }
+
+    /// The scene with its ray's origin moved to `e + t v`.
+    fn shifted(&self, t: f64) -> (VolumeScene, f64) {
+        let mut out = self.clone();
+        out.ray = Ray {
+            origin: self.ray.at(t),
+            dir: self.ray.dir,
+        };
+        out.t_min = self.t_min - t;
+        out.t_max = self.t_max - t;
+        (out, t)
+    }
+
+    /// Re-anchored at the middle of the support along the ray as it is.
+    fn anchored_at_support(&self) -> (VolumeScene, f64) {
         let field = match &self.emission {
             Some(EmissionMap::Field(f)) => Some(f),
             _ => None,
@@ -274,14 +308,7 @@ impl VolumeScene {
         if !t_star.is_finite() || t_star == 0.0 {
             return (self.clone(), 0.0);
         }
-        let mut out = self.clone();
-        out.ray = Ray {
-            origin: self.ray.at(t_star),
-            dir: self.ray.dir,
-        };
-        out.t_min = self.t_min - t_star;
-        out.t_max = self.t_max - t_star;
-        (out, t_star)
+        self.shifted(t_star)
     }
 
     /// Checks the numbers a user supplies (`lambda >= 0`, `t_min <= t_max`,

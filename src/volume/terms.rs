@@ -538,12 +538,12 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     let transmittance = log_transmittance.exp();
     let underflow = transmittance < f64::MIN_POSITIVE;
 
-    // V-B.
+    // V-B: tau's value, and so tau's cost.
     let background = scene.background.map(|b| Term {
         id: "V-B",
         value: b * transmittance,
         error: b * transmittance * depth.error,
-        evaluations: 0,
+        evaluations: optical_depth.evaluations,
         kind: depth.kind,
         reliable: depth.reliable,
     });

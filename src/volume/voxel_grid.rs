@@ -272,6 +272,10 @@ impl Medium for VoxelGrid {
     /// end points (each widened to the neighbouring centre), not the global
     /// maximum. Times `1 + 8 eps` for the rounding of the interpolation
     /// weights; 0 where the ray misses the box.
+    fn centre(&self) -> Option<Vec3> {
+        Some((self.min + self.max) * 0.5)
+    }
+
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
         let Some((a, b)) = self.chord(ray, t0, t1) else {
             return 0.0;
