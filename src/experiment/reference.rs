@@ -411,7 +411,7 @@ pub struct Crosscheck {
     pub experiment: String,
     /// The quantity's name.
     pub quantity: &'static str,
-    /// lightquad's converged value (400 nodes per piece).
+    /// lightquad's converged value (the family's converged evaluation at n = 400).
     pub lightquad: f64,
     /// Mitsuba's value and standard error, when it has one.
     pub mitsuba: Option<(f64, f64)>,
@@ -468,7 +468,7 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
 /// The comparison as a Markdown table.
 pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
     let mut md = String::from(
-        "| experiment | quantity | lightquad (converged, 400 nodes per piece) | Mitsuba 3 +- std. error | closed form | lightquad - Mitsuba |\n\
+        "| experiment | quantity | lightquad (converged evaluation, n = 400) | Mitsuba 3 +- std. error | closed form | lightquad - Mitsuba |\n\
          |---|---|---:|---:|---:|---|\n",
     );
     for r in rows {
