@@ -466,49 +466,46 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// A family's flag on a value (here `Cancellation`, which a family raises when
+/// a sum lost digits) reaches the report's row, once per kind. (The volume
+/// family can no longer raise it: its terms are all non-negative since
+/// negative emission is refused, so the flag is set on the jobs' values here.)
 #[test]
-fn cancellation_in_the_total_is_flagged() {
-    use lightquad::exact::volume::emission;
+fn a_familys_value_flag_reaches_the_report_row() {
     use lightquad::experiment::report::{RowFlag, RuleInfo, rows};
     use lightquad::experiment::validate::parse_json;
     use lightquad::family::Flag;
-    // Negative emission c = -1 on a chord of 2 at sigma = 1 and a background
-    // I_b = -I_E / tau: the total V-I is zero up to rounding.
-    let (sigma, chord) = (1.0f64, 2.0f64);
-    let i_e = emission(sigma, chord, -1.0);
-    let i_b = -i_e / (-sigma * chord).exp();
-    let text = VALID
-        .replace("\"kappa\": 2.0", "\"kappa\": 1.0")
-        .replace("[-3.0, 0.3, 0.0]", "[-3.0, 0.0, 0.0]")
-        .replace(
-            "\"c\": 1.0 }",
-            &format!("\"c\": -1.0 }}, \"background\": {i_b:e}"),
-        )
-        .replace("[\"tau\", \"I_E\"]", "[\"I\"]")
-        .replace(
-            "{ \"type\": \"closed-form\" }",
-            "{ \"type\": \"value\", \"values\": { \"I\": 0.0 } }",
-        );
+    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
     let exp = lightquad::families::builtin()
         .load(parse_json(&text).expect("parses"), "h")
         .expect("valid");
     let jobs: Vec<_> = [4usize, 16]
         .iter()
-        .map(|&n| exp.run_job((0, n, 0)))
+        .map(|&n| {
+            let mut job = exp.run_job((0, n, 0));
+            for m in job.quantities.values_mut() {
+                m.flags.push(Flag::Cancellation { parts: 2.0 });
+                m.flags.push(Flag::Cancellation { parts: 3.0 });
+            }
+            job
+        })
         .collect();
     let rules = [RuleInfo {
         label: "gauss-legendre".into(),
         is_random: false,
         min_budget: 1,
     }];
-    let table = rows(&rules, &jobs, "I", &[0.0]);
-    assert!(
-        table.iter().all(|r| r
+    let reference = exp.run_job((0, 64, 0)).quantities["I"].value.clone();
+    let table = rows(&rules, &jobs, "I", &reference);
+    assert_eq!(table.len(), 2, "{table:?}");
+    for row in &table {
+        let n = row
             .flags
             .iter()
-            .any(|f| matches!(f, RowFlag::Job(Flag::Cancellation { .. })))),
-        "{table:?}"
-    );
+            .filter(|f| matches!(f, RowFlag::Job(Flag::Cancellation { .. })))
+            .count();
+        assert_eq!(n, 1, "{row:?}");
+    }
 }
 
 /// Runs the binary, killing it after `secs` (a regression must not hang CI).
@@ -974,5 +971,53 @@ fn a_converged_reference_is_converged_per_quantity() {
         .find(|l| l.starts_with("| gauss-legendre | ") && !l.contains("| 2 |"))
         .expect("gauss-legendre in the order table");
     assert!(!ranking.contains("not reached"), "{ranking}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// Regressions from the issue 9 hostile review: a negative emission is
+/// refused like a negative background; a reference value for a quantity the
+/// experiment does not ask for is refused, not ignored.
+#[test]
+fn negative_emission_and_stray_reference_values_are_refused() {
+    rejected(
+        &VALID.replace("\"c\": 1.0", "\"c\": -1.0"),
+        "scene.emission.c",
+        "a finite number >= 0",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"value\", \"values\": { \"tau\": 0.02, \"I_E\": 0.4, \"I_L\": 1.0 } }",
+        ),
+        "reference.values.I_L",
+        "not among the experiment's quantities",
+    );
+}
+
+/// Regression from the issue 9 hostile review: with kappa 0 no collision is
+/// possible, so delta tracking's tau = 1 and I_E = 0 are exact (closed forms
+/// 1 and 0): no Wilson bound, no "all walks alike" flag.
+#[test]
+fn tracking_through_an_empty_medium_is_exact_and_unflagged() {
+    let text = VALID.replace("\"kappa\": 2.0", "\"kappa\": 0.0").replace(
+        "{ \"rule\": \"gauss-legendre\" }, { \"rule\": \"stratified\" }",
+        "{ \"rule\": \"delta-tracking\" }",
+    );
+    let (dir, out, o) = run_text("empty", &text);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+    let rows: Vec<&str> = report
+        .lines()
+        .filter(|l| {
+            l.starts_with("| delta-tracking | 4 |") || l.starts_with("| delta-tracking | 16 |")
+        })
+        .collect();
+    assert_eq!(rows.len(), 4, "{report}");
+    for row in rows {
+        assert!(
+            row.contains("| 0.00e0 | 0.00e0 |") && !row.contains("alike"),
+            "{row}"
+        );
+    }
     let _ = fs::remove_dir_all(&dir);
 }

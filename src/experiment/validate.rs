@@ -369,6 +369,22 @@ pub fn literal_values<Q: Quantity>(
     quantities: &[Q],
     channels: impl Fn(Q) -> usize,
 ) -> Result<BTreeMap<Q, Vec<f64>>, SpecError> {
+    // A value for a quantity the experiment does not ask for is a mistake
+    // (a typo, or a quantity dropped from the list): refused, not ignored.
+    if let Some(extra) = values.keys().find(|q| !quantities.contains(q)) {
+        return Err(SpecError::at(
+            format!("reference.values.{}", extra.name()),
+            format!(
+                "{} is not among the experiment's quantities ({}): remove it or add it to quantities",
+                extra.name(),
+                quantities
+                    .iter()
+                    .map(|q| q.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
+    }
     let mut out = BTreeMap::new();
     for q in quantities {
         let Some(v) = values.get(q) else {

@@ -755,6 +755,20 @@ fn finite(path: &str, x: f64, accepted: &str) -> Result<f64, SpecError> {
     }
 }
 
+/// `x` when finite and `>= 0`, else an error at `path`.
+fn non_negative(path: &str, x: f64) -> Result<f64, SpecError> {
+    if x.is_finite() && x >= 0.0 {
+        Ok(x)
+    } else {
+        Err(SpecError::at(
+            path,
+            format!(
+                "{x} is not a finite number >= 0 (emitted radiance; absorption belongs to sigma)"
+            ),
+        ))
+    }
+}
+
 /// The medium (or emission field) of `spec`, errors anchored at `at`.
 fn medium(spec: &MediumSpec, at: &str) -> Result<Arc<dyn Medium>, SpecError> {
     Ok(match spec {
@@ -876,15 +890,14 @@ fn scene(s: &SceneSpec) -> Result<VolumeScene, SpecError> {
         .transpose()?;
     scene.emission = match &s.emission {
         None => None,
-        Some(EmissionSpec::Constant { c }) => Some(EmissionMap::Constant(finite(
-            "scene.emission.c",
-            *c,
-            "a finite number",
-        )?)),
-        Some(EmissionSpec::Proportional { k }) => Some(EmissionMap::Proportional(finite(
+        // Emitted radiance is not negative (absorption belongs to sigma), as
+        // for a table's values.
+        Some(EmissionSpec::Constant { c }) => {
+            Some(EmissionMap::Constant(non_negative("scene.emission.c", *c)?))
+        }
+        Some(EmissionSpec::Proportional { k }) => Some(EmissionMap::Proportional(non_negative(
             "scene.emission.k",
             *k,
-            "a finite number",
         )?)),
         Some(EmissionSpec::Table { points }) => Some(EmissionMap::Table(
             TransferTable::new(points.iter().map(|p| (p[0], p[1])).collect())

@@ -173,6 +173,9 @@ impl Scores {
     /// bound `W(n) D` with `D = spread(x)` instead.
     fn tracked(&self, evaluations: u64, spread: impl Fn(f64) -> f64) -> Tracked {
         let (n, x) = (self.walks.count(), self.walks.mean());
+        // No unseen outcome can move a score (D = 0): the walks are exact,
+        // not merely alike, and carry neither a bound nor the flag.
+        let exact = self.alike && spread(x) == 0.0;
         let error = if self.alike {
             wilson_unseen(n) * spread(x)
         } else {
@@ -183,7 +186,7 @@ impl Scores {
             error,
             evaluations,
             walks: n,
-            all_alike: self.alike,
+            all_alike: self.alike && !exact,
         }
     }
 
@@ -364,6 +367,17 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
     check(sigma.lambda, t0, t1, n)?;
     let mut evaluations = 0u64;
     let spans = spans(tracker, sigma, ray, t0, t1, &mut evaluations)?;
+    // A majorant of 0 everywhere: no collision is possible, every walk scores
+    // 1, and tau = 1 is exact (no Wilson bound, no flag).
+    if spans.iter().all(|s| s.bar == 0.0) {
+        return Ok(Tracked {
+            value: 1.0,
+            error: 0.0,
+            evaluations,
+            walks: n as u64,
+            all_alike: false,
+        });
+    }
     let mut scores = Scores::default();
     for _ in 0..n {
         scores.add(walk(tracker, sigma, ray, &spans, &mut evaluations, rng)?);
