@@ -277,14 +277,21 @@ fn spans(
             } else {
                 bar
             };
-            spans.push(Span {
+            let span = Span {
                 a: s0,
                 b: s1,
                 bar,
                 v_bar,
                 control,
                 majorant,
-            });
+            };
+            // Ratio tracking crosses the whole span: about `majorant * length`
+            // tentative collisions per walk, known before the first walk.
+            // Refuse now instead of spinning up to the cap on every walk.
+            if tracker != Tracker::Delta && majorant * (s1 - s0) > (MAX_COLLISIONS / 2) as f64 {
+                return Err(too_deep(&span));
+            }
+            spans.push(span);
         }
     }
     Ok(spans)
@@ -295,7 +302,7 @@ fn spans(
 fn too_deep(span: &Span) -> QuadError {
     QuadError::invalid(
         "optical depth",
-        span.majorant * (span.b - span.a),
+        format!("{:.3e}", span.majorant * (span.b - span.a)),
         format!(
             "at most {MAX_COLLISIONS} tentative collisions per walk and span: \
              the majorant's optical depth is too large for tracking"
