@@ -1021,3 +1021,22 @@ fn tracking_through_an_empty_medium_is_exact_and_unflagged() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A fault inside `budgets` names its own path and reason (it said "data did
+/// not match any variant of untagged enum Budgets" at `budgets`).
+#[test]
+fn a_fault_inside_budgets_names_its_path() {
+    let with = |b: &str| VALID.replace("\"budgets\": [4, 16, 64]", &format!("\"budgets\": {b}"));
+    rejected(
+        &with("{ \"from\": 4, \"to\": 64, \"factor\": \"NaN\" }"),
+        "budgets.factor",
+        "expected f64",
+    );
+    rejected(&with("[4, \"x\", 16]"), "budgets[1]", "expected i64");
+    rejected(
+        &with("{ \"from\": 4, \"to\": 64, \"factor\": 2, \"step\": 1 }"),
+        "budgets.step",
+        "unknown field",
+    );
+    rejected(&with("\"many\""), "budgets", "a list of budgets");
+}

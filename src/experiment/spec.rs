@@ -59,7 +59,9 @@ fn default_targets() -> Vec<f64> {
 }
 
 /// Budgets: a list, or a geometric range `from, from*factor, ... <= to`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+/// Read by [`untagged`] (a list or a map, never buffered), so an error
+/// inside names its own path (`budgets.factor`, `budgets[2]`).
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum Budgets {
     /// An explicit list.
@@ -82,8 +84,9 @@ pub struct BudgetRange {
     pub factor: f64,
 }
 
-/// A literal reference value: a number, or one number per channel.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+/// A literal reference value: a number, or one number per channel (read by
+/// [`untagged`], so an error names its own path).
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum Literal {
     /// One channel.
@@ -143,4 +146,62 @@ pub enum ReferenceSpec<Q> {
 
 fn four_hundred() -> usize {
     400
+}
+
+/// Deserialises the two untagged enums of experiment files by the JSON
+/// kind they meet (number, list, map) instead of serde's untagged buffering,
+/// which loses the path and the reason of an error inside ("data did not
+/// match any variant").
+mod untagged {
+    use super::{BudgetRange, Budgets, Literal};
+    use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
+    use serde::de::{Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
+    use std::fmt;
+
+    impl<'de> Deserialize<'de> for Budgets {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            struct V;
+            impl<'de> Visitor<'de> for V {
+                type Value = Budgets;
+                fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                    f.write_str(
+                        "a list of budgets ([4, 16, 64]) or a range \
+                         ({\"from\": 4, \"to\": 4096, \"factor\": 4})",
+                    )
+                }
+                fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Budgets, A::Error> {
+                    Vec::<i64>::deserialize(SeqAccessDeserializer::new(seq)).map(Budgets::List)
+                }
+                fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Budgets, A::Error> {
+                    BudgetRange::deserialize(MapAccessDeserializer::new(map)).map(Budgets::Range)
+                }
+            }
+            d.deserialize_any(V)
+        }
+    }
+
+    impl<'de> Deserialize<'de> for Literal {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            struct V;
+            impl<'de> Visitor<'de> for V {
+                type Value = Literal;
+                fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                    f.write_str("a number, or a list of numbers (one per channel)")
+                }
+                fn visit_f64<E: serde::de::Error>(self, x: f64) -> Result<Literal, E> {
+                    Ok(Literal::Scalar(x))
+                }
+                fn visit_i64<E: serde::de::Error>(self, x: i64) -> Result<Literal, E> {
+                    Ok(Literal::Scalar(x as f64))
+                }
+                fn visit_u64<E: serde::de::Error>(self, x: u64) -> Result<Literal, E> {
+                    Ok(Literal::Scalar(x as f64))
+                }
+                fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Literal, A::Error> {
+                    Vec::<f64>::deserialize(SeqAccessDeserializer::new(seq)).map(Literal::Channels)
+                }
+            }
+            d.deserialize_any(V)
+        }
+    }
 }
