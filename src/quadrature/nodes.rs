@@ -278,14 +278,19 @@ impl Composite {
 ///   shrink): `max(|d|, |Q_2h - Q_4h|)`, the larger of the two differences
 ///   undivided.
 ///
-/// Without the `4h` rule only `|d| / (2^p - 1)` is available.
+/// Without the `4h` rule nothing shows the order, and the estimate assumes
+/// no more than order 2 (what a kink still gives): `|d| / (min(2^p, 4) - 1)`.
+/// For Simpson that is `|d| / 3`, five times Richardson's `|d| / 15` on a
+/// smooth integrand, but honest where a jump makes the order 1 (`|d| / 15`
+/// was below a tenth of the true error at 6.9% of 8400 jump and kink cases).
 pub fn richardson<V: Value>(sum: ProductSum<V>, order: i32) -> Estimate<V> {
     let coarse = sum.companion.unwrap_or(sum.value);
     let full = 2f64.powi(order);
+    let unchecked = full.min(4.0);
     let error = match sum.companion4 {
-        None => sum
-            .value
-            .zip(coarse, |fine, coarse| (fine - coarse).abs() / (full - 1.0)),
+        None => sum.value.zip(coarse, |fine, coarse| {
+            (fine - coarse).abs() / (unchecked - 1.0)
+        }),
         Some(coarser) => V::from_fn(|c| {
             let d = sum.value.channel(c) - coarse.channel(c);
             let d2 = coarse.channel(c) - coarser.channel(c);
