@@ -377,3 +377,65 @@ fn gauss_legendre_hybrid_estimate_costs_two_and_a_half_rules_and_can_be_switched
         est2.error
     );
 }
+
+/// Estimates at random jump and kink positions (300 positions by the golden
+/// ratio, 14 budgets from 31 to 8193, a step `[x > s]` with integral `1 - s`
+/// and a kink `|x - s|` with integral `(s^2 + (1-s)^2)/2`): the share whose
+/// estimate is below a tenth of the true error (above 1e-13) without the
+/// rule doubting it. Measured: trapezoid 0 and Simpson 0 of 8400 (Simpson
+/// was 578 with the unchecked `|d|/15`), Gauss–Legendre 14 of 8400,
+/// Gauss–Kronrod 293 of 6151 (4.8%: a jump between a panel's outermost node
+/// and its end is invisible to the panel, a known limit of the G7–K15 pair,
+/// not yet handled). The bounds hold those figures, so a regression fails.
+#[test]
+fn estimates_at_random_jump_and_kink_positions_rarely_lie() {
+    use lightquad::quadrature::AnyRule;
+    for (name, allowed) in [
+        ("trapezoid", 0.0),
+        ("simpson", 0.0),
+        ("gauss-legendre", 0.002),
+        ("gauss-kronrod", 0.05),
+    ] {
+        let rule = AnyRule::by_name(name).expect("a rule");
+        let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(1);
+        let (mut lies, mut total) = (0usize, 0usize);
+        for k in 0..300 {
+            let s = 0.05 + 0.9 * ((k as f64 * 0.618_033_988_749_895) % 1.0);
+            for n in [
+                31usize, 33, 63, 65, 127, 129, 255, 257, 511, 513, 1025, 2049, 4097, 8193,
+            ] {
+                for kink in [false, true] {
+                    let f = |x: f64| {
+                        if kink {
+                            (x - s).abs()
+                        } else if x > s {
+                            1.0
+                        } else {
+                            0.0
+                        }
+                    };
+                    let exact = if kink {
+                        0.5 * (s * s + (1.0 - s) * (1.0 - s))
+                    } else {
+                        1.0 - s
+                    };
+                    let e = rule
+                        .integrate::<1, f64, _, _>(n, &mut rng, |p: [f64; 1]| f(p[0]))
+                        .expect("finite");
+                    let truth = (e.value - exact).abs();
+                    if truth > 1e-13 {
+                        total += 1;
+                        if e.error < 0.1 * truth && e.reliable {
+                            lies += 1;
+                        }
+                    }
+                }
+            }
+        }
+        let share = lies as f64 / total as f64;
+        assert!(
+            share <= allowed,
+            "{name}: {lies} of {total} estimates below a tenth of the true error, unflagged"
+        );
+    }
+}
