@@ -17,7 +17,7 @@
 //! |---|---|---|
 //! | `trapezoid` | composite trapezoid, product in D > 1 | Richardson, half step; observed order from the quarter step when nested |
 //! | `simpson` | composite Simpson, product in D > 1 | Richardson, half step; observed order from the quarter step when nested |
-//! | `gauss-legendre` | Gauss–Legendre of any order, product in D > 1 | tail of the differences of `Q_m, Q_{m-1}, Q_{m-2}`, checked against `Q_m - Q_{m/2}` from m = 32 |
+//! | `gauss-legendre` | Gauss–Legendre of any order, product in D > 1 | tail of the differences of `Q_m, Q_{m-1}, Q_{m-2}`, checked against `Q_m - Q_{m/2}` from m = 16 |
 //! | `gauss-kronrod` | adaptive Gauss–Kronrod G7–K15 (D = 1) | embedded G7 |
 //! | `monte-carlo` | plain Monte Carlo | standard error |
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
