@@ -389,6 +389,17 @@ pub trait Family: Sized + Send + Sync + 'static {
     /// The quantities `estimator` estimates.
     fn estimates(estimator: &Self::Estimator) -> &'static [Self::Quantity];
 
+    /// Why `estimator` cannot estimate `quantity` in this `scene`, though it
+    /// estimates it in general ([`Family::estimates`]); checked when an
+    /// experiment is validated. None: it can.
+    fn refuses(
+        _scene: &Self::Scene,
+        _estimator: &Self::Estimator,
+        _quantity: Self::Quantity,
+    ) -> Option<String> {
+        None
+    }
+
     /// Evaluates `quantities` with `method` at `budget`, drawing randomness from
     /// `rng` only.
     fn evaluate(

@@ -1040,3 +1040,24 @@ fn a_fault_inside_budgets_names_its_path() {
     );
     rejected(&with("\"many\""), "budgets", "a list of budgets");
 }
+
+/// Delta tracking with an emission field of its own is refused when the
+/// experiment is checked (its collisions score c(v) of the density and would
+/// miss a field that emits outside the medium), not by failing every job.
+#[test]
+fn delta_tracking_with_an_emission_field_is_refused_at_check() {
+    let text = VALID
+        .replace(
+            "{ \"type\": \"constant\", \"c\": 1.0 }",
+            "{ \"type\": \"field\", \"field\": { \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 2.0, \"kappa\": 1.0 } }",
+        )
+        .replace(
+            "{ \"rule\": \"gauss-legendre\" }, { \"rule\": \"stratified\" }",
+            "{ \"rule\": \"delta-tracking\" }",
+        );
+    rejected(
+        &text,
+        "rules[0]",
+        "cannot estimate quantities[1] (I_E) in this scene",
+    );
+}

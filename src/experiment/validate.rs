@@ -287,6 +287,16 @@ fn check_methods<F: Family>(spec: &ExperimentSpec<F>, scene: &F::Scene) -> Resul
                             ),
                         ));
                     }
+                    if let Some(why) = F::refuses(scene, e, *q) {
+                        return Err(SpecError::at(
+                            at,
+                            format!(
+                                "estimator `{}` cannot estimate quantities[{k}] ({}) in this scene: {why}",
+                                e.name(),
+                                q.name()
+                            ),
+                        ));
+                    }
                 }
             }
         }

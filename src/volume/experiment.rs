@@ -361,6 +361,19 @@ impl Family for Volume {
         }
     }
 
+    /// Delta tracking scores `c(v)` at its collisions: an emission field of
+    /// its own (which may emit where the medium does not) is not a map of
+    /// the density, so I_E and I are refused for it.
+    fn refuses(built: &Built, tracker: &Tracker, q: VolumeQuantity) -> Option<String> {
+        let field = matches!(built.scene.emission, Some(EmissionMap::Field(_)));
+        let emits = matches!(q, VolumeQuantity::Emission | VolumeQuantity::Total);
+        (*tracker == Tracker::Delta && field && emits).then(|| {
+            "its collisions score c(v) of the density, and the scene's emission is a field of \
+             its own (scene.emission.type = field): integrate it with a quadrature rule"
+                .to_string()
+        })
+    }
+
     fn evaluate(
         built: &Built,
         method: &Method<Tracker>,
