@@ -256,10 +256,7 @@ impl VolumeScene {
         // First at the closest approach to the medium's centre, so that a
         // far origin does not round the chord away; then at the middle of the
         // support as seen from there.
-        let field = match &self.emission {
-            Some(EmissionMap::Field(f)) => Some(f),
-            _ => None,
-        };
+        let field = self.emission_field();
         let near = self
             .medium
             .iter()
@@ -273,6 +270,14 @@ impl VolumeScene {
         let (near_scene, _) = self.shifted(t_near);
         let (out, t_star) = near_scene.anchored_at_support();
         (out, t_near + t_star)
+    }
+
+    /// The emission field, when the scene's emission is one.
+    fn emission_field(&self) -> Option<&Arc<dyn Medium>> {
+        match &self.emission {
+            Some(EmissionMap::Field(f)) => Some(f),
+            _ => None,
+        }
     }
 
     /// The scene with its ray's origin moved to `e + t v`.
@@ -289,10 +294,7 @@ impl VolumeScene {
 
     /// Re-anchored at the middle of the support along the ray as it is.
     fn anchored_at_support(&self) -> (VolumeScene, f64) {
-        let field = match &self.emission {
-            Some(EmissionMap::Field(f)) => Some(f),
-            _ => None,
-        };
+        let field = self.emission_field();
         let (first, last) = self
             .medium
             .iter()
