@@ -8,7 +8,12 @@ pub enum ErrorKind {
     /// A deterministic rule's estimate of `|value - exact|` (Richardson,
     /// embedded rule, geometric tail). Estimates over disjoint regions add.
     Deterministic,
-    /// One standard error of a random estimate. Standard errors of
+    /// One standard error of a random estimate, widened by
+    /// [`t95_factor`] where it was estimated from few degrees of freedom, so
+    /// that `value +- 1.96 error` is the two-sided 95% Student-t interval
+    /// (`+- 1.96` plain sample standard errors cover 93% of normal data at
+    /// 15 degrees of freedom and 89% at 5; the stratified rule's volume
+    /// quantities at 16 cells covered 87-92% before the widening). Standard errors of
     /// independent estimates over disjoint regions add in quadrature
     /// (`sqrt(a^2 + b^2)`); adding them linearly would overstate the
     /// uncertainty by up to the square root of the number of regions.
@@ -123,9 +128,59 @@ impl<V: Value> Estimate<V> {
     }
 }
 
+/// `t_dof(0.975) / 1.96`: the factor that turns `+- 1.96` standard errors
+/// estimated with `dof` degrees of freedom into the two-sided 95% Student-t
+/// interval (1.312 at 5, 1.087 at 15, 1.0001 at 10^4, 0.99998 in the
+/// normal limit); infinite for
+/// `dof <= 0`, where there is no estimate of the spread.
+pub fn t95_factor(dof: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    /// The normal quantile `z_0.975`.
+    const Z: f64 = 1.959_963_984_540_054;
+    if dof.is_nan() || dof <= 0.0 {
+        return f64::INFINITY;
+    }
+    if dof > 1e4 {
+        // Cornish-Fisher: `t = z + (z^3 + z)/(4 nu) + (5z^5 + 16z^3 + 3z)/(96 nu^2)`,
+        // within 1e-11 here; statrs' inversion loses digits past 1e5 degrees
+        // of freedom (1.95985 at 10^6, below the normal quantile).
+        let (z2, nu) = (Z * Z, dof);
+        let t = Z
+            + Z * (z2 + 1.0) / (4.0 * nu)
+            + Z * (5.0 * z2 * z2 + 16.0 * z2 + 3.0) / (96.0 * nu * nu);
+        return t / 1.96;
+    }
+    match StudentsT::new(0.0, 1.0, dof) {
+        Ok(t) => t.inverse_cdf(0.975) / 1.96,
+        Err(_) => f64::INFINITY,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn t95_factor_matches_printed_student_t_quantiles() {
+        // t_{0.975} from the standard tables (e.g. NIST/SEMATECH e-Handbook
+        // 1.3.6.7.2): 12.706 (1), 2.571 (5), 2.131 (15), 2.042 (30), 1.984 (100).
+        for (dof, t) in [
+            (1.0, 12.706),
+            (5.0, 2.571),
+            (15.0, 2.131),
+            (30.0, 2.042),
+            (100.0, 1.984),
+        ] {
+            let got = t95_factor(dof) * 1.96;
+            assert!((got - t).abs() < 6e-4, "dof {dof}: {got} vs {t}");
+        }
+        // Both sides of the switch to the expansion, and the normal limit.
+        let (below, above) = (t95_factor(1e4), t95_factor(1e4 * (1.0 + 1e-9)));
+        assert!((below - above).abs() < 1e-11, "{below} vs {above}");
+        assert!((t95_factor(1e12) * 1.96 - 1.959_963_985).abs() < 1e-9);
+        assert_eq!(t95_factor(0.0), f64::INFINITY);
+        assert_eq!(t95_factor(f64::NAN), f64::INFINITY);
+    }
 
     #[test]
     fn standard_errors_of_disjoint_regions_add_in_quadrature_and_bounds_linearly() {

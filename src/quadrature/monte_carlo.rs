@@ -1,13 +1,15 @@
 //! Plain Monte Carlo: `Q = (1/N) sum f(U_i)` with `U_i` independent and uniform
 //! on `[0, 1)^D`; standard error `s / sqrt(N)` with the sample standard deviation
-//! `s` accumulated by Welford's update (no cancellation when the mean is large).
+//! `s` accumulated by Welford's update (no cancellation when the mean is large),
+//! widened to the Student-t interval of `N - 1` degrees of freedom
+//! ([`t95_factor`]).
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::Rule;
 use crate::error::QuadError;
-use crate::estimate::Estimate;
+use crate::estimate::{Estimate, t95_factor};
 use crate::quadrature::nodes::non_finite;
 use crate::value::Value;
 use rand::RngExt;
@@ -67,6 +69,14 @@ impl<V: Value> Welford<V> {
         }
         self.m2.map(|m2| (m2 / ((k - 1.0) * k)).sqrt())
     }
+
+    /// [`standard_error`](Self::standard_error) times
+    /// [`t95_factor`]`(k - 1)`: `mean +- 1.96` of it is the 95% Student-t
+    /// interval of `k` samples.
+    pub fn interval_error(&self) -> V {
+        let t = t95_factor(self.count as f64 - 1.0);
+        self.standard_error().map(|e| e * t)
+    }
 }
 
 impl Rule for MonteCarlo {
@@ -119,7 +129,7 @@ impl Rule for MonteCarlo {
         }
         Ok(Estimate::random(
             acc.mean(),
-            acc.standard_error(),
+            acc.interval_error(),
             n as u64,
         ))
     }

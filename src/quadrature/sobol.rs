@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 use super::{Dimensions, Rule};
 use super::monte_carlo::Welford;
 use crate::error::QuadError;
-use crate::estimate::Estimate;
+use crate::estimate::{Estimate, t95_factor};
 use crate::quadrature::nodes::non_finite;
 use crate::sum::Compensated;
 use crate::value::Value;
@@ -198,7 +198,7 @@ impl Rule for Sobol {
             }
             means.add(sum.total().map(|s| s / per as f64));
         }
-        let t = student_t_factor(reps)?;
+        let t = t95_factor(reps as f64 - 1.0);
         Ok(Estimate::random(
             means.mean(),
             means.standard_error().map(|e| e * t),
@@ -207,12 +207,3 @@ impl Rule for Sobol {
     }
 }
 
-/// `t_{R-1}(0.975) / 1.96`: the factor that makes `+- 1.96` standard errors
-/// from `R` independent means the two-sided 95% Student-t interval.
-fn student_t_factor(replicates: usize) -> Result<f64, QuadError> {
-    use statrs::distribution::{ContinuousCDF, StudentsT};
-    let dof = (replicates - 1) as f64;
-    let t = StudentsT::new(0.0, 1.0, dof)
-        .map_err(|e| QuadError::invalid("replicates", replicates, format!("an integer >= 2 ({e})")))?;
-    Ok(t.inverse_cdf(0.975) / 1.96)
-}

@@ -12,14 +12,15 @@
 //! integrands (a gradient `g` across cells of width `h` adds `(g h)^2`, while
 //! `sigma^2` itself is only `(g h)^2 / 12`). Then
 //! `Var(Q) = (1/N^2) sum_i sigma_i^2 ~ (1/N^2) (N / T) sum_triples (...)^2 / 6`
-//! over the `T` triples.
+//! over the `T` triples. The standard error has `T` degrees of freedom and is
+//! widened by [`t95_factor`]`(T)` to the Student-t interval.
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::{Rule, per_axis};
 use crate::error::QuadError;
-use crate::estimate::Estimate;
+use crate::estimate::{Estimate, t95_factor};
 use crate::quadrature::nodes::non_finite;
 use crate::sum::Compensated;
 use crate::value::Value;
@@ -124,9 +125,12 @@ impl Rule for Stratified {
         } else {
             V::zero().map(|_| f64::INFINITY)
         };
+        // Each triple's squared second difference is one degree of freedom
+        // of the variance estimate.
+        let t = t95_factor(triples as f64);
         Ok(Estimate::random(
             sum.total().map(|s| s / nf),
-            variance_sum.map(|v| v.sqrt() / nf),
+            variance_sum.map(|v| v.sqrt() / nf * t),
             cells as u64,
         ))
     }

@@ -114,7 +114,8 @@ pub struct Extinction<'a> {
 pub struct Tracked {
     /// The mean score.
     pub value: f64,
-    /// One standard error, or its honest substitute (module documentation):
+    /// One standard error widened to the Student-t interval
+    /// ([`Welford::interval_error`]), or its honest substitute (module documentation):
     /// the Wilson half-width over 1.96 for 0/1 scores, `W(n) D` when every
     /// walk scored alike.
     pub error: f64,
@@ -179,7 +180,7 @@ impl Scores {
         let error = if self.alike {
             wilson_unseen(n) * spread(x)
         } else {
-            self.walks.standard_error()
+            self.walks.interval_error()
         };
         Tracked {
             value: x,
