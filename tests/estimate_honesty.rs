@@ -383,8 +383,10 @@ fn gauss_legendre_hybrid_estimate_costs_two_and_a_half_rules_and_can_be_switched
 /// and a kink `|x - s|` with integral `(s^2 + (1-s)^2)/2`): the share whose
 /// estimate is below a tenth of the true error (above 1e-13) without the
 /// rule doubting it. Measured: trapezoid 0 and Simpson 0 of 8400 (Simpson
-/// was 578 with the unchecked `|d|/15`), Gauss–Legendre 2 of 8400 (14
-/// while m = 31 still used the consecutive orders alone), Gauss–Kronrod 0 of 6151 (was 293:
+/// was 578 with the unchecked `|d|/15`), Gauss–Legendre 0 of 8400 (14
+/// while m = 31 still used the consecutive orders alone, 2 while an
+/// inconsistent tail trusted a half order that agreed by chance: a kink at
+/// s = 0.2907, m = 31, estimate 1.8e-7 against 1.1e-4), Gauss–Kronrod 0 of 6151 (was 293:
 /// a jump between a panel's outermost node and its end was invisible to the
 /// panel; the panels' extrapolations to their meeting points now see it).
 /// The bounds hold those figures, so a regression fails.
@@ -394,7 +396,7 @@ fn estimates_at_random_jump_and_kink_positions_rarely_lie() {
     for (name, allowed) in [
         ("trapezoid", 0.0),
         ("simpson", 0.0),
-        ("gauss-legendre", 0.0005),
+        ("gauss-legendre", 0.0),
         ("gauss-kronrod", 0.0),
     ] {
         let rule = AnyRule::by_name(name).expect("a rule");
