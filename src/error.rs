@@ -35,6 +35,19 @@ pub enum QuadError {
         /// Dimensions the rule supports, in words.
         supported: &'static str,
     },
+    /// The integral is beyond the f64 range (or the rule's arithmetic is,
+    /// even with the integrand scaled to at most 1).
+    #[error(
+        "rule `{rule}`: the integral overflows f64: the integrand scaled by 2^-{exponent} integrates to {value}, which times 2^{exponent} is beyond 1.8e308"
+    )]
+    Overflow {
+        /// Rule name.
+        rule: &'static str,
+        /// The scaled estimate, formatted.
+        value: String,
+        /// The scaling exponent.
+        exponent: i32,
+    },
     /// The integrand returned a non-finite value.
     #[error("integrand returned {value} at unit-cube point {point:?}")]
     NonFiniteIntegrand {

@@ -132,6 +132,9 @@ impl Family for Poly {
                     let sum = (0..n).fold(lightquad::Rgb::zeros(), |s, i| {
                         s + moments(k, i as f64 / n as f64)
                     }) / n as f64;
+                    // A bug planted at budget 7: the runner must turn its
+                    // NaN into a failed job.
+                    let sum = if n == 7 { sum.map(|_| f64::NAN) } else { sum };
                     let e = lightquad::Estimate::deterministic(
                         sum,
                         lightquad::Rgb::repeat(1.0 / n as f64),
@@ -378,4 +381,58 @@ fn the_family_and_its_limits_are_checked_before_any_job_runs() {
     for tag in ["estimator", "dims", "scene", "eq"] {
         let _ = fs::remove_dir_all(scratch(tag));
     }
+}
+
+#[test]
+fn a_non_finite_value_is_a_failed_job_that_resume_and_merge_keep() {
+    // NaN/inf used to be written as JSON null with exit 0; `--resume` then
+    // re-ran those jobs forever and `merge` called the folder incomplete.
+    let text = FILE
+        .replace("[\"moment\", \"moments\", \"square\"]", "[\"moment\"]")
+        .replace("[16, 64, 256]", "[7, 16]")
+        .replace(
+            "{ \"rule\": \"product\", \"outer\": { \"rule\": \"gauss-legendre\" }, \"inner\": { \"rule\": \"trapezoid\" } },\n",
+            "{ \"rule\": \"left-riemann\" },\n",
+        );
+    let (result, dir) = run(&registry(), &text, "nan");
+    let e = result.expect_err("a failed job").to_string();
+    assert!(e.contains("2 of 12 jobs failed"), "{e}");
+    let file = dir.join("out/poly-moments/results.jsonl");
+    let before = fs::read_to_string(&file).expect("results");
+    let results = read_results(&file, None);
+    assert_eq!(results.len(), 12, "every line parses");
+    let failed: Vec<_> = results.iter().filter(|r| r.failure.is_some()).collect();
+    assert_eq!(failed.len(), 2);
+    for r in &failed {
+        assert_eq!((r.rule.as_str(), r.budget), ("left-riemann", 7));
+        let why = r.failure.as_deref().unwrap_or_default();
+        assert!(why.contains("non-finite moment (NaN)"), "{why}");
+    }
+    let report = fs::read_to_string(dir.join("out/poly-moments/report.md")).expect("report");
+    assert!(report.contains("non-finite moment"), "{report}");
+    // --resume keeps the failures as they are: nothing re-runs.
+    let opts = RunOptions {
+        out: dir.join("out"),
+        resume: true,
+        shard: None,
+        progress: false,
+    };
+    let again = run_files(&registry(), &[dir.join("e.json")], &opts);
+    assert!(again.is_err(), "still failed");
+    let after = fs::read_to_string(&file).expect("results");
+    // Byte-identical lines (a re-run job would carry a new wall time).
+    let lines = |t: &str| {
+        let mut v: Vec<String> = t.lines().map(str::to_string).collect();
+        v.sort();
+        v
+    };
+    assert_eq!(lines(&before), lines(&after));
+    // merge: complete (no "incomplete"), the failures reported as failures.
+    let merged = lightquad::experiment::merge(&registry(), &[dir.join("out")], &dir.join("m"));
+    let e = merged.expect_err("failed jobs").to_string();
+    assert!(
+        e.contains("2 of 12 jobs failed") && !e.contains("incomplete"),
+        "{e}"
+    );
+    let _ = fs::remove_dir_all(&dir);
 }

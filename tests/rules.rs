@@ -496,3 +496,81 @@ fn gauss_kronrod_stays_within_its_budget() {
         );
     }
 }
+
+/// Every rule of the registry with its default parameters, and a product.
+fn every_rule() -> Vec<AnyRule> {
+    let mut all: Vec<AnyRule> = lightquad::quadrature::BaseRule::defaults()
+        .into_iter()
+        .map(AnyRule::Base)
+        .collect();
+    all.push(AnyRule::by_name("product(gauss-legendre,monte-carlo)").expect("product"));
+    all
+}
+
+#[test]
+fn integrands_near_the_top_of_the_f64_range_give_finite_estimates() {
+    // Sums (Gauss-Kronrod, Sobol), second differences (stratified) and
+    // squared deviations (Monte Carlo) of finite values near 1.8e308 used to
+    // overflow into Ok(NaN); the integrand is now scaled by a power of two
+    // and the estimate scaled back. The integrals are 1e308 (a constant) and
+    // 0 (a jump from -1e308 to 1e308 at 1/2, integral over the unit cube).
+    let mut rng = rng(5);
+    for rule in every_rule() {
+        let name = rule.label();
+        for d in [1usize, 2] {
+            let (constant, jump) = if d == 1 {
+                (
+                    rule.integrate::<1, f64, _, _>(64, &mut rng, |_| 1e308),
+                    rule.integrate::<1, f64, _, _>(64, &mut rng, |u| {
+                        if u[0] < 0.5 { -1e308 } else { 1e308 }
+                    }),
+                )
+            } else {
+                (
+                    rule.integrate::<2, f64, _, _>(64, &mut rng, |_| 1e308),
+                    rule.integrate::<2, f64, _, _>(64, &mut rng, |u| {
+                        if u[0] < 0.5 { -1e308 } else { 1e308 }
+                    }),
+                )
+            };
+            let (Ok(c), Ok(j)) = (constant, jump) else {
+                // Only a rule that does not integrate in `d` dimensions may refuse.
+                assert!(!rule.dimensions().contains(d), "{name} in {d}-D refused");
+                continue;
+            };
+            assert!(
+                ((c.value - 1e308) / 1e308).abs() < 1e-12 && c.error.is_finite(),
+                "{name} {d}-D constant: {c:?}"
+            );
+            assert!(
+                j.value.is_finite() && j.error.is_finite(),
+                "{name} {d}-D jump: {j:?}"
+            );
+            // The jump's estimate is honest about its error (0 is exact).
+            assert!(
+                j.value.abs() <= 10.0 * j.error.max(1e-300),
+                "{name} {d}-D jump: {j:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn budgets_beyond_two_to_the_forty_are_refused_at_once() {
+    // n = usize::MAX used to loop for centuries (the trapezoid) or wrap.
+    let mut rng = rng(1);
+    for rule in every_rule() {
+        for n in [usize::MAX, usize::MAX / 2, (1 << 40) + 1] {
+            let e1 = rule.integrate::<1, f64, _, _>(n, &mut rng, |_| 1.0);
+            let e2 = rule.integrate::<2, f64, _, _>(n, &mut rng, |_| 1.0);
+            for e in [e1, e2] {
+                let message = e.expect_err("refused").to_string();
+                assert!(
+                    message.contains("invalid n") || message.contains("dimension"),
+                    "{}: {message}",
+                    rule.label()
+                );
+            }
+        }
+    }
+}

@@ -254,7 +254,7 @@ impl Rule for GaussKronrod {
         Ok(())
     }
 
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,

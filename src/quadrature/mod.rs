@@ -97,13 +97,14 @@ pub trait Rule {
         Ok(())
     }
 
-    /// Estimates `int_{[0,1]^D} f(u) du` with a budget of about `n` evaluations,
-    /// for an integrand that may fail: its first error stops the rule and is
-    /// returned as is.
+    /// The rule itself, which [`Rule::try_integrate`] guards against
+    /// overflow: estimates `int_{[0,1]^D} f(u) du` with a budget of about `n`
+    /// evaluations, for an integrand that may fail: its first error stops the
+    /// rule and is returned as is.
     ///
     /// `rng` drives the randomised rules and is ignored by deterministic ones;
     /// with the same `rng` state the result is bit-for-bit reproducible.
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,
@@ -115,6 +116,62 @@ pub trait Rule {
         f: F,
     ) -> Result<Estimate<V>, QuadError>;
 
+    /// Estimates `int_{[0,1]^D} f(u) du` with a budget of about `n` evaluations,
+    /// for an integrand that may fail: its first error stops the rule and is
+    /// returned as is. `n` above [`MAX_BUDGET`] is an error. A rule's sums, differences and squares of finite values
+    /// near the top of the f64 range can overflow into an infinite or NaN
+    /// estimate; then the integral is taken again of `f 2^-e`, with `2^e` the
+    /// largest `|f|` seen (an exact scaling), and scaled back. An estimate that
+    /// is still not finite is an error ([`QuadError::Overflow`]), never a
+    /// silent NaN. The second pass's evaluations are counted.
+    fn try_integrate<
+        const D: usize,
+        V: Value,
+        R: rand::Rng + ?Sized,
+        F: FnMut([f64; D]) -> Result<V, QuadError>,
+    >(
+        &self,
+        n: usize,
+        rng: &mut R,
+        mut f: F,
+    ) -> Result<Estimate<V>, QuadError> {
+        if n > MAX_BUDGET {
+            return Err(QuadError::invalid(
+                "n",
+                n,
+                format!("a budget of at most 2^40 = {MAX_BUDGET} evaluations"),
+            ));
+        }
+        let mut largest = 0.0f64;
+        let first = self.integrate_unguarded(n, rng, |u| {
+            let y = f(u)?;
+            largest = largest.max(y.max_abs());
+            Ok(y)
+        })?;
+        if sound(&first) {
+            return Ok(first);
+        }
+        // 2^e >= largest |f|, so every scaled value is at most 1 in size.
+        let e = largest.log2().ceil().clamp(0.0, 1023.0) as i32;
+        let (down, up) = (2f64.powi(-e), 2f64.powi(e));
+        let second = self.integrate_unguarded(n, rng, |u| Ok(f(u)?.map(|y| y * down)))?;
+        let scaled = Estimate {
+            value: second.value.map(|v| v * up),
+            error: second.error.map(|x| x * up),
+            evaluations: first.evaluations + second.evaluations,
+            ..second
+        };
+        if sound(&scaled) {
+            Ok(scaled)
+        } else {
+            Err(QuadError::Overflow {
+                rule: self.name(),
+                value: format!("{:?}", second.value),
+                exponent: e,
+            })
+        }
+    }
+
     /// [`Rule::try_integrate`] for an integrand that cannot fail.
     fn integrate<const D: usize, V: Value, R: rand::Rng + ?Sized, F: FnMut([f64; D]) -> V>(
         &self,
@@ -124,6 +181,18 @@ pub trait Rule {
     ) -> Result<Estimate<V>, QuadError> {
         self.try_integrate(n, rng, |u| Ok(f(u)))
     }
+}
+
+/// The largest budget any rule accepts, `2^40` (about 1.1e12) evaluations:
+/// hours of work at a nanosecond per evaluation. A larger `n` (`usize::MAX`
+/// from an unchecked computation) is refused at once instead of looping for
+/// centuries.
+pub const MAX_BUDGET: usize = 1 << 40;
+
+/// A finite value and an error that is a number (an infinite error is a
+/// rule's way of saying it has no estimate, not an overflow).
+fn sound<V: Value>(e: &Estimate<V>) -> bool {
+    e.value.all_finite() && (0..V::CHANNELS).all(|c| !e.error.channel(c).is_nan())
 }
 
 /// Nodes per axis for a product rule with a budget of `n` evaluations in `D`
@@ -249,7 +318,7 @@ macro_rules! registry {
             fn check(&self) -> Result<(), QuadError> {
                 match self { $(BaseRule::$rule(r) => r.check(),)+ }
             }
-            fn try_integrate<
+            fn integrate_unguarded<
                 const D: usize,
                 V: Value,
                 R: rand::Rng + ?Sized,
@@ -260,7 +329,7 @@ macro_rules! registry {
                 rng: &mut R,
                 f: F,
             ) -> Result<Estimate<V>, QuadError> {
-                match self { $(BaseRule::$rule(r) => r.try_integrate(n, rng, f),)+ }
+                match self { $(BaseRule::$rule(r) => r.integrate_unguarded(n, rng, f),)+ }
             }
         }
     };
@@ -403,7 +472,7 @@ impl Rule for AnyRule {
             AnyRule::Product(r) => r.check(),
         }
     }
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,
@@ -415,8 +484,8 @@ impl Rule for AnyRule {
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
         match self {
-            AnyRule::Base(r) => r.try_integrate(n, rng, f),
-            AnyRule::Product(r) => r.try_integrate(n, rng, f),
+            AnyRule::Base(r) => r.integrate_unguarded(n, rng, f),
+            AnyRule::Product(r) => r.integrate_unguarded(n, rng, f),
         }
     }
 }

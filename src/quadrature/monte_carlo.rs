@@ -97,7 +97,7 @@ impl Rule for MonteCarlo {
         true
     }
 
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,

@@ -144,7 +144,7 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
         Ok(())
     }
 
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,

@@ -83,7 +83,7 @@ impl Rule for Simpson {
         5usize.saturating_pow(dim as u32)
     }
 
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,

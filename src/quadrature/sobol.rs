@@ -148,7 +148,7 @@ impl Rule for Sobol {
         Ok(())
     }
 
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,

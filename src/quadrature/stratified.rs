@@ -53,7 +53,7 @@ impl Rule for Stratified {
         true
     }
 
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,

@@ -80,7 +80,7 @@ impl Rule for Trapezoid {
         3usize.saturating_pow(dim as u32)
     }
 
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,

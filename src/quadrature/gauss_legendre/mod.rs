@@ -398,7 +398,7 @@ impl Rule for GaussLegendre {
         "Gauss–Legendre of any order 1..=1e8 (product rule in D > 1); error estimate from the tail of Q_m - Q_(m-1), Q_(m-1) - Q_(m-2), checked against Q_m - Q_(m/2) from m = 16"
     }
 
-    fn try_integrate<
+    fn integrate_unguarded<
         const D: usize,
         V: Value,
         R: rand::Rng + ?Sized,
