@@ -181,6 +181,14 @@ impl Family for Poly {
         n: usize,
         quantities: &[PolyQuantity],
     ) -> Result<Outcome<PolyQuantity>, QuadError> {
+        // A bug planted at degree 49: the reference cannot be computed.
+        if *k == 49.0 {
+            return Err(QuadError::invalid(
+                "degree",
+                49,
+                "a degree the planted bug spares",
+            ));
+        }
         let gl = Method::Rule(lightquad::quadrature::AnyRule::by_name("gauss-legendre")?);
         let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
         Self::evaluate(k, &gl, n * n, &mut rng, quantities)
@@ -434,5 +442,25 @@ fn a_non_finite_value_is_a_failed_job_that_resume_and_merge_keep() {
         e.contains("2 of 12 jobs failed") && !e.contains("incomplete"),
         "{e}"
     );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A reference that cannot be computed is said so on the page, and the run
+/// fails: never a page that claims convergence and shows no table.
+#[test]
+fn a_reference_that_cannot_be_computed_fails_the_run_and_says_why() {
+    let text = FILE
+        .replace("\"degree\": 5", "\"degree\": 49")
+        .replace("{ \"type\": \"closed-form\" }", "{ \"type\": \"converged\" }")
+        .replace(
+            "{ \"rule\": \"product\", \"outer\": { \"rule\": \"gauss-legendre\" }, \"inner\": { \"rule\": \"trapezoid\" } },\n",
+            "",
+        );
+    let (result, dir) = run(&registry(), &text, "noref");
+    let e = result.expect_err("a run without a reference").to_string();
+    assert!(e.contains("has no reference"), "{e}");
+    let report = fs::read_to_string(dir.join("out/poly-moments/report.md")).expect("report");
+    assert!(report.contains("## moment (no reference)"), "{report}");
+    assert!(!report.contains("(converged)"), "{report}");
     let _ = fs::remove_dir_all(&dir);
 }

@@ -305,8 +305,31 @@ impl Family for Volume {
     type Estimator = Tracker;
 
     fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
+        let scene = scene(spec)?;
+        // Products the terms use, checked here rather than failing every job:
+        // the fault is lambda's where the medium alone (lambda = 1) is fine.
+        let (sigma, depth) = scene.anchored().0.depth_bound();
+        if !(sigma.is_finite() && depth.is_finite()) {
+            let mut alone = scene.clone();
+            alone.lambda = 1.0;
+            let (s1, d1) = alone.anchored().0.depth_bound();
+            let path = if s1.is_finite() && d1.is_finite() {
+                "scene.lambda"
+            } else {
+                "scene.medium"
+            };
+            return Err(SpecError::at(
+                path,
+                format!(
+                    "the optical depth along the ray overflows f64 (lambda = {:e} times \
+                     the largest density, {sigma:e}, times the chord is {depth:e}): expected \
+                     a medium and a lambda whose optical depth along the ray stays below 1.8e308",
+                    scene.lambda
+                ),
+            ));
+        }
         Ok(Built {
-            scene: scene(spec)?,
+            scene,
             scheme: match spec.depth_scheme {
                 DepthSchemeSpec::Cumulative => DepthScheme::Cumulative,
                 DepthSchemeSpec::Nested => DepthScheme::Nested,
