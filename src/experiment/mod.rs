@@ -12,6 +12,7 @@
 //! [`crate::families`] is the one registry that names them.
 
 pub mod fit;
+pub mod plot;
 pub mod reference;
 pub mod registry;
 pub mod report;
