@@ -489,7 +489,8 @@ pub fn ranked(ranking: &[Ranked]) -> Vec<Ranked> {
 pub const EXACT_FROM_START: &str = "at the error floor from its first budget: this integrand is \
 easy for it, the rank says little in general";
 
-/// Writes `report.md`, the SVG plots and `results.csv` of one experiment.
+/// Writes `report.md`, the SVG plots, `results.csv` and `index.html` of one
+/// experiment.
 pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Result<Summary, String> {
     let sections = sections(page, results)?;
     let mut md = header(page, results);
@@ -554,6 +555,7 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
     let _ = writeln!(md, "{FLAG_LEGEND}");
     write_atomic(&dir.join("report.md"), md.as_bytes()).map_err(|e| e.to_string())?;
     write_atomic(&dir.join("results.csv"), csv(results).as_bytes()).map_err(|e| e.to_string())?;
+    super::html::write_experiment(dir, page, results, &sections)?;
     Ok(summary)
 }
 
@@ -802,7 +804,7 @@ fn field(s: &str) -> String {
     }
 }
 
-/// Writes the index page: every experiment, per quantity the rules ranked by
+/// Writes the index pages (`index.md`, `index.html`): every experiment, per quantity the rules ranked by
 /// time to the middle target error, the Mitsuba comparison, and the
 /// families' audits of printed formulas.
 pub fn write_index(
@@ -861,5 +863,6 @@ pub fn write_index(
     for audit in audits {
         let _ = writeln!(md, "{audit}");
     }
-    write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())
+    write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())?;
+    super::html::write_index(out, entries, crosscheck, audits, problems)
 }
