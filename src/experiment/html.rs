@@ -46,6 +46,9 @@ table.sortable th.asc::after { content: " \25B2"; color: var(--fg); }
 table.sortable th.desc::after { content: " \25BC"; color: var(--fg); }
 td.num, th.num { text-align: right; font-variant-numeric: tabular-nums; }
 td.num { white-space: nowrap; }
+td.r, th.r { text-align: right; font-variant-numeric: tabular-nums; }
+td.r { min-width: 7rem; }
+details > summary { cursor: pointer; color: #0b5cad; margin: .3rem 0; }
 tr.warn td { background: var(--warn); }
 tr.floor td { color: var(--muted); }
 .sw { display: inline-block; width: .9em; height: .9em; border-radius: 2px; margin-right: .4em; vertical-align: -.1em; }
@@ -470,7 +473,11 @@ fn section(page: &Page, s: &Section) -> String {
 fn row(page: &Page, r: &Row) -> String {
     let class = if r.flags.iter().any(alarming) {
         " class=\"warn\""
-    } else if !r.flags.is_empty() {
+    } else if r
+        .flags
+        .iter()
+        .any(|f| matches!(f, RowFlag::AtReferenceAccuracy(_)))
+    {
         " class=\"floor\""
     } else {
         ""
@@ -598,7 +605,7 @@ pub fn write_index(
                 ranking_chart(summary, scale)
             );
         }
-        b.push_str("<div class=\"scroll\"><table class=\"sortable\"><thead><tr><th>quantity</th><th class=\"num\">rank</th><th>rule</th><th class=\"num\">time to target (s)</th><th>note</th></tr></thead><tbody>");
+        b.push_str("<details><summary>as a table</summary><div class=\"scroll\"><table class=\"sortable\"><thead><tr><th>quantity</th><th class=\"num\">rank</th><th>rule</th><th class=\"num\">time to target (s)</th><th>note</th></tr></thead><tbody>");
         for (q, ranking) in summary {
             for (i, r) in ranked(ranking).iter().enumerate() {
                 let time = r
@@ -619,7 +626,7 @@ pub fn write_index(
                 );
             }
         }
-        b.push_str("</tbody></table></div>\n");
+        b.push_str("</tbody></table></div></details>\n");
     }
     if !crosscheck.is_empty() {
         let _ = writeln!(

@@ -88,7 +88,7 @@ fn table(lines: &[&str]) -> String {
         .unwrap_or_default();
     let align = |i: usize| {
         if right.get(i).copied().unwrap_or(false) {
-            " class=\"num\""
+            " class=\"r\""
         } else {
             ""
         }
@@ -175,12 +175,9 @@ mod tests {
     #[test]
     fn tables_get_headers_and_alignment() {
         let html = to_html("| a | b |\n|---|---:|\n| x \\| y | 1e-3 |\n", 0);
+        assert!(html.contains("<th>a</th><th class=\"r\">b</th>"), "{html}");
         assert!(
-            html.contains("<th>a</th><th class=\"num\">b</th>"),
-            "{html}"
-        );
-        assert!(
-            html.contains("<td>x | y</td><td class=\"num\">1e-3</td>"),
+            html.contains("<td>x | y</td><td class=\"r\">1e-3</td>"),
             "{html}"
         );
     }
