@@ -7,11 +7,15 @@
 //! [`spec`] (serde, unknown fields rejected, JSON paths in errors) ->
 //! [`validate`](mod@validate) (every number checked, the family builds its
 //! scene) -> [`run`](mod@run) (jobs in parallel, results appended as they
-//! finish) -> [`report`] (Markdown, SVG, CSV, index). Nothing here names a
+//! finish) -> [`report`] (Markdown, SVG, CSV, index) and [`html`] (the same as
+//! self-contained HTML pages). Nothing here names a
 //! family: it is generic over [`Family`](crate::family::Family), and
 //! [`crate::families`] is the one registry that names them.
 
 pub mod fit;
+pub mod html;
+pub mod markdown;
+pub mod plot;
 pub mod reference;
 pub mod registry;
 pub mod report;

@@ -11,9 +11,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use plotters::prelude::*;
-
 use super::fit::fitted_order;
+use super::plot;
 use super::reference::{Crosscheck, Reference, crosscheck_markdown, rms};
 use super::run::{JobResult, write_atomic};
 use crate::family::{Flag, Measured};
@@ -99,8 +98,8 @@ impl std::fmt::Display for RowFlag {
     }
 }
 
-/// The legend of the flags, below every page.
-const FLAG_LEGEND: &str = "Flags: `failed` (the job's reason follows); `non-finite value`; \
+/// The legend of the flags (Markdown), below every page.
+pub const FLAG_LEGEND: &str = "Flags: `failed` (the job's reason follows); `non-finite value`; \
 `outside 4 standard errors` (a random estimate whose standard error misses the true error: \
 the root mean square over channels of error / standard error above 4); \
 `estimate off by more than 10x` (a deterministic error estimate, above the rounding floor); \
@@ -364,7 +363,7 @@ pub fn time_to(rows: &[&Row], target: f64) -> Option<f64> {
 }
 
 /// An error for a table cell: "—" where there is none (a failed row).
-fn cell(x: f64) -> String {
+pub fn cell(x: f64) -> String {
     if x.is_nan() {
         "—".into()
     } else {
@@ -374,139 +373,12 @@ fn cell(x: f64) -> String {
 
 /// A value for a table cell: the number, or the root mean square of the
 /// channels with their count.
-fn show_value(v: &[f64]) -> String {
+pub fn show_value(v: &[f64]) -> String {
     match v {
         [] => "—".into(),
         [x] => format!("{x:.15e}"),
         _ => format!("rms {:.15e} ({} channels)", rms(v.iter().copied()), v.len()),
     }
-}
-
-/// Draws error against `x` (time or n), one log-log curve per rule.
-fn plot(
-    path: &Path,
-    title: &str,
-    x_label: &str,
-    series: &[(String, Vec<(f64, f64)>)],
-    floor: f64,
-) -> Result<(), String> {
-    // Errors at or below `floor` (exact zeros, the rounding floor, the
-    // reference's own accuracy) are not resolved: they are drawn on a dashed
-    // floor line as open markers, not as numbers on the axis.
-    let series: Vec<(String, Vec<(f64, f64)>)> = series
-        .iter()
-        .map(|(name, s)| {
-            let kept = s.iter().filter(|(_, y)| !y.is_nan());
-            (
-                name.clone(),
-                kept.map(|&(x, y)| (x, y.max(floor))).collect(),
-            )
-        })
-        .collect();
-    let series = &series;
-    let pts: Vec<(f64, f64)> = series.iter().flat_map(|s| s.1.iter().copied()).collect();
-    if pts.is_empty() {
-        return Ok(());
-    }
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for (x, y) in &pts {
-        x0 = x0.min(*x);
-        x1 = x1.max(*x);
-        y0 = y0.min(*y);
-        y1 = y1.max(*y);
-    }
-    // Whole decades, at least one wide on each axis: plotters' log axis
-    // misbehaves on ranges that are very narrow or start off a decade.
-    let decades = |lo: f64, hi: f64| {
-        let a = lo.log10().floor().clamp(-300.0, 300.0);
-        let b = hi.log10().ceil().clamp(-300.0, 300.0).max(a + 1.0);
-        (10f64.powf(a), 10f64.powf(b))
-    };
-    let (x0, x1) = decades(x0, x1);
-    // A decade below the floor line, so it is not drawn on the axis.
-    let at_floor = pts.iter().any(|&(_, y)| y <= floor);
-    let y0 = if at_floor { y0.min(floor / 10.0) } else { y0 };
-    let (y0, y1) = decades(y0, y1);
-    // The legend panel is wide enough for a product label of two rule names.
-    let root = SVGBackend::new(path, (1020, 520)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    // The legend gets a panel of its own on the right, so it never hides a curve.
-    let (left, right) = root.split_horizontally(700);
-    let mut chart = ChartBuilder::on(&left)
-        .caption(title, ("sans-serif", 18))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(80)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-        .map_err(|e| e.to_string())?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
-        .y_desc("relative error")
-        .x_label_formatter(&|v| format!("{v:.0e}"))
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .draw()
-        .map_err(|e| e.to_string())?;
-    for (i, (name, s)) in series.iter().enumerate() {
-        let colour = Palette99::pick(i).to_rgba();
-        chart
-            .draw_series(LineSeries::new(s.iter().copied(), colour.stroke_width(2)))
-            .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(
-                s.iter()
-                    .filter(|&&(_, y)| y > floor)
-                    .map(|&(x, y)| Circle::new((x, y), 3, colour.filled())),
-            )
-            .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(
-                s.iter()
-                    .filter(|&&(_, y)| y <= floor)
-                    .map(|&(x, y)| Circle::new((x, y), 5, colour.stroke_width(2))),
-            )
-            .map_err(|e| e.to_string())?;
-        let y = 60 + 24 * i as i32;
-        right
-            .draw(&PathElement::new(
-                vec![(8, y), (34, y)],
-                colour.stroke_width(3),
-            ))
-            .map_err(|e| e.to_string())?;
-        right
-            .draw(&Text::new(name.clone(), (42, y - 8), ("sans-serif", 14)))
-            .map_err(|e| e.to_string())?;
-    }
-    if pts.iter().any(|&(_, y)| y <= floor) {
-        let grey = RGBColor(110, 110, 110);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x0, floor), (x1, floor)],
-                6,
-                4,
-                grey.stroke_width(1),
-            ))
-            .map_err(|e| e.to_string())?;
-        let y = 60 + 24 * series.len() as i32 + 12;
-        right
-            .draw(&Circle::new((21, y), 5, grey.stroke_width(2)))
-            .map_err(|e| e.to_string())?;
-        right
-            .draw(&Text::new(
-                format!("error at or below {floor:.0e} (not resolved:"),
-                (42, y - 8),
-                ("sans-serif", 14),
-            ))
-            .map_err(|e| e.to_string())?;
-        right
-            .draw(&Text::new(
-                "exact, rounding, or the reference's accuracy)",
-                (42, y + 10),
-                ("sans-serif", 14),
-            ))
-            .map_err(|e| e.to_string())?;
-    }
-    root.present().map_err(|e| e.to_string())
 }
 
 /// Per-experiment summary for the index: per quantity, in the file's order,
@@ -526,13 +398,42 @@ pub struct Ranked {
     pub exact_from_start: bool,
 }
 
-/// Writes `report.md`, the SVG plots and `results.csv` of one experiment.
-pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Result<Summary, String> {
-    let mut md = header(page, results);
-    if let Some(audit) = &page.scene_audit {
-        let _ = writeln!(md, "{audit}");
-    }
-    let mut summary = Summary::new();
+/// One quantity of an experiment page, computed once and shown by both the
+/// Markdown and the HTML page.
+#[derive(Debug, Clone)]
+pub struct Section {
+    /// The quantity.
+    pub quantity: &'static str,
+    /// The reference value as shown, or why there is none (then the rest is empty).
+    pub reference: Result<String, String>,
+    /// A row per (rule, budget).
+    pub rows: Vec<Row>,
+    /// The heading of the slope-against-budget column.
+    pub slope_heading: String,
+    /// A line per rule: fitted slopes and times to the targets.
+    pub fits: Vec<Fit>,
+    /// The plots: (what they show, file name, SVG text).
+    pub plots: Vec<(&'static str, String, String)>,
+    /// Each rule's time to the middle target.
+    pub ranking: Vec<Ranked>,
+}
+
+/// A rule's fitted slopes and times to the targets, as shown.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fit {
+    /// The rule's label.
+    pub label: String,
+    /// The slope of log error against log budget per axis ("—": too few rows).
+    pub slope_budget: String,
+    /// The slope of log error against log evaluations.
+    pub slope_evaluations: String,
+    /// Per target: the time in seconds, "not reached" or "below reference accuracy".
+    pub times: Vec<String>,
+}
+
+/// Computes the sections of a page, one per quantity in the file's order.
+pub fn sections(page: &Page, results: &[JobResult]) -> Result<Vec<Section>, String> {
+    let mut out = Vec::new();
     for &q in &page.quantities {
         let Some(reference) = page.reference.values.get(q) else {
             let why = page
@@ -540,11 +441,15 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
                 .missing
                 .get(q)
                 .map_or("no reference value", String::as_str);
-            let _ = writeln!(
-                md,
-                "## {q} (no reference)\n\nNo reference, so no true errors, orders or times to target: \
-                 {why}. The jobs' values and estimated errors are in results.csv.\n"
-            );
+            out.push(Section {
+                quantity: q,
+                reference: Err(why.to_string()),
+                rows: Vec::new(),
+                slope_heading: String::new(),
+                fits: Vec::new(),
+                plots: Vec::new(),
+                ranking: Vec::new(),
+            });
             continue;
         };
         let mut rows = rows(&page.rules, results, q, reference);
@@ -554,13 +459,91 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
                 r.flags.push(RowFlag::AtReferenceAccuracy(accuracy));
             }
         }
+        out.push(orders_and_plots(page, q, show_value(reference), rows)?);
+    }
+    Ok(out)
+}
+
+/// The rules whose minimum budget is above the smallest budget, in words.
+pub fn skipped(page: &Page) -> Vec<String> {
+    page.rules
+        .iter()
+        .filter(|r| page.budgets.first().is_some_and(|&b| b < r.min_budget))
+        .map(|r| format!("{} needs at least {}", r.label, r.min_budget))
+        .collect()
+}
+
+/// A ranking, fastest first; rules that never reached the target last, by name.
+pub fn ranked(ranking: &[Ranked]) -> Vec<Ranked> {
+    let mut ranked = ranking.to_vec();
+    ranked.sort_by(|a, b| match (a.seconds, b.seconds) {
+        (Some(x), Some(y)) => x.total_cmp(&y),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => a.label.cmp(&b.label),
+    });
+    ranked
+}
+
+/// Said of a rule ranked while exact from its first budget.
+pub const EXACT_FROM_START: &str = "at the error floor from its first budget: this integrand is \
+easy for it, the rank says little in general";
+
+/// Writes `report.md`, the SVG plots, `results.csv` and `index.html` of one
+/// experiment.
+pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Result<Summary, String> {
+    let sections = sections(page, results)?;
+    let mut md = header(page, results);
+    if let Some(audit) = &page.scene_audit {
+        let _ = writeln!(md, "{audit}");
+    }
+    let mut summary = Summary::new();
+    for s in &sections {
+        let q = s.quantity;
+        let reference = match &s.reference {
+            Ok(r) => r,
+            Err(why) => {
+                let _ = writeln!(
+                    md,
+                    "## {q} (no reference)\n\nNo reference, so no true errors, orders or times to target: \
+                     {why}. The jobs' values and estimated errors are in results.csv.\n"
+                );
+                continue;
+            }
+        };
         let _ = writeln!(
             md,
-            "## {q} (reference {})\n\n{}",
-            show_value(reference),
-            table(page, &rows)
+            "## {q} (reference {reference})\n\n{}",
+            table(page, &s.rows)
         );
-        summary.push((q, orders_and_plots(dir, page, q, &rows, &mut md)?));
+        let _ = writeln!(
+            md,
+            "\n| rule | {} | fitted slope vs log evaluations (the cost) | {} |\n|---|---:|---:|{}",
+            s.slope_heading,
+            page.targets
+                .iter()
+                .map(|t| format!("time to {t:.0e} (s)"))
+                .collect::<Vec<_>>()
+                .join(" | "),
+            "---:|".repeat(page.targets.len())
+        );
+        for f in &s.fits {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} |",
+                f.label,
+                f.slope_budget,
+                f.slope_evaluations,
+                f.times.join(" | ")
+            );
+        }
+        md.push('\n');
+        for (what, file, text) in &s.plots {
+            write_atomic(&dir.join(file), text.as_bytes()).map_err(|e| e.to_string())?;
+            let _ = writeln!(md, "![error against {what}]({file})");
+        }
+        md.push('\n');
+        summary.push((q, s.ranking.clone()));
     }
     if !page.crosscheck.is_empty() {
         let _ = writeln!(
@@ -572,6 +555,7 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
     let _ = writeln!(md, "{FLAG_LEGEND}");
     write_atomic(&dir.join("report.md"), md.as_bytes()).map_err(|e| e.to_string())?;
     write_atomic(&dir.join("results.csv"), csv(results).as_bytes()).map_err(|e| e.to_string())?;
+    super::html::write_experiment(dir, page, results, &sections)?;
     Ok(summary)
 }
 
@@ -590,11 +574,9 @@ fn header(page: &Page, results: &[JobResult]) -> String {
         format!(" Equations: {}.", page.equations.join(", "))
     };
     let shared = if page.quantities.len() > 1 {
-        " Each quantity is evaluated and timed on its own (a job evaluates only the terms that \
-         quantity needs), so its times are its own cost."
-            .to_string()
+        SHARED
     } else {
-        String::new()
+        ""
     };
     let _ = writeln!(
         md,
@@ -602,12 +584,7 @@ fn header(page: &Page, results: &[JobResult]) -> String {
          Reference: {}\n",
         page.family, page.budgets, page.budget_unit, page.repeats, page.seed, page.reference.note
     );
-    let skipped: Vec<String> = page
-        .rules
-        .iter()
-        .filter(|r| page.budgets.first().is_some_and(|&b| b < r.min_budget))
-        .map(|r| format!("{} needs at least {}", r.label, r.min_budget))
-        .collect();
+    let skipped = skipped(page);
     if !skipped.is_empty() {
         let _ = writeln!(
             md,
@@ -615,17 +592,27 @@ fn header(page: &Page, results: &[JobResult]) -> String {
             skipped.join(", ")
         );
     }
-    if let Some(r) = results.first() {
-        let _ = writeln!(
-            md,
-            "lightquad {} (commit {}), {}, experiment hash {}.\n",
+    if let Some(p) = provenance(results) {
+        let _ = writeln!(md, "{p}\n");
+    }
+    md
+}
+
+/// Said of an experiment of several quantities.
+pub const SHARED: &str = " Each quantity is evaluated and timed on its own (a job evaluates only \
+the terms that quantity needs), so its times are its own cost.";
+
+/// The version, commit, machine and experiment hash of a run, in words.
+pub fn provenance(results: &[JobResult]) -> Option<String> {
+    results.first().map(|r| {
+        format!(
+            "lightquad {} (commit {}), {}, experiment hash {}.",
             r.version,
             r.git_commit.as_deref().unwrap_or("unknown"),
             r.machine,
             r.experiment_hash
-        );
-    }
-    md
+        )
+    })
 }
 
 /// The table of one quantity: a row per (rule, budget).
@@ -652,21 +639,21 @@ fn table(page: &Page, rows: &[Row]) -> String {
     md
 }
 
-fn label(page: &Page, i: usize) -> String {
+/// The label of rule `i` of the page.
+pub fn label(page: &Page, i: usize) -> String {
     page.rules
         .get(i)
         .map_or_else(|| format!("rule #{i}"), |r| r.label.clone())
 }
 
-/// Fitted orders, times to the targets and the two plots of one quantity;
-/// returns each rule's time to the middle target.
+/// Fitted orders, times to the targets and the two plots of one quantity,
+/// with each rule's time to the middle target.
 fn orders_and_plots(
-    dir: &Path,
     page: &Page,
-    q: &str,
-    rows: &[Row],
-    md: &mut String,
-) -> Result<Vec<Ranked>, String> {
+    q: &'static str,
+    reference: String,
+    rows: Vec<Row>,
+) -> Result<Section, String> {
     let accuracy = page.reference.accuracy_of(q);
     let dimension = page
         .quantities
@@ -677,27 +664,21 @@ fn orders_and_plots(
     // Below this an error is not resolved: f64 rounding, or the reference's
     // own accuracy.
     let floor = accuracy.max(1e-16);
-    let _ = writeln!(
-        md,
-        "\n| rule | fitted slope of log error vs log n{} (order p shows as -p; the largest {FIT_ROWS} budgets above the floor) | fitted slope vs log evaluations (the cost) | {} |\n|---|---:|---:|{}",
+    let slope_heading = format!(
+        "fitted slope of log error vs log n{} (order p shows as -p; the largest {FIT_ROWS} budgets above the floor)",
         if dimension > 1 {
             format!("^(1/{dimension}), the nodes per axis,")
         } else {
             String::new()
         },
-        page.targets
-            .iter()
-            .map(|t| format!("time to {t:.0e} (s)"))
-            .collect::<Vec<_>>()
-            .join(" | "),
-        "---:|".repeat(page.targets.len())
     );
     let middle = page
         .targets
         .get(page.targets.len() / 2)
         .copied()
         .unwrap_or(1e-6);
-    let (mut ranking, mut by_time, mut by_n) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut ranking, mut fits, mut by_time, mut by_n) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for i in 0..page.rules.len() {
         let mine: Vec<&Row> = rows.iter().filter(|r| r.rule_index == i).collect();
         if mine.is_empty() {
@@ -716,13 +697,12 @@ fn orders_and_plots(
             .collect();
         let slope =
             |against| order(&mine, against, accuracy).map_or("—".into(), |o| format!("{o:.2}"));
-        let _ = writeln!(
-            md,
-            "| {label} | {} | {} | {} |",
-            slope(Against::Budget { dimension }),
-            slope(Against::Evaluations),
-            times.join(" | ")
-        );
+        fits.push(Fit {
+            label: label.clone(),
+            slope_budget: slope(Against::Budget { dimension }),
+            slope_evaluations: slope(Against::Evaluations),
+            times,
+        });
         let first = mine
             .iter()
             .filter(|r| !r.rel_error.is_nan())
@@ -748,25 +728,26 @@ fn orders_and_plots(
         ));
     }
     let base = format!("{}-{q}", page.name);
-    plot(
-        &dir.join(format!("{base}-time.svg")),
-        &format!("{}: {q} error against time", page.name),
-        "median run time (s)",
-        &by_time,
-        floor,
-    )?;
-    plot(
-        &dir.join(format!("{base}-n.svg")),
-        &format!("{}: {q} error against evaluations", page.name),
-        "evaluations",
-        &by_n,
-        floor,
-    )?;
-    let _ = writeln!(
-        md,
-        "\n![error against time]({base}-time.svg)\n![error against evaluations]({base}-n.svg)\n"
-    );
-    Ok(ranking)
+    let mut plots = Vec::new();
+    let drawn = [
+        ("time", "time", "median run time (s)", by_time),
+        ("evaluations", "n", "evaluations", by_n),
+    ];
+    for (what, suffix, x_label, series) in drawn {
+        let title = format!("{}: {q} error against {what}", page.name);
+        if let Some(text) = plot::svg(&title, x_label, &series, floor)? {
+            plots.push((what, format!("{base}-{suffix}.svg"), text));
+        }
+    }
+    Ok(Section {
+        quantity: q,
+        reference: Ok(reference),
+        rows,
+        slope_heading,
+        fits,
+        plots,
+        ranking,
+    })
 }
 
 /// A CSV line per job and quantity (a channel vector as `;`-separated numbers).
@@ -823,7 +804,7 @@ fn field(s: &str) -> String {
     }
 }
 
-/// Writes the index page: every experiment, per quantity the rules ranked by
+/// Writes the index pages (`index.md`, `index.html`): every experiment, per quantity the rules ranked by
 /// time to the middle target error, the Mitsuba comparison, and the
 /// families' audits of printed formulas.
 pub fn write_index(
@@ -851,20 +832,13 @@ pub fn write_index(
     for (name, description, summary) in entries {
         let _ = writeln!(md, "## [{name}]({name}/report.md)\n\n{description}\n");
         for (q, ranking) in summary {
-            let mut ranked = ranking.clone();
-            ranked.sort_by(|a, b| match (a.seconds, b.seconds) {
-                (Some(x), Some(y)) => x.total_cmp(&y),
-                (Some(_), None) => std::cmp::Ordering::Less,
-                (None, Some(_)) => std::cmp::Ordering::Greater,
-                (None, None) => a.label.cmp(&b.label),
-            });
-            let list: Vec<String> = ranked
+            let list: Vec<String> = ranked(ranking)
                 .iter()
                 .map(|r| {
                     let exact = if r.exact_from_start {
-                        ", at the error floor from its first budget: this integrand is easy for it, the rank says little in general"
+                        format!(", {EXACT_FROM_START}")
                     } else {
-                        ""
+                        String::new()
                     };
                     match r.seconds {
                         Some(t) => format!("{} ({t:.1e} s{exact})", r.label),
@@ -889,5 +863,6 @@ pub fn write_index(
     for audit in audits {
         let _ = writeln!(md, "{audit}");
     }
-    write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())
+    write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())?;
+    super::html::write_index(out, entries, crosscheck, audits, problems)
 }
