@@ -600,7 +600,7 @@ fn proportional_emission_obeys_the_identity_i_e_equals_k_over_lambda_times_one_m
 /// 1e-15: 4.9e-11, 6.2e-7, 6.5e-5, 5.8e-3 with the product form of the shadow
 /// ray's small root; 1.1e-12, 2.3e-11, 7.0e-10, 1.4e-9 with the stable root,
 /// the rest being the rounding of the points `e + t v` three units from the
-/// eye; at most 1.7e-16 once the chord is measured from its own middle.
+/// eye; at most 1.7e-16 once the chord is measured from its own middle (now from its start).
 #[test]
 fn grazing_shadow_rays_are_accurate_to_1e_12() {
     for eps in [1e-8f64, 1e-11, 1e-13, 1e-15] {

@@ -456,7 +456,10 @@ impl Family for Volume {
 
     fn settings(spec: &SceneSpec) -> String {
         format!(
-            "depth scheme {:?}, shadow rays {:?}",
+            "depth scheme {:?}, shadow rays {:?}; every rule gets the budget on each smooth piece of \
+             the ray, and V-E and V-L pieces are further cut at optical depths 1, 2, 4, 8, ... from \
+             their start (measured with the majorant) where a piece is thicker than 2, so a thick \
+             medium's boundary layer is resolved (a piece of depth D costs about 1 + log2 D budgets)",
             spec.depth_scheme, spec.shadow
         )
     }
@@ -508,7 +511,7 @@ fn estimate(
             format!("one of {} for {}", names.join(", "), tracker.name()),
         ));
     }
-    // Measured from the middle of the medium, as the quadrature terms are
+    // Measured from the start of the medium's support, as the quadrature terms are
     // (VolumeScene::anchored).
     let (anchored, _) = built.scene.anchored();
     let scene = &anchored;
@@ -672,7 +675,7 @@ fn total(res: &VolumeResult) -> Measured {
 
 /// The closed form of a quantity for this scene, when `exact` has one.
 fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
-    // The chord from the middle of the medium's support, where its length
+    // The chord from the start of the medium's support, where its length
     // keeps its digits (VolumeScene::anchored).
     let (scene, _) = built.scene.anchored();
     let scene = &scene;

@@ -475,7 +475,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     rng: &mut Rg,
 ) -> Result<VolumeResult, QuadError> {
     scene.validate()?;
-    // Parameters measured from the middle of the chord, so the points of a
+    // Parameters measured from the start of the support, so the points of a
     // grazing chord far from the eye keep their digits (VolumeScene::anchored).
     let (anchored, shift) = scene.anchored();
     let scene = &anchored;
