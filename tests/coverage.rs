@@ -44,6 +44,17 @@ fn assert_95(covered: u64, what: &str) {
     );
 }
 
+/// Panics unless `covered` of `R` is consistent with a coverage of at least
+/// 0.95 (one-sided, at `ALPHA / 2`).
+fn assert_at_least_95(covered: u64, what: &str) {
+    let binom = Binomial::new(0.95, R).expect("valid");
+    eprintln!("{what}: {covered}/{R}");
+    assert!(
+        binom.cdf(covered) > ALPHA / 2.0,
+        "{what}: {covered}/{R} covered at 1.96 errors"
+    );
+}
+
 /// Chord length 2 through a unit sphere of density `kappa` centred at the
 /// origin; emission `c = 1`, background 0.5, a light of intensity 2 behind
 /// the eye (so V-L has the closed form `exact::light_behind`).
@@ -129,10 +140,17 @@ fn stochastic_rules_cover_95_percent_on_every_volume_quantity() {
             for n in [16, 64] {
                 let counts = coverage(&b, &rule, n, &on_sphere, |q| sphere_exact(kappa, albedo, q));
                 for (q, c) in on_sphere.iter().zip(counts) {
-                    assert_95(
-                        c,
-                        &format!("{name} kappa {kappa} albedo {albedo:?} {q:?} n = {n}"),
-                    );
+                    let what = format!("{name} kappa {kappa} albedo {albedo:?} {q:?} n = {n}");
+                    if name == "stratified" && n == 16 {
+                        // At 16 cells the second differences also carry the
+                        // integrand's curvature, (f'' h^2)^2 against
+                        // sigma^2 = (f' h)^2 / 12 (68% more at kappa 2), and
+                        // the row's end triples count double: conservative
+                        // (99.75%), which only the lower bound checks.
+                        assert_at_least_95(c, &what);
+                    } else {
+                        assert_95(c, &what);
+                    }
                 }
             }
         }
@@ -284,14 +302,8 @@ fn walks_that_all_agree_are_flagged_and_their_error_is_not_zero() {
         );
         // Most runs are degenerate here (P(no walk through) = (1 - tau)^16 = 0.90).
         assert!(alike > R * 8 / 10, "{}: {alike}", tracker.name());
-        // The bound is conservative here: coverage must not fall below 95%
-        // (one-sided binomial test at ALPHA / 2).
-        let binom = Binomial::new(0.95, R).expect("valid");
-        assert!(
-            binom.cdf(covered) > ALPHA / 2.0,
-            "{}: {covered}/{R} covered",
-            tracker.name()
-        );
+        // The bound is conservative here: coverage must not fall below 95%.
+        assert_at_least_95(covered, tracker.name());
     }
 }
 
