@@ -107,6 +107,15 @@ impl<E: Estimator> Method<E> {
         }
     }
 
+    /// The resolution per axis a budget buys ([`Rule::resolution`]); an
+    /// estimator's budget itself (walks).
+    pub fn resolution(&self, n: usize, dim: usize) -> f64 {
+        match self {
+            Method::Rule(r) => r.resolution(n, dim),
+            Method::Estimator(_) => n as f64,
+        }
+    }
+
     /// True for randomised rules and estimators.
     pub fn is_random(&self) -> bool {
         match self {

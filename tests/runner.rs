@@ -494,6 +494,7 @@ fn a_familys_value_flag_reaches_the_report_row() {
         label: "gauss-legendre".into(),
         is_random: false,
         min_budget: 1,
+        resolution: Default::default(),
     }];
     let reference = exp.run_job((0, 64, 0)).quantities["I"].value.clone();
     let table = rows(&rules, &jobs, "I", &reference);
@@ -1059,4 +1060,36 @@ fn delta_tracking_with_an_emission_field_is_refused_at_check() {
         "rules[0]",
         "cannot estimate quantities[1] (I_E) in this scene",
     );
+}
+
+/// The slope against n is fitted against the resolution the rule really
+/// uses: Simpson takes the largest 4k + 1 <= n points, so against the budget
+/// its slope read -4.39 on calibration-exp (the independent check of issue
+/// 9); against its intervals (error `h^4 (f'(1) - f'(0)) / 180`) it is -4.
+#[test]
+fn simpson_and_the_trapezoid_show_their_orders_against_the_points_they_use() {
+    let (dir, out, o) = run_text(
+        "slopes",
+        r#"{ "name": "s", "family": "calibration", "scene": {}, "quantities": ["exp"],
+        "rules": [{ "rule": "simpson" }, { "rule": "trapezoid" }],
+        "budgets": [16, 64, 256, 1024, 4096], "repeats": 1,
+        "reference": { "type": "closed-form" } }"#,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = fs::read_to_string(out.join("s/report.md")).expect("report");
+    for (rule, order) in [("simpson", -4.0), ("trapezoid", -2.0)] {
+        let line = report
+            .lines()
+            .find(|l| l.starts_with(&format!("| {rule} | -")))
+            .unwrap_or_else(|| panic!("no slope row for {rule}: {report}"));
+        let slope: f64 = line
+            .split('|')
+            .nth(2)
+            .expect("cell")
+            .trim()
+            .parse()
+            .expect("a number");
+        assert!((slope - order).abs() < 0.02, "{rule}: {line}");
+    }
+    let _ = fs::remove_dir_all(&dir);
 }

@@ -108,6 +108,19 @@ fn page<'a, F: Family>(
                 },
                 is_random: m.is_random(),
                 min_budget: super::validate::min_budget::<F>(&exp.scene, m, &spec.quantities),
+                resolution: spec
+                    .quantities
+                    .iter()
+                    .map(|&q| F::dimension(&exp.scene, q))
+                    .map(|d| {
+                        let by_budget = exp
+                            .budgets
+                            .iter()
+                            .map(|&b| (b, m.resolution(b, d)))
+                            .collect();
+                        (d, by_budget)
+                    })
+                    .collect(),
             }
         })
         .collect();

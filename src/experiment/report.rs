@@ -63,6 +63,11 @@ pub struct RuleInfo {
     pub is_random: bool,
     /// The smallest budget it runs at (smaller budgets are skipped for it).
     pub min_budget: usize,
+    /// Per dimension, the resolution per axis each budget buys
+    /// ([`crate::quadrature::Rule::resolution`]: intervals of a composite
+    /// rule, nodes or samples per axis otherwise); a missing entry is read as
+    /// `n^(1/D)`.
+    pub resolution: BTreeMap<usize, BTreeMap<usize, f64>>,
 }
 
 /// A fact about a row of a report table.
@@ -308,13 +313,16 @@ fn channel(v: &[f64], c: usize) -> f64 {
 
 /// What a fitted slope is measured against.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Against {
-    /// The budget per axis, `n^(1/D)` for a D-dimensional quantity (nodes or
-    /// samples per piece): a rule of order p shows as -p whatever an
-    /// evaluation costs and whatever the dimension.
-    Budget {
+pub enum Against<'a> {
+    /// The resolution per axis each budget buys the rule (intervals of a
+    /// composite rule, nodes or samples per axis: `n^(1/D)` where the map has
+    /// no entry): a rule of order p shows as -p whatever an evaluation costs
+    /// and whatever the dimension.
+    Resolution {
         /// The quantity's dimension D.
         dimension: usize,
+        /// Budget to resolution, for this rule and dimension.
+        by_budget: Option<&'a BTreeMap<usize, f64>>,
     },
     /// The evaluations spent: the cost (nested depth makes it ~n^2, so an
     /// order-2 rule shows as -1 there).
@@ -336,9 +344,12 @@ pub fn order(rows: &[&Row], against: Against, floor: f64) -> Option<f64> {
         .filter(|r| r.rel_error > (100.0 * FLOOR).max(10.0 * floor))
         .map(|r| {
             let x = match against {
-                Against::Budget { dimension } => {
-                    (r.budget as f64).powf(1.0 / dimension.max(1) as f64)
-                }
+                Against::Resolution {
+                    dimension,
+                    by_budget,
+                } => by_budget
+                    .and_then(|m| m.get(&r.budget).copied())
+                    .unwrap_or_else(|| (r.budget as f64).powf(1.0 / dimension.max(1) as f64)),
                 Against::Evaluations => r.evaluations,
             };
             (x, r.rel_error)
@@ -665,9 +676,11 @@ fn orders_and_plots(
     // own accuracy.
     let floor = accuracy.max(1e-16);
     let slope_heading = format!(
-        "fitted slope of log error vs log n{} (order p shows as -p; the largest {FIT_ROWS} budgets above the floor)",
+        "fitted slope of log error vs log of the resolution per axis that n buys{} (the intervals \
+         of the points a composite rule uses, nodes or samples per axis otherwise: order p shows \
+         as -p; the largest {FIT_ROWS} budgets above the floor)",
         if dimension > 1 {
-            format!("^(1/{dimension}), the nodes per axis,")
+            format!(", about n^(1/{dimension})")
         } else {
             String::new()
         },
@@ -699,7 +712,10 @@ fn orders_and_plots(
             |against| order(&mine, against, accuracy).map_or("—".into(), |o| format!("{o:.2}"));
         fits.push(Fit {
             label: label.clone(),
-            slope_budget: slope(Against::Budget { dimension }),
+            slope_budget: slope(Against::Resolution {
+                dimension,
+                by_budget: page.rules.get(i).and_then(|r| r.resolution.get(&dimension)),
+            }),
             slope_evaluations: slope(Against::Evaluations),
             times,
         });

@@ -97,6 +97,15 @@ pub trait Rule {
         Ok(())
     }
 
+    /// The resolution per axis that a budget of `n` evaluations in `dim`
+    /// dimensions buys: the `x` an error of order `O(x^-p)` falls with, so a
+    /// fit of the error against it shows an order-p rule as `-p`. Nodes or
+    /// samples per axis, `floor(n^(1/dim))`, by default; the intervals
+    /// `m - 1` of the points a composite rule really uses.
+    fn resolution(&self, n: usize, dim: usize) -> f64 {
+        integer_root(n, dim) as f64
+    }
+
     /// The rule itself, which [`Rule::try_integrate`] guards against
     /// overflow: estimates `int_{[0,1]^D} f(u) du` with a budget of about `n`
     /// evaluations, for an integrand that may fail: its first error stops the
@@ -193,6 +202,21 @@ pub const MAX_BUDGET: usize = 1 << 40;
 /// rule's way of saying it has no estimate, not an overflow).
 fn sound<V: Value>(e: &Estimate<V>) -> bool {
     e.value.all_finite() && (0..V::CHANNELS).all(|c| !e.error.channel(c).is_nan())
+}
+
+/// The largest `m` with `m^dim <= n` (`n` itself for `dim <= 1`).
+pub fn integer_root(n: usize, dim: usize) -> usize {
+    if dim <= 1 {
+        return n;
+    }
+    let mut m = (n as f64).powf(1.0 / dim as f64).round() as usize;
+    while m > 0 && m.checked_pow(dim as u32).is_none_or(|p| p > n) {
+        m -= 1;
+    }
+    while (m + 1).checked_pow(dim as u32).is_some_and(|p| p <= n) {
+        m += 1;
+    }
+    m
 }
 
 /// Nodes per axis for a product rule with a budget of `n` evaluations in `D`
@@ -317,6 +341,9 @@ macro_rules! registry {
             }
             fn check(&self) -> Result<(), QuadError> {
                 match self { $(BaseRule::$rule(r) => r.check(),)+ }
+            }
+            fn resolution(&self, n: usize, dim: usize) -> f64 {
+                match self { $(BaseRule::$rule(r) => r.resolution(n, dim),)+ }
             }
             fn integrate_unguarded<
                 const D: usize,
@@ -470,6 +497,12 @@ impl Rule for AnyRule {
         match self {
             AnyRule::Base(r) => r.check(),
             AnyRule::Product(r) => r.check(),
+        }
+    }
+    fn resolution(&self, n: usize, dim: usize) -> f64 {
+        match self {
+            AnyRule::Base(r) => r.resolution(n, dim),
+            AnyRule::Product(r) => r.resolution(n, dim),
         }
     }
     fn integrate_unguarded<

@@ -206,6 +206,13 @@ pub struct Composite {
 }
 
 impl Composite {
+    /// The intervals per axis, `m - 1`, of the points a budget of `n` in
+    /// `dim` dimensions uses ([`super::Rule::resolution`]).
+    pub fn resolution(&self, n: usize, dim: usize) -> f64 {
+        let m = super::integer_root(n, dim).max(self.min_points);
+        ((self.usable)(m) - 1) as f64
+    }
+
     /// The rule's tensor product on `[0, 1]^D` with a budget of `n`
     /// evaluations, and Richardson's error estimate.
     pub fn integrate<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(

@@ -83,6 +83,10 @@ impl Rule for Simpson {
         5usize.saturating_pow(dim as u32)
     }
 
+    fn resolution(&self, n: usize, dim: usize) -> f64 {
+        COMPOSITE.resolution(n, dim)
+    }
+
     fn integrate_unguarded<
         const D: usize,
         V: Value,

@@ -80,6 +80,10 @@ impl Rule for Trapezoid {
         3usize.saturating_pow(dim as u32)
     }
 
+    fn resolution(&self, n: usize, dim: usize) -> f64 {
+        COMPOSITE.resolution(n, dim)
+    }
+
     fn integrate_unguarded<
         const D: usize,
         V: Value,
