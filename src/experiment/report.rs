@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::fit::fitted_order;
+use super::fit::fitted_line;
 use super::plot;
 use super::reference::{Crosscheck, Reference, crosscheck_markdown, rms};
 use super::run::{JobResult, write_atomic};
@@ -339,6 +339,17 @@ pub const FIT_ROWS: usize = 4;
 /// floor and ten times the reference's own accuracy (`floor`); None below
 /// three such rows.
 pub fn order(rows: &[&Row], against: Against, floor: f64) -> Option<f64> {
+    order_and_scatter(rows, against, floor).map(|(o, _)| o)
+}
+
+/// Errors further than this factor from the fitted line: the slope is shown
+/// as erratic, not as an order (a deterministic rule's; a random rule's root
+/// mean square over a few repeats scatters more and gets twice the room).
+pub const ERRATIC: f64 = 2.0;
+
+/// [`order`] with the largest factor by which a fitted point lies off the
+/// line ([`super::fit::fitted_line`]).
+pub fn order_and_scatter(rows: &[&Row], against: Against, floor: f64) -> Option<(f64, f64)> {
     let mut pts: Vec<(f64, f64)> = rows
         .iter()
         .filter(|r| r.rel_error > (100.0 * FLOOR).max(10.0 * floor))
@@ -360,7 +371,7 @@ pub fn order(rows: &[&Row], against: Against, floor: f64) -> Option<f64> {
     }
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
     let tail = pts.len().saturating_sub(FIT_ROWS);
-    fitted_order(&pts[tail..])
+    fitted_line(&pts[tail..])
 }
 
 /// The least median time among rows whose error meets `target`.
@@ -708,8 +719,36 @@ fn orders_and_plots(
                 (false, Some(s)) => format!("{s:.2e}"),
             })
             .collect();
-        let slope =
-            |against| order(&mine, against, accuracy).map_or("—".into(), |o| format!("{o:.2}"));
+        // A deterministic rule whose error grows with the budget inside the
+        // fitted rows (a kink that moves between nodes) has no order either.
+        let deterministic = !page.rules.get(i).is_some_and(|r| r.is_random);
+        let grew = deterministic && {
+            let fitted: Vec<f64> = mine
+                .iter()
+                .filter(|r| r.rel_error > (100.0 * FLOOR).max(10.0 * accuracy))
+                .map(|r| r.rel_error)
+                .collect();
+            let tail = &fitted[fitted.len().saturating_sub(FIT_ROWS)..];
+            tail.windows(2).any(|w| w[1] > 1.5 * w[0])
+        };
+        let slope = |against| match order_and_scatter(&mine, against, accuracy) {
+            None => "—".into(),
+            Some((o, off))
+                if off
+                    > if deterministic {
+                        ERRATIC
+                    } else {
+                        2.0 * ERRATIC
+                    }
+                    || grew =>
+            {
+                format!(
+                    "{o:.2} (erratic: errors up to {off:.1}x off the line{}, not an order)",
+                    if grew { ", growing with n" } else { "" }
+                )
+            }
+            Some((o, _)) => format!("{o:.2}"),
+        };
         fits.push(Fit {
             label: label.clone(),
             slope_budget: slope(Against::Resolution {
