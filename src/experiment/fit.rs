@@ -44,7 +44,9 @@ mod tests {
 
     #[test]
     fn a_power_law_fits_exactly_and_an_oscillation_does_not() {
-        let law: Vec<(f64, f64)> = [4.0, 8.0, 16.0, 32.0].map(|n| (n, 3.0 * n.powi(-2))).into();
+        let law: Vec<(f64, f64)> = [4.0f64, 8.0, 16.0, 32.0]
+            .map(|n| (n, 3.0 * n.powi(-2)))
+            .into();
         let (slope, off) = fitted_line(&law).expect("fit");
         assert!((slope + 2.0).abs() < 1e-12 && (off - 1.0).abs() < 1e-12);
         // Errors of GL on a kink that moves between nodes (the voxel grid's
