@@ -1,5 +1,5 @@
-//! Volume rendering with a directional light (docs/EQUATIONS.md, V-tau .. V-I;
-//! seeds/000): media as density fields, the terms along an eye ray with any
+//! Volume rendering with a directional light (docs/EQUATIONS.md, V-tau .. V-I):
+//! media as density fields, the terms along an eye ray with any
 //! rule, closed forms in [`crate::exact`], the document's printed formulas in
 //! [`audit`], and the stochastic estimators renderers use (tracking).
 
