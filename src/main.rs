@@ -222,12 +222,14 @@ fn fixed_nodes(rule: &str, n: usize) -> Result<(Vec<f64>, Vec<f64>), Failure> {
             let t = gauss_legendre::table(n)?;
             Ok((t.x, t.w))
         }
-        "simpson" if !(3..=MAX_POINTS).contains(&n) || n % 2 == 0 => Err(QuadError::invalid(
-            "n",
-            n,
-            format!("an odd number of Simpson nodes in 3..={MAX_POINTS}"),
-        )
-        .into()),
+        "simpson" if !(3..=MAX_POINTS).contains(&n) || n.is_multiple_of(2) => {
+            Err(QuadError::invalid(
+                "n",
+                n,
+                format!("an odd number of Simpson nodes in 3..={MAX_POINTS}"),
+            )
+            .into())
+        }
         "simpson" => {
             let t = lightquad::quadrature::simpson::unit_nodes(n);
             // From [0, 1] to [-1, 1].

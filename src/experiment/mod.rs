@@ -171,13 +171,13 @@ pub fn run_sources(
     files: &[Source],
     opts: &RunOptions,
 ) -> Result<PathBuf, RunError> {
-    if let Some((k, n)) = opts.shard {
-        if k == 0 || k > n {
-            return Err(RunError::Io {
-                path: opts.out.display().to_string(),
-                message: format!("invalid shard {k}/{n}: expected k/n with 1 <= k <= n"),
-            });
-        }
+    if let Some((k, n)) = opts.shard
+        && (k == 0 || k > n)
+    {
+        return Err(RunError::Io {
+            path: opts.out.display().to_string(),
+            message: format!("invalid shard {k}/{n}: expected k/n with 1 <= k <= n"),
+        });
     }
     let loaded = load_all(registry, files)?;
     writable(&opts.out)?;
