@@ -11,6 +11,25 @@
 //! self-contained HTML pages). Nothing here names a
 //! family: it is generic over [`Family`](crate::family::Family), and
 //! [`crate::families`] is the one registry that names them.
+//!
+//! ```
+//! use lightquad::experiment::validate::parse_json;
+//!
+//! // An experiment file, checked as `lightquad check` does: 2 rules x 3 budgets
+//! // x 2 repeats = 12 jobs.
+//! let text = r#"{"name": "e", "family": "calibration", "scene": {},
+//!   "quantities": ["exp"], "rules": [{"rule": "trapezoid"}, {"rule": "gauss-legendre"}],
+//!   "budgets": [4, 16, 64], "repeats": 2, "reference": {"type": "closed-form"}}"#;
+//! let registry = lightquad::families::builtin();
+//! let exp = registry.load(parse_json(text)?, "hash")?;
+//! assert_eq!(exp.shape(), (2, 3, 2));
+//! assert_eq!(exp.jobs(None).len(), 12);
+//! // A fault names its JSON path.
+//! let bad = text.replace("\"repeats\": 2", "\"repeats\": 0");
+//! let e = registry.load(parse_json(&bad)?, "hash").err().expect("refused");
+//! assert!(e.to_string().contains("repeats"), "{e}");
+//! # Ok::<(), lightquad::error::SpecError>(())
+//! ```
 
 pub mod fit;
 pub mod html;
