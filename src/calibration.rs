@@ -10,6 +10,26 @@
 //! | `exp-rgb` | `int_0^1 (e^u, e^{2u}, e^{3u}) du` | `((e-1), (e^2-1)/2, (e^3-1)/3)` | 1 |
 //! | `gaussian-disk` | `int_{unit disk} e^{-(x^2+y^2)} dA` | `pi (1 - 1/e)` | 2 |
 //! | `cos3-hemisphere` | `int_{H^2} cos^3(theta) d omega` | `pi / 2` | 2 |
+//!
+//! ```
+//! use lightquad::calibration::Calibration;
+//! use lightquad::experiment::validate::{deserialize, validate};
+//! use lightquad::family::Family;
+//!
+//! let json = serde_json::json!({
+//!     "name": "c", "family": "calibration", "scene": {},
+//!     "quantities": ["exp", "cos3-hemisphere"],
+//!     "rules": [{"rule": "gauss-legendre"}], "budgets": [4, 16], "repeats": 1,
+//!     "reference": {"type": "closed-form"}
+//! });
+//! let exp = validate::<Calibration>(deserialize(json)?, "hash")?;
+//! // The closed forms of the table above.
+//! for (q, want) in exp.spec.quantities.iter().zip([std::f64::consts::E - 1.0, std::f64::consts::PI / 2.0]) {
+//!     let v = Calibration::closed_form(&exp.scene, *q).expect("has one");
+//!     assert!((v[0] - want).abs() < 1e-15);
+//! }
+//! # Ok::<(), lightquad::error::SpecError>(())
+//! ```
 
 use std::f64::consts::{E, PI};
 

@@ -1,6 +1,16 @@
 //! Errors of the quadrature core: every variant names the parameter, the value
 //! it was given and what is accepted, so a user can fix the input without
 //! reading the code.
+//!
+//! ```
+//! use lightquad::QuadError;
+//! use lightquad::domain::Segment;
+//!
+//! // Bad input is an error that says what was expected, never a panic.
+//! let e = Segment::new(1.0, f64::NAN).unwrap_err();
+//! assert!(matches!(e, QuadError::InvalidParameter { .. }), "{e}");
+//! assert!(!e.to_string().is_empty());
+//! ```
 
 use thiserror::Error;
 

@@ -1,4 +1,17 @@
 //! The result of every integration: a value, an error estimate and a cost.
+//!
+//! ```
+//! use lightquad::{ErrorKind, Estimate};
+//!
+//! // Two halves of an integral, each with its error estimate: the sum adds the
+//! // values and the costs.
+//! let a = Estimate::deterministic(0.5, 1e-12, 16);
+//! let b = Estimate::deterministic(0.25, 1e-12, 16);
+//! let total = a.combine(b);
+//! assert_eq!(total.value, 0.75);
+//! assert_eq!(total.evaluations, 32);
+//! assert_eq!(total.kind, ErrorKind::Deterministic);
+//! ```
 
 use crate::value::Value;
 

@@ -1,5 +1,12 @@
 //! The registry of equation families: the one place in the crate that names
 //! them. An experiment file picks one with `"family": "<name>"`.
+//!
+//! ```
+//! let registry = lightquad::families::builtin();
+//! let names: Vec<&str> = registry.entries().iter().map(|f| f.name).collect();
+//! assert_eq!(names, ["calibration", "volume"]);
+//! assert!(registry.get("volume").expect("registered").quantities().contains(&"tau"));
+//! ```
 
 use crate::experiment::Registry;
 

@@ -12,6 +12,17 @@
 //! Adding a family: a module that implements [`Family`], and one line in
 //! [`crate::families::builtin`] (or [`crate::experiment::Registry::with`] from
 //! outside the crate).
+//!
+//! ```
+//! use lightquad::family::{Family, Quantity};
+//! use lightquad::volume::experiment::Volume;
+//!
+//! // What a family declares: its tag, quantities and equation IDs.
+//! assert_eq!(Volume::NAME, "volume");
+//! let quantities: Vec<&str> = <Volume as Family>::Quantity::all().iter().map(Quantity::name).collect();
+//! assert!(quantities.contains(&"I_L"));
+//! assert!(Volume::EQUATIONS.contains(&"V-tau"));
+//! ```
 
 use std::collections::BTreeMap;
 use std::fmt::Debug;

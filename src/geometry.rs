@@ -1,5 +1,18 @@
 //! Rays and spheres, with ray–sphere roots that stay accurate for grazing
 //! rays, origins on or near the surface, and coordinates scaled by 1e-6 or 1e6.
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::{Ray, Sphere};
+//!
+//! // A ray at height 0.6 through a unit sphere: the chord is 2 sqrt(1 - 0.36) = 1.6.
+//! let ray = Ray::new(Vec3::new(-3.0, 0.6, 0.0), Vec3::new(2.0, 0.0, 0.0))?;
+//! let sphere = Sphere::new(Vec3::zeros(), 1.0)?;
+//! let (t0, t1) = sphere.clip(&ray, 0.0, f64::INFINITY).expect("hits");
+//! assert!((t1 - t0 - 1.6).abs() < 1e-12);
+//! assert!((ray.at(t0) - Vec3::new(-0.8, 0.6, 0.0)).norm() < 1e-12);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use crate::domain::Vec3;
 use crate::error::QuadError;

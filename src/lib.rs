@@ -2,9 +2,17 @@
 //!
 //! How accurate is each numerical approximation of a light-transport integral,
 //! and what does it cost? lightquad answers with pluggable quadrature rules,
-//! domains that map the unit cube onto the geometry of rendering, and (in later
-//! modules) the equations of volume rendering, the rendering equation and
-//! Whitted's model, each with closed forms where they exist.
+//! domains that map the unit cube onto the geometry of rendering, and the
+//! equations of volume rendering with a directional light ([`volume`],
+//! docs/EQUATIONS.md V-*) with closed forms ([`exact`]) where they exist. The
+//! rendering equation and Whitted's model (R-*, W-* there) are stated in
+//! docs/EQUATIONS.md but are not yet a family.
+//!
+//! Runnable programs in `examples/`: `cargo run --release --example
+//! quadrature_over_a_domain` (a rule over a disk and a hemisphere),
+//! `volume_term` (transmittance and emission along a ray through a constant
+//! sphere), `experiment_from_code` (an experiment file run from code into a
+//! report); each checks its result against a closed form it computes.
 //!
 //! Three independent axes meet only where an integral is evaluated:
 //!

@@ -4,10 +4,10 @@ use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use lightquad::experiment;
+use lightquad::experiment::Source;
 use lightquad::experiment::run::RunOptions;
 use lightquad::families;
 use lightquad::quadrature::gauss_legendre;
@@ -35,12 +35,19 @@ enum Command {
         /// Number of nodes (Gauss–Legendre: 1..=100000000; trapezoid: >= 2; Simpson: odd, >= 3).
         n: usize,
     },
-    /// Run experiments (default: every file in experiments/) and write a report
-    /// of error against run time: <out>/index.md, one folder per experiment.
+    /// Run experiments and write a report of error against run time to the
+    /// --out folder (default ./report, in the working folder): index.md and
+    /// index.html, a folder per experiment.
+    ///
+    /// Without files, runs the bundled suite: the experiments/ folder of
+    /// lightquad's source and its Mitsuba 3 values, built into this binary, so
+    /// it runs the same from any folder. A given file's Mitsuba values are
+    /// looked for relative to the file (../reference/values/<name>.json), then
+    /// among the bundled ones.
     Run {
-        /// Experiment files; none runs the bundled experiments/ folder.
+        /// Experiment files; none runs the bundled suite.
         files: Vec<PathBuf>,
-        /// Output folder.
+        /// Output folder: <out>/index.md, <out>/index.html, <out>/<experiment>/.
         #[arg(long, default_value = "report")]
         out: PathBuf,
         /// Keep the jobs an interrupted run finished and run only the rest.
@@ -56,8 +63,7 @@ enum Command {
     },
     /// Validate experiment files without running them.
     Check {
-        /// Experiment files.
-        #[arg(required = true)]
+        /// Experiment files; none checks the bundled suite.
         files: Vec<PathBuf>,
     },
     /// Print the JSON Schema of experiment files.
@@ -122,18 +128,14 @@ fn run(command: Command) -> Result<(), Failure> {
                     .num_threads(t)
                     .build_global()?;
             }
-            let files = if files.is_empty() {
-                experiment::experiment_files(Path::new("experiments"))?
-            } else {
-                files
-            };
+            let sources = sources(files)?;
             let opts = RunOptions {
                 out: dir,
                 resume,
                 shard,
-                progress: std::io::stderr().is_terminal(),
+                progress: true,
             };
-            let index = experiment::run_files(&registry, &files, &opts)?;
+            let index = experiment::run_sources(&registry, &sources, &opts)?;
             match shard {
                 None => writeln!(out, "report: {}", index.display())?,
                 Some(_) => writeln!(
@@ -144,8 +146,8 @@ fn run(command: Command) -> Result<(), Failure> {
             }
         }
         Command::Check { files } => {
-            for f in files {
-                let exp = experiment::load(&registry, &f)?;
+            for f in sources(files)? {
+                let exp = experiment::load_source(&registry, &f)?;
                 let (rules, budgets, repeats) = exp.shape();
                 writeln!(
                     out,
@@ -170,6 +172,22 @@ fn run(command: Command) -> Result<(), Failure> {
     }
     out.flush()?;
     Ok(())
+}
+
+/// The experiments of `run` and `check`: the files, or the bundled suite.
+fn sources(files: Vec<PathBuf>) -> Result<Vec<Source>, Failure> {
+    if !files.is_empty() {
+        return Ok(files.into_iter().map(Source::File).collect());
+    }
+    let suite = Source::bundled_suite();
+    if suite.is_empty() {
+        return Err(
+            "this lightquad was built without its experiments/ folder, so it bundles no \
+                    experiments: give experiment files"
+                .into(),
+        );
+    }
+    Ok(suite)
 }
 
 /// Every rule and estimator, then the families with their quantities.
@@ -204,12 +222,14 @@ fn fixed_nodes(rule: &str, n: usize) -> Result<(Vec<f64>, Vec<f64>), Failure> {
             let t = gauss_legendre::table(n)?;
             Ok((t.x, t.w))
         }
-        "simpson" if !(3..=MAX_POINTS).contains(&n) || n % 2 == 0 => Err(QuadError::invalid(
-            "n",
-            n,
-            format!("an odd number of Simpson nodes in 3..={MAX_POINTS}"),
-        )
-        .into()),
+        "simpson" if !(3..=MAX_POINTS).contains(&n) || n.is_multiple_of(2) => {
+            Err(QuadError::invalid(
+                "n",
+                n,
+                format!("an odd number of Simpson nodes in 3..={MAX_POINTS}"),
+            )
+            .into())
+        }
         "simpson" => {
             let t = lightquad::quadrature::simpson::unit_nodes(n);
             // From [0, 1] to [-1, 1].

@@ -5,6 +5,20 @@
 //! running error term with Knuth's branch-free TwoSum, so the sum is as accurate
 //! as if it were accumulated in twice the precision and then rounded, while
 //! staying cheap enough to vectorise (six additions per term).
+//!
+//! ```
+//! use lightquad::sum::{Compensated, sum_f64};
+//!
+//! // 1 + 1e-16 ten million times: a plain f64 sum stays at 1, the compensated
+//! // sum keeps the 1e-9.
+//! let mut s = Compensated::<f64>::new();
+//! s.add(1.0);
+//! for _ in 0..10_000_000 {
+//!     s.add(1e-16);
+//! }
+//! assert!((s.total() - (1.0 + 1e-9)).abs() < 1e-15);
+//! assert_eq!(sum_f64([1e100, 1.0, -1e100]), 1.0);
+//! ```
 
 use crate::value::Value;
 

@@ -1,5 +1,18 @@
 //! Integrand values: a scalar `f64` or an RGB triple, behind one small trait so
 //! every rule sums colours in one pass instead of three separate runs.
+//!
+//! ```
+//! use lightquad::quadrature::{GaussLegendre, Rule};
+//! use lightquad::Rgb;
+//! use rand::SeedableRng;
+//!
+//! // One integral per colour channel: int_0^1 (1, 2u, 3u^2) du = (1, 1, 1).
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let est = GaussLegendre::default()
+//!     .integrate(8, &mut rng, |u: [f64; 1]| Rgb::new(1.0, 2.0 * u[0], 3.0 * u[0] * u[0]))?;
+//! assert!((est.value - Rgb::new(1.0, 1.0, 1.0)).norm() < 1e-14);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use nalgebra::Vector3;
 

@@ -367,18 +367,65 @@ fn shards_merge_into_the_full_report() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// `lightquad run` without files runs the bundled suite from any folder (here
+/// a fresh one without experiments/ or reference/): every experiment of
+/// experiments/, the Mitsuba comparison of every committed values file, and a
+/// line per finished experiment on stderr (not a terminal).
 #[test]
 fn the_bundled_experiments_run_and_report_every_quantity() {
     let dir = scratch("bundled");
     let out = dir.join("report");
     let o = bin()
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["run", "--out"])
-        .arg(&out)
+        .current_dir(&dir)
+        .args(["run", "--out", "report"])
         .output()
         .expect("runs");
     assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!dir.join("experiments").exists());
     let index = fs::read_to_string(out.join("index.md")).expect("index");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // Each committed values file gives rows with Mitsuba's value (not a note).
+    assert!(index.contains("## lightquad vs Mitsuba 3 vs closed form"));
+    let mut values = 0;
+    for f in fs::read_dir(root.join("reference/values")).expect("values") {
+        let v: serde_json::Value =
+            serde_json::from_str(&fs::read_to_string(f.expect("entry").path()).expect("read"))
+                .expect("json");
+        let name = v["experiment"].as_str().expect("experiment");
+        for (q, entry) in v["quantities"].as_object().expect("quantities") {
+            let value = entry["value"].as_f64().expect("value");
+            let row = format!("| {name} | {q} | ");
+            let line = index
+                .lines()
+                .find(|l| l.starts_with(&row))
+                .unwrap_or_else(|| panic!("no Mitsuba row for {name} {q}"));
+            assert!(
+                line.contains(&format!("| {value:.10e} +- ")),
+                "{name} {q}: Mitsuba's {value:e} not in {line}"
+            );
+            values += 1;
+        }
+    }
+    assert!(values >= 5, "{values} Mitsuba values");
+    // One progress line per experiment: its name, jobs (as in its results
+    // file) and failures.
+    let err = stderr(&o);
+    for f in fs::read_dir(root.join("experiments")).expect("folder") {
+        let p = f.expect("entry").path();
+        if p.extension().is_none_or(|x| x != "json") {
+            continue;
+        }
+        let spec: serde_json::Value =
+            serde_json::from_str(&fs::read_to_string(&p).expect("read")).expect("json");
+        let name = spec["name"].as_str().expect("name");
+        let jobs = results(&out, name).len();
+        let line = format!("finished {name}: {jobs} jobs, 0 failed, ");
+        assert_eq!(
+            err.lines().filter(|l| l.starts_with(&line)).count(),
+            1,
+            "{line} in {err}"
+        );
+    }
     let files =
         fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments")).expect("folder");
     let mut n = 0;

@@ -50,10 +50,10 @@ fn mutate(v: &mut Value, k: &mut usize, new: &Value, drop: bool) -> bool {
                     return true;
                 }
                 *k -= 1;
-                if let Some(child) = map.get_mut(&key) {
-                    if mutate(child, k, new, drop) {
-                        return true;
-                    }
+                if let Some(child) = map.get_mut(&key)
+                    && mutate(child, k, new, drop)
+                {
+                    return true;
                 }
             }
             false

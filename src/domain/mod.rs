@@ -14,6 +14,20 @@
 //! | [`SphericalCap`] (sphere when the cap is whole) | 2 | 3-D point | area |
 //! | [`Hemisphere`] (uniform or cosine-weighted map) | 2 | unit direction | solid angle |
 //! | [`Pixel`] (image-plane square) | 2 | `[x, y]` | area |
+//!
+//! ```
+//! use lightquad::domain::{Domain, Segment, integrate_over};
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! // int_1^3 t^2 dt = 26 / 3 over a ray segment, and its measure (length).
+//! let seg = Segment::new(1.0, 3.0)?;
+//! assert_eq!(seg.measure(), 2.0);
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let est = integrate_over(&GaussLegendre::default(), &seg, 4, &mut rng, |t: f64| t * t)?;
+//! assert!((est.value - 26.0 / 3.0).abs() < 1e-13);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 pub mod disk;
 pub mod frame;

@@ -169,16 +169,16 @@ fn equations() -> Vec<Equation> {
     for line in text.lines() {
         if let Some(h) = line.strip_prefix("## ") {
             section = h.trim().to_string();
-        } else if let Some(row) = line.strip_prefix("| ") {
-            if let Some((id, rest)) = row.split_once(" | ") {
-                let statement = rest.trim().trim_end_matches('|').trim();
-                if id != "ID" && !id.starts_with('-') {
-                    out.push(Equation {
-                        id: id.trim().to_string(),
-                        statement: statement.to_string(),
-                        section: section.clone(),
-                    });
-                }
+        } else if let Some(row) = line.strip_prefix("| ")
+            && let Some((id, rest)) = row.split_once(" | ")
+        {
+            let statement = rest.trim().trim_end_matches('|').trim();
+            if id != "ID" && !id.starts_with('-') {
+                out.push(Equation {
+                    id: id.trim().to_string(),
+                    statement: statement.to_string(),
+                    section: section.clone(),
+                });
             }
         }
     }

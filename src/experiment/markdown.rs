@@ -26,22 +26,22 @@ pub fn inline(s: &str) -> String {
     let mut bold = false;
     let mut rest = s;
     while !rest.is_empty() {
-        if let Some(after) = rest.strip_prefix('`') {
-            if let Some(end) = after.find('`') {
-                out.push_str("<code>");
-                out.push_str(&escape(&after[..end]));
-                out.push_str("</code>");
-                rest = &after[end + 1..];
-                continue;
-            }
+        if let Some(after) = rest.strip_prefix('`')
+            && let Some(end) = after.find('`')
+        {
+            out.push_str("<code>");
+            out.push_str(&escape(&after[..end]));
+            out.push_str("</code>");
+            rest = &after[end + 1..];
+            continue;
         }
-        if let Some(after) = rest.strip_prefix("**") {
-            if bold || after.contains("**") {
-                out.push_str(if bold { "</strong>" } else { "<strong>" });
-                bold = !bold;
-                rest = after;
-                continue;
-            }
+        if let Some(after) = rest.strip_prefix("**")
+            && (bold || after.contains("**"))
+        {
+            out.push_str(if bold { "</strong>" } else { "<strong>" });
+            bold = !bold;
+            rest = after;
+            continue;
         }
         let c = rest.chars().next().unwrap_or(' ');
         out.push_str(&escape(&rest[..c.len_utf8()]));

@@ -11,15 +11,36 @@
 //! self-contained HTML pages). Nothing here names a
 //! family: it is generic over [`Family`](crate::family::Family), and
 //! [`crate::families`] is the one registry that names them.
+//!
+//! ```
+//! use lightquad::experiment::validate::parse_json;
+//!
+//! // An experiment file, checked as `lightquad check` does: 2 rules x 3 budgets
+//! // x 2 repeats = 12 jobs.
+//! let text = r#"{"name": "e", "family": "calibration", "scene": {},
+//!   "quantities": ["exp"], "rules": [{"rule": "trapezoid"}, {"rule": "gauss-legendre"}],
+//!   "budgets": [4, 16, 64], "repeats": 2, "reference": {"type": "closed-form"}}"#;
+//! let registry = lightquad::families::builtin();
+//! let exp = registry.load(parse_json(text)?, "hash")?;
+//! assert_eq!(exp.shape(), (2, 3, 2));
+//! assert_eq!(exp.jobs(None).len(), 12);
+//! // A fault names its JSON path.
+//! let bad = text.replace("\"repeats\": 2", "\"repeats\": 0");
+//! let e = registry.load(parse_json(&bad)?, "hash").err().expect("refused");
+//! assert!(e.to_string().contains("repeats"), "{e}");
+//! # Ok::<(), lightquad::error::SpecError>(())
+//! ```
 
 pub mod fit;
 pub mod html;
 pub mod markdown;
 pub mod plot;
+mod progress;
 pub mod reference;
 pub mod registry;
 pub mod report;
 pub mod run;
+pub mod source;
 pub mod spec;
 pub mod validate;
 
@@ -29,6 +50,7 @@ use std::path::{Path, PathBuf};
 
 pub use registry::{FamilyEntry, Loaded, Registry};
 use run::{JobResult, RunOptions, file_hash, read_results, run_experiment, write_atomic};
+pub use source::Source;
 pub use validate::SpecError;
 
 /// An error of a run, naming the file (and the JSON path when it is a spec fault).
@@ -80,33 +102,55 @@ fn io(path: &Path, e: impl std::fmt::Display) -> RunError {
 
 /// Reads, parses and validates one experiment file of any family in `registry`.
 pub fn load(registry: &Registry, path: &Path) -> Result<Box<dyn Loaded>, RunError> {
-    let bytes = fs::read(path).map_err(|e| io(path, e))?;
-    load_bytes(registry, path, &bytes)
+    load_source(registry, &Source::File(path.to_path_buf()))
 }
 
-fn load_bytes(registry: &Registry, path: &Path, bytes: &[u8]) -> Result<Box<dyn Loaded>, RunError> {
-    let text = std::str::from_utf8(bytes).map_err(|e| io(path, format!("not UTF-8: {e}")))?;
+/// Reads, parses and validates one experiment (a file or a bundled one).
+pub fn load_source(registry: &Registry, source: &Source) -> Result<Box<dyn Loaded>, RunError> {
+    let bytes = read_source(source)?;
+    load_bytes(registry, source, &bytes)
+}
+
+fn read_source(source: &Source) -> Result<Vec<u8>, RunError> {
+    source.read().map_err(|message| RunError::Io {
+        path: source.display(),
+        message,
+    })
+}
+
+fn load_bytes(
+    registry: &Registry,
+    source: &Source,
+    bytes: &[u8],
+) -> Result<Box<dyn Loaded>, RunError> {
+    let file = source.display();
+    let text = std::str::from_utf8(bytes).map_err(|e| RunError::Io {
+        path: file.clone(),
+        message: format!("not UTF-8: {e}"),
+    })?;
     let spec_error = |source| RunError::Spec {
-        file: path.display().to_string(),
+        file: file.clone(),
         source,
     };
     let json = validate::parse_json(text).map_err(spec_error)?;
-    registry.load(json, &file_hash(bytes)).map_err(spec_error)
+    registry
+        .load_from(json, &file_hash(bytes), source.origin())
+        .map_err(spec_error)
 }
 
 /// An experiment with the bytes it was loaded from.
-type Input = (Box<dyn Loaded>, PathBuf, Vec<u8>);
+type Input = (Box<dyn Loaded>, Source, Vec<u8>);
 
 /// Loads every file and checks that no two share a name.
-fn load_all(registry: &Registry, files: &[PathBuf]) -> Result<Vec<Input>, RunError> {
+fn load_all(registry: &Registry, files: &[Source]) -> Result<Vec<Input>, RunError> {
     let mut names = BTreeSet::new();
     let mut out = Vec::new();
     for f in files {
-        let bytes = fs::read(f).map_err(|e| io(f, e))?;
+        let bytes = read_source(f)?;
         let exp = load_bytes(registry, f, &bytes)?;
         if !names.insert(exp.name().to_string()) {
             return Err(RunError::Spec {
-                file: f.display().to_string(),
+                file: f.display(),
                 source: SpecError::at(
                     "name",
                     format!("{:?} is used by another experiment in this run", exp.name()),
@@ -135,13 +179,24 @@ pub fn run_files(
     files: &[PathBuf],
     opts: &RunOptions,
 ) -> Result<PathBuf, RunError> {
-    if let Some((k, n)) = opts.shard {
-        if k == 0 || k > n {
-            return Err(RunError::Io {
-                path: opts.out.display().to_string(),
-                message: format!("invalid shard {k}/{n}: expected k/n with 1 <= k <= n"),
-            });
-        }
+    let sources: Vec<Source> = files.iter().cloned().map(Source::File).collect();
+    run_sources(registry, &sources, opts)
+}
+
+/// [`run_files`] for experiments that are files or bundled ones
+/// ([`Source::bundled_suite`]: what `lightquad run` runs without files).
+pub fn run_sources(
+    registry: &Registry,
+    files: &[Source],
+    opts: &RunOptions,
+) -> Result<PathBuf, RunError> {
+    if let Some((k, n)) = opts.shard
+        && (k == 0 || k > n)
+    {
+        return Err(RunError::Io {
+            path: opts.out.display().to_string(),
+            message: format!("invalid shard {k}/{n}: expected k/n with 1 <= k <= n"),
+        });
     }
     let loaded = load_all(registry, files)?;
     writable(&opts.out)?;
@@ -149,11 +204,7 @@ pub fn run_files(
         .iter()
         .map(|(e, _, _)| e.jobs(opts.shard).len())
         .sum();
-    let bar = if opts.progress {
-        indicatif::ProgressBar::new(total as u64)
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = progress::bar(opts.progress, total);
     let mut done = Vec::new();
     for (exp, _, bytes) in loaded {
         let dir = opts.out.join(exp.name());
@@ -165,7 +216,9 @@ pub fn run_files(
             write_atomic(&spec_path, &bytes).map_err(|e| io(&dir, e))?;
         }
         bar.set_message(exp.name().to_string());
+        let started = std::time::Instant::now();
         let results = run_experiment(exp.as_ref(), opts, &bar).map_err(|e| io(&dir, e))?;
+        progress::finished(opts.progress, &bar, exp.name(), &results, started.elapsed());
         done.push((exp, results));
     }
     bar.finish_and_clear();

@@ -5,8 +5,8 @@
 
 use std::collections::BTreeMap;
 use std::fs;
-use std::path::Path;
 
+use super::source::{Origin, Values, find_values};
 use super::spec::{ExperimentSpec, ReferenceSpec};
 use super::validate::{Experiment, literal_values};
 use crate::error::SpecError;
@@ -46,11 +46,13 @@ impl Reference {
 }
 
 /// The reference values an experiment can know before it runs (none for a
-/// converged reference); checks the reference spec.
+/// converged reference); checks the reference spec. A Mitsuba values file is
+/// looked for relative to `origin`, the experiment file's folder.
 pub fn known_values<F: Family>(
     spec: &ExperimentSpec<F>,
     scene: &F::Scene,
     hash: &str,
+    origin: &Origin,
 ) -> Result<Option<Known<F::Quantity>>, SpecError> {
     Ok(Some(match &spec.reference {
         ReferenceSpec::ClosedForm {} => closed_forms(spec, scene)?,
@@ -86,7 +88,30 @@ pub fn known_values<F: Family>(
                     ),
                 ));
             }
-            mitsuba_values(file, hash, &spec.quantities)?
+            let at = "reference.file";
+            match find_values(origin, &spec.name, hash, Some(file)) {
+                Values::Found { location, json } => {
+                    values_from_json(&location, &json, &spec.quantities)?
+                }
+                Values::Stale {
+                    location,
+                    made_from,
+                } => return Err(stale_values(&location, &made_from, hash)),
+                Values::Missing { looked } => {
+                    return Err(SpecError::at(
+                        at,
+                        format!(
+                            "no Mitsuba values file for this experiment (looked for {}, relative \
+                             to the experiment file); run scripts/reference.sh to generate it",
+                            looked.join(", ")
+                        ),
+                    ));
+                }
+                // find_values expects a file the reference names.
+                Values::NotExpected => {
+                    return Err(SpecError::at(at, format!("{file}: not found")));
+                }
+            }
         }
         ReferenceSpec::Converged { n } => {
             if !(2..=100_000).contains(n) {
@@ -154,16 +179,30 @@ pub fn mitsuba_values<Q: Quantity>(
     })?;
     let json: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| SpecError::at(at, format!("{path}: {e}")))?;
-    let file_hash = json["experiment_hash"].as_str().unwrap_or("");
-    if file_hash != hash {
-        return Err(SpecError::at(
-            at,
-            format!(
-                "{path} is stale: it was made from an experiment file with hash {file_hash:?}, this one \
-                 hashes to {hash:?}; regenerate it (scripts/reference.sh)"
-            ),
-        ));
+    let made_from = json["experiment_hash"].as_str().unwrap_or("");
+    if made_from != hash {
+        return Err(stale_values(path, made_from, hash));
     }
+    values_from_json(path, &json, quantities)
+}
+
+fn stale_values(path: &str, made_from: &str, hash: &str) -> SpecError {
+    SpecError::at(
+        "reference.file",
+        format!(
+            "{path} is stale: it was made from an experiment file with hash {made_from:?}, this one \
+             hashes to {hash:?}; regenerate it (scripts/reference.sh)"
+        ),
+    )
+}
+
+/// The value and standard error per quantity of a values file's JSON.
+fn values_from_json<Q: Quantity>(
+    path: &str,
+    json: &serde_json::Value,
+    quantities: &[Q],
+) -> Result<Known<Q>, SpecError> {
+    let at = "reference.file";
     let mut values = BTreeMap::new();
     let mut worst = 0.0f64;
     for q in quantities {
@@ -421,18 +460,40 @@ pub struct Crosscheck {
     pub note: String,
 }
 
-/// The comparison rows of an experiment that has a Mitsuba values file in
-/// `reference/values/<name>.json` (relative to the working folder); none
-/// otherwise. Scalar quantities only (Mitsuba's files hold scalars).
+/// The comparison rows of an experiment with Mitsuba values (found as
+/// [`find_values`] says: relative to the experiment file, or built into the
+/// binary); none when it has none and none is expected. Values that are
+/// expected but missing, or stale, give rows saying so, so the comparison
+/// never silently disappears. Scalar quantities only (Mitsuba's files hold
+/// scalars).
 pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
-    let path = Path::new("reference/values").join(format!("{}.json", exp.spec.name));
-    let Ok(text) = fs::read_to_string(&path) else {
-        return Vec::new();
+    let named = match &exp.spec.reference {
+        ReferenceSpec::Mitsuba { file } => Some(file.as_str()),
+        _ => None,
     };
-    let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else {
-        return Vec::new();
+    let (json, note) = match find_values(&exp.origin, &exp.spec.name, &exp.hash, named) {
+        Values::NotExpected => return Vec::new(),
+        Values::Found { json, .. } => (json, None),
+        Values::Stale {
+            location,
+            made_from,
+        } => (
+            serde_json::Value::Null,
+            Some(format!(
+                "values file {location} is stale (made from experiment hash {made_from}, this \
+                 file hashes to {}): regenerate with scripts/reference.sh",
+                exp.hash
+            )),
+        ),
+        Values::Missing { looked } => (
+            serde_json::Value::Null,
+            Some(format!(
+                "MISSING: no Mitsuba values file found (looked for {}): generate it with \
+                 scripts/reference.sh",
+                looked.join(", ")
+            )),
+        ),
     };
-    let stale = json["experiment_hash"].as_str() != Some(exp.hash.as_str());
     let lightquad = converged(exp, 400).unwrap_or_default();
     let scalar = |v: Option<&Vec<f64>>| v.and_then(|v| (v.len() == 1).then(|| v[0]));
     exp.spec
@@ -441,18 +502,15 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
         .map(|q| {
             let entry = &json["quantities"][q.name()];
             let mitsuba = match (entry["value"].as_f64(), entry["std_error"].as_f64()) {
-                (Some(v), Some(se)) if !stale => Some((v, se)),
+                (Some(v), Some(se)) if note.is_none() => Some((v, se)),
                 _ => None,
             };
-            let note = if stale {
-                "values file is stale (experiment changed): regenerate with scripts/reference.sh"
-                    .into()
-            } else {
+            let note = note.clone().unwrap_or_else(|| {
                 json["unsupported"][q.name()]
                     .as_str()
                     .unwrap_or("")
                     .to_string()
-            };
+            });
             Crosscheck {
                 experiment: exp.spec.name.clone(),
                 quantity: q.name(),

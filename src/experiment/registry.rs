@@ -11,8 +11,9 @@ use std::path::Path;
 use super::reference::{Crosscheck, crosscheck, reference};
 use super::report::{Page, RuleInfo, Summary, write_experiment};
 use super::run::{JobKey, JobResult, jobs, run_job};
+use super::source::Origin;
 use super::spec::ExperimentSpec;
-use super::validate::{Experiment, deserialize, validate};
+use super::validate::{Experiment, deserialize, validate_from};
 use crate::error::SpecError;
 use crate::family::{Estimator, Family, Method, Quantity};
 
@@ -148,7 +149,7 @@ fn page<'a, F: Family>(
     }
 }
 
-type LoadFn = fn(serde_json::Value, &str) -> Result<Box<dyn Loaded>, SpecError>;
+type LoadFn = fn(serde_json::Value, &str, Origin) -> Result<Box<dyn Loaded>, SpecError>;
 
 /// What the runner and the CLI know of a family.
 #[derive(Clone)]
@@ -172,7 +173,13 @@ impl FamilyEntry {
             name: F::NAME,
             about: F::ABOUT,
             equations: F::EQUATIONS,
-            load: |json, hash| Ok(Box::new(validate::<F>(deserialize::<F>(json)?, hash)?)),
+            load: |json, hash, origin| {
+                Ok(Box::new(validate_from::<F>(
+                    deserialize::<F>(json)?,
+                    hash,
+                    origin,
+                )?))
+            },
             schema: || schemars::schema_for!(ExperimentSpec<F>),
             estimators: || {
                 F::Estimator::all()
@@ -235,8 +242,20 @@ impl Registry {
         self.entries.iter().find(|e| e.name == name)
     }
 
-    /// Reads a parsed experiment file by its `family` tag and validates it.
+    /// Reads a parsed experiment file by its `family` tag and validates it, as
+    /// if its file were in the working folder.
     pub fn load(&self, json: serde_json::Value, hash: &str) -> Result<Box<dyn Loaded>, SpecError> {
+        self.load_from(json, hash, Origin::default())
+    }
+
+    /// Reads a parsed experiment file that came from `origin` by its `family`
+    /// tag and validates it.
+    pub fn load_from(
+        &self,
+        json: serde_json::Value,
+        hash: &str,
+        origin: Origin,
+    ) -> Result<Box<dyn Loaded>, SpecError> {
         let names: Vec<&str> = self.entries.iter().map(|e| e.name).collect();
         let accepted = format!("expected one of {}", names.join(", "));
         if !json.is_object() {
@@ -261,7 +280,7 @@ impl Registry {
                 format!("unknown family {tag:?}: {accepted}"),
             ));
         };
-        (entry.load)(json, hash)
+        (entry.load)(json, hash, origin)
     }
 
     /// The JSON Schema (2020-12) of experiment files: one of the families'

@@ -70,7 +70,8 @@ pub struct RunOptions {
     pub resume: bool,
     /// Run only shard `k` of `n` (1-based) of every experiment's jobs.
     pub shard: Option<(usize, usize)>,
-    /// Show a progress bar (on a terminal).
+    /// Report progress on stderr: a bar on a terminal, a line per finished
+    /// experiment otherwise.
     pub progress: bool,
 }
 

@@ -59,7 +59,7 @@ fn default_targets() -> Vec<f64> {
 }
 
 /// Budgets: a list, or a geometric range `from, from*factor, ... <= to`.
-/// Read by [`untagged`] (a list or a map, never buffered), so an error
+/// Read by a visitor of its own (a list or a map, never buffered), so an error
 /// inside names its own path (`budgets.factor`, `budgets[2]`).
 #[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 #[serde(untagged)]
@@ -85,7 +85,7 @@ pub struct BudgetRange {
 }
 
 /// A literal reference value: a number, or one number per channel (read by
-/// [`untagged`], so an error names its own path).
+/// a visitor of its own, so an error names its own path).
 #[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum Literal {
@@ -128,10 +128,10 @@ pub enum ReferenceSpec<Q> {
         uncertainty: f64,
     },
     /// Values written by the Mitsuba 3 harness (`reference/`), e.g.
-    /// `reference/values/<name>.json`; stale files (another experiment hash)
-    /// are rejected.
+    /// `../reference/values/<name>.json` for a file in `experiments/`; stale
+    /// files (another experiment hash) are rejected.
     Mitsuba {
-        /// Path of the values file, relative to the working folder.
+        /// Path of the values file, relative to the experiment file's folder.
         file: String,
     },
     /// The family's converged deterministic evaluation at `n` nodes per

@@ -6,6 +6,7 @@
 use std::collections::BTreeMap;
 
 use super::reference::{Known, known_values};
+use super::source::Origin;
 use super::spec::{Budgets, ExperimentSpec};
 pub use crate::error::SpecError;
 use crate::family::{Estimator, Family, Method, Quantity};
@@ -31,6 +32,8 @@ pub struct Experiment<F: Family> {
     /// Reference values known before running (closed forms, literals, Mitsuba
     /// values); a converged reference is computed when the report is written.
     pub known: Option<Known<F::Quantity>>,
+    /// Where its file came from: Mitsuba values are looked for relative to it.
+    pub origin: Origin,
 }
 
 /// Parses the text of an experiment file as JSON (syntax only: the family's
@@ -123,10 +126,21 @@ pub fn deserialize<F: Family>(json: serde_json::Value) -> Result<ExperimentSpec<
     serde_path_to_error::deserialize(json).map_err(path_error)
 }
 
-/// Validates a parsed experiment whose file hashes to `hash`.
+/// Validates a parsed experiment whose file hashes to `hash`, as if its file
+/// were in the working folder.
 pub fn validate<F: Family>(
     spec: ExperimentSpec<F>,
     hash: &str,
+) -> Result<Experiment<F>, SpecError> {
+    validate_from(spec, hash, Origin::default())
+}
+
+/// Validates a parsed experiment whose file hashes to `hash` and came from
+/// `origin` (a Mitsuba values file is looked for relative to it).
+pub fn validate_from<F: Family>(
+    spec: ExperimentSpec<F>,
+    hash: &str,
+    origin: Origin,
 ) -> Result<Experiment<F>, SpecError> {
     check_header::<F>(&spec)?;
     let scene = F::build(&spec.scene)?;
@@ -147,13 +161,14 @@ pub fn validate<F: Family>(
             ));
         }
     }
-    let known = known_values::<F>(&spec, &scene, hash)?;
+    let known = known_values::<F>(&spec, &scene, hash, &origin)?;
     Ok(Experiment {
         spec,
         scene,
         budgets,
         hash: hash.to_string(),
         known,
+        origin,
     })
 }
 

@@ -23,6 +23,21 @@
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
 //! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles, times t_{R-1}(0.975)/1.96 |
 //! | `product` | iterated 2-D rule from any two 1-D rules (`AnyRule::by_name("product(A,B)")` in the library) | outer estimate + integrated inner estimates |
+//!
+//! ```
+//! use lightquad::quadrature::{GaussLegendre, Rule, Trapezoid};
+//! use rand::SeedableRng;
+//!
+//! // int_0^1 e^u du = e - 1: Gauss–Legendre converges spectrally, the trapezoid
+//! // rule as n^-2.
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let exact = std::f64::consts::E - 1.0;
+//! let gl = GaussLegendre::default().integrate(8, &mut rng, |u: [f64; 1]| u[0].exp())?;
+//! let tr = Trapezoid.integrate(8, &mut rng, |u: [f64; 1]| u[0].exp())?;
+//! assert!((gl.value - exact).abs() < 1e-14);
+//! assert!((tr.value - exact).abs() > 1e-4 && (tr.value - exact).abs() < 1e-2);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 pub mod nodes;
 pub mod product;

@@ -193,10 +193,10 @@ impl DirectionalLight {
                 "a finite number >= 0",
             ));
         }
-        if let Some(a) = albedo {
-            if !(0.0..=1.0).contains(&a) {
-                return Err(QuadError::invalid("albedo", a, "a number in [0, 1]"));
-            }
+        if let Some(a) = albedo
+            && !(0.0..=1.0).contains(&a)
+        {
+            return Err(QuadError::invalid("albedo", a, "a number in [0, 1]"));
         }
         Ok(DirectionalLight {
             toward_light: normalize("toward_light", toward_light)?,
@@ -366,14 +366,14 @@ impl VolumeScene {
                 ));
             }
         }
-        if let Some(b) = self.background {
-            if !(b.is_finite() && b >= 0.0) {
-                return Err(QuadError::invalid(
-                    "background",
-                    b,
-                    "a finite radiance >= 0",
-                ));
-            }
+        if let Some(b) = self.background
+            && !(b.is_finite() && b >= 0.0)
+        {
+            return Err(QuadError::invalid(
+                "background",
+                b,
+                "a finite radiance >= 0",
+            ));
         }
         match &self.emission {
             Some(EmissionMap::Constant(c)) | Some(EmissionMap::Proportional(c))

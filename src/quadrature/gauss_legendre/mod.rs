@@ -266,7 +266,7 @@ fn tail_estimate(q: f64, q1: f64, q2: f64) -> f64 {
 
 /// Orders from which the error estimate adds the half-order rule to the
 /// consecutive ones ([`hybrid_estimate`]); below it, `Q_{m-1}` and `Q_{m-2}`
-/// alone ([`tail_estimate`]). Below 16 the half-order rule has at most 8
+/// alone (`tail_estimate`). Below 16 the half-order rule has at most 8
 /// nodes and resolves little. From 16 to 31 the hybrid is pessimistic on
 /// smooth integrands its half order does not resolve (cos(20x): estimate
 /// 2e4 to 6e4 times the truth, Runge's function 8e1 to 4e3 times), but it is
@@ -320,7 +320,7 @@ const ROUNDING_ULPS: f64 = 128.0;
 /// On a Kahaner-style battery (smooth, endpoint-singular, kinked and
 /// discontinuous integrands, 44 random kink and jump positions, 32 to 65537
 /// nodes) no estimate above rounding falls below a tenth of the true error.
-/// The consecutive orders alone ([`tail_estimate`]) see algebraic convergence
+/// The consecutive orders alone (`tail_estimate`) see algebraic convergence
 /// but drown in rounding at large `m` (estimate/true `3e-5` for
 /// `int_0^1 sqrt(x)` at `m = 65536`); the halving orders alone are
 /// pessimistic by up to `10^14` where `Q_m` has converged and `Q_{m/2}` has
@@ -363,7 +363,7 @@ pub fn hybrid_estimate(m: usize, q: [f64; 4], magnitude: f64) -> f64 {
 /// for `m >= 16`, with `Q_{ceil(m/2)}` ([`hybrid_estimate`]: the tail of the
 /// consecutive differences, checked against the halving difference, which
 /// sees algebraic convergence where the consecutive differences drown in
-/// rounding); below 16 the consecutive orders alone ([`tail_estimate`]). It
+/// rounding); below 16 the consecutive orders alone (`tail_estimate`). It
 /// costs `(m-1)^D + (m-2)^D + ceil(m/2)^D` extra evaluations (about `2.5 m`
 /// in one dimension; without the half order below 16) and can be switched
 /// off with `error_estimate: false`, in which case the error is reported as

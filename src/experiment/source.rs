@@ -1,0 +1,219 @@
+//! Where experiments and their Mitsuba values come from: files, or the
+//! bundled suite built into the binary (every `experiments/*.json` and
+//! `reference/values/*.json` of the source tree, embedded by `build.rs`), so
+//! that `lightquad run` works the same from any folder.
+//!
+//! A Mitsuba values file is looked for relative to the experiment file, never
+//! the working folder: first the file its `reference` names (`{"type":
+//! "mitsuba", "file": ...}`, relative to the experiment file's folder), then
+//! `<experiment folder>/../reference/values/<name>.json` (this repository's
+//! layout), then the values built into the binary. Values are keyed by the
+//! experiment file's hash, so the first one made from these exact bytes is
+//! used wherever it was found.
+//!
+//! ```
+//! use lightquad::experiment::source::{Origin, Values, bundled_experiments, find_values};
+//! use lightquad::experiment::run::file_hash;
+//!
+//! // The bundled suite holds the experiments of experiments/ ...
+//! let (file, text) = bundled_experiments()
+//!     .iter()
+//!     .find(|(f, _)| *f == "v-l-single-scattering.json")
+//!     .expect("bundled");
+//! assert!(text.contains("\"family\": \"volume\""));
+//! // ... and their Mitsuba values, found for these bytes from any folder.
+//! let hash = file_hash(text.as_bytes());
+//! let found = find_values(&Origin::Bundled, "v-l-single-scattering", &hash, None);
+//! assert!(matches!(found, Values::Found { .. }), "{file}: {found:?}");
+//! // An edited copy is told apart by its hash: the values are stale.
+//! let stale = find_values(&Origin::Bundled, "v-l-single-scattering", "0123", None);
+//! assert!(matches!(stale, Values::Stale { .. }));
+//! ```
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+mod generated {
+    include!(concat!(env!("OUT_DIR"), "/bundled.rs"));
+}
+
+/// The bundled experiment files: (file name, exact text), sorted by name.
+pub fn bundled_experiments() -> &'static [(&'static str, &'static str)] {
+    generated::EXPERIMENTS
+}
+
+/// The bundled Mitsuba values file of experiment `name`, if any.
+pub fn bundled_values(name: &str) -> Option<&'static str> {
+    let file = format!("{name}.json");
+    generated::VALUES
+        .iter()
+        .find(|(f, _)| *f == file)
+        .map(|(_, text)| *text)
+}
+
+/// Where to find the experiments of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Source {
+    /// An experiment file.
+    File(PathBuf),
+    /// A file of the bundled suite, by file name (e.g. `v-l-single-scattering.json`).
+    Bundled(&'static str),
+}
+
+impl Source {
+    /// The whole bundled suite.
+    pub fn bundled_suite() -> Vec<Source> {
+        bundled_experiments()
+            .iter()
+            .map(|(f, _)| Source::Bundled(f))
+            .collect()
+    }
+
+    /// The path shown in messages: the file, or `<bundled>/<file name>`.
+    pub fn display(&self) -> String {
+        match self {
+            Source::File(p) => p.display().to_string(),
+            Source::Bundled(f) => format!("<bundled>/{f}"),
+        }
+    }
+
+    /// The file's bytes.
+    pub fn read(&self) -> Result<Vec<u8>, String> {
+        match self {
+            Source::File(p) => fs::read(p).map_err(|e| e.to_string()),
+            Source::Bundled(f) => bundled_experiments()
+                .iter()
+                .find(|(name, _)| name == f)
+                .map(|(_, text)| text.as_bytes().to_vec())
+                .ok_or_else(|| {
+                    format!(
+                        "no such bundled experiment; the bundled ones are {}",
+                        bundled_experiments()
+                            .iter()
+                            .map(|(f, _)| *f)
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                }),
+        }
+    }
+
+    /// Where relative paths inside the experiment are resolved.
+    pub fn origin(&self) -> Origin {
+        match self {
+            Source::File(p) => Origin::Folder(match p.parent() {
+                Some(dir) if !dir.as_os_str().is_empty() => dir.to_path_buf(),
+                _ => PathBuf::from("."),
+            }),
+            Source::Bundled(_) => Origin::Bundled,
+        }
+    }
+}
+
+/// Where a loaded experiment came from: relative paths inside it (a Mitsuba
+/// values file) are resolved against it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Origin {
+    /// A file in this folder.
+    Folder(PathBuf),
+    /// The bundled suite: its values are the bundled ones.
+    Bundled,
+}
+
+impl Default for Origin {
+    /// The working folder (for experiments given as JSON, without a file).
+    fn default() -> Self {
+        Origin::Folder(PathBuf::from("."))
+    }
+}
+
+/// The Mitsuba values of an experiment, as [`find_values`] found them.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Values {
+    /// None expected and none found: the experiment has no Mitsuba comparison.
+    NotExpected,
+    /// A values file made from this experiment's exact bytes.
+    Found {
+        /// Where it was found (a path, or `<bundled>/values/<name>.json`).
+        location: String,
+        /// Its JSON.
+        json: serde_json::Value,
+    },
+    /// Values for another version of the experiment (another hash) only.
+    Stale {
+        /// Where they were found.
+        location: String,
+        /// The hash they were made from.
+        made_from: String,
+    },
+    /// Expected (the experiment names a values file, or is one of the bundled
+    /// experiments with Mitsuba values) but found nowhere.
+    Missing {
+        /// Where they were looked for.
+        looked: Vec<String>,
+    },
+}
+
+/// Looks for the Mitsuba values of experiment `name` whose file hashes to
+/// `hash`: `named` (the file its reference names, relative to the experiment
+/// file's folder), then `<folder>/../reference/values/<name>.json`, then the
+/// bundled values. The first made from these bytes wins; otherwise the first
+/// found is stale.
+pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>) -> Values {
+    let mut places: Vec<(String, Option<String>)> = Vec::new();
+    if let Origin::Folder(dir) = origin {
+        if let Some(file) = named {
+            let path = resolve(dir, file);
+            places.push((path.display().to_string(), fs::read_to_string(&path).ok()));
+        }
+        let path = dir
+            .join("..")
+            .join("reference")
+            .join("values")
+            .join(format!("{name}.json"));
+        places.push((path.display().to_string(), fs::read_to_string(&path).ok()));
+    }
+    places.push((
+        format!("<bundled>/values/{name}.json"),
+        bundled_values(name).map(str::to_string),
+    ));
+    let mut stale = None;
+    for (location, text) in &places {
+        let Some(json) = text
+            .as_deref()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(t).ok())
+        else {
+            continue;
+        };
+        let made_from = json["experiment_hash"].as_str().unwrap_or("").to_string();
+        if made_from == hash {
+            return Values::Found {
+                location: location.clone(),
+                json,
+            };
+        }
+        stale.get_or_insert(Values::Stale {
+            location: location.clone(),
+            made_from,
+        });
+    }
+    if let Some(s) = stale {
+        s
+    } else if named.is_some() || bundled_values(name).is_some() {
+        Values::Missing {
+            looked: places.into_iter().map(|(l, _)| l).collect(),
+        }
+    } else {
+        Values::NotExpected
+    }
+}
+
+/// `file` relative to `dir` (absolute paths as they are).
+fn resolve(dir: &Path, file: &str) -> PathBuf {
+    let file = Path::new(file);
+    if file.is_absolute() {
+        file.to_path_buf()
+    } else {
+        dir.join(file)
+    }
+}
