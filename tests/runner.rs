@@ -1140,3 +1140,57 @@ fn simpson_and_the_trapezoid_show_their_orders_against_the_points_they_use() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// Two runs into one folder: the second used to replace results.jsonl while
+/// the first kept appending to the unlinked file (528 jobs reported, 76
+/// lines left). Now a run holds `<out>/.lightquad.lock`; a second run (here
+/// this test, holding the lock as a running `lightquad run` would) stops at
+/// once with an error naming the folder, and touches nothing.
+#[test]
+fn a_second_run_into_a_busy_folder_stops_and_touches_nothing() {
+    let (dir, out, o) = run_text("busy", VALID);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let results = out.join("t/results.jsonl");
+    let before = fs::read(&results).expect("results");
+    let lock = fs::OpenOptions::new()
+        .write(true)
+        .open(out.join(".lightquad.lock"))
+        .expect("the run left its lock file");
+    lock.try_lock().expect("free once the run ended");
+    let file = dir.join("e.json");
+    for args in [
+        vec!["run".to_string(), "--out".into()],
+        vec![
+            "merge".to_string(),
+            out.display().to_string(),
+            "--out".into(),
+        ],
+    ] {
+        let o = bin()
+            .args(&args)
+            .arg(&out)
+            .args(if args[0] == "run" {
+                vec![&file]
+            } else {
+                vec![]
+            })
+            .output()
+            .expect("runs");
+        assert!(!o.status.success(), "{args:?} ran into a busy folder");
+        assert!(
+            stderr(&o).contains("another lightquad run or merge is writing into this folder"),
+            "{}",
+            stderr(&o)
+        );
+        assert_eq!(fs::read(&results).expect("results"), before, "{args:?}");
+    }
+    drop(lock);
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
+}

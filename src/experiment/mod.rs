@@ -162,6 +162,38 @@ fn load_all(registry: &Registry, files: &[Source]) -> Result<Vec<Input>, RunErro
     Ok(out)
 }
 
+/// Holds `<out>/.lightquad.lock` (one per shard for `run --shard`, which may
+/// share a folder) locked for as long as the run writes there: a second run
+/// into the same folder stops at once with an error instead of replacing the
+/// first's results file while the first keeps appending to the replaced one
+/// (528 jobs reported, 76 lines left). The lock is advisory and released by
+/// the operating system when the process ends, also after `kill -9`.
+fn lock_output(out: &Path, shard: Option<(usize, usize)>) -> Result<fs::File, RunError> {
+    let name = match shard {
+        None => ".lightquad.lock".to_string(),
+        Some((k, n)) => format!(".lightquad.shard-{k}-of-{n}.lock"),
+    };
+    let path = out.join(name);
+    let file = fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(|e| io(&path, e))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(fs::TryLockError::WouldBlock) => Err(io(
+            out,
+            format!(
+                "another lightquad run or merge is writing into this folder (it holds {}): \
+                 wait for it to finish or give another --out",
+                path.display()
+            ),
+        )),
+        Err(fs::TryLockError::Error(e)) => Err(io(&path, format!("cannot lock: {e}"))),
+    }
+}
+
 /// Checks that `dir` exists (or can be made) and is writable.
 fn writable(dir: &Path) -> Result<(), RunError> {
     fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
@@ -200,6 +232,7 @@ pub fn run_sources(
     }
     let loaded = load_all(registry, files)?;
     writable(&opts.out)?;
+    let _lock = lock_output(&opts.out, opts.shard)?;
     let total: usize = loaded
         .iter()
         .map(|(e, _, _)| e.jobs(opts.shard).len())
@@ -320,6 +353,7 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
         });
     }
     writable(out)?;
+    let _lock = lock_output(out, None)?;
     let mut missing = Vec::new();
     let mut done = Vec::new();
     for (name, (exp, mut results)) in by_name {
