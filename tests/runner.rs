@@ -1194,3 +1194,33 @@ fn a_second_run_into_a_busy_folder_stops_and_touches_nothing() {
     assert!(o.status.success(), "{}", stderr(&o));
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// Inputs that passed `check` or hung (issue 10, item 5): a 300-character
+/// name (the run then failed, "File name too long", with a folder left); a
+/// Mitsuba values file or an experiment file that is a FIFO or /dev/zero
+/// (read forever).
+#[test]
+fn long_names_and_files_that_are_not_regular_are_refused() {
+    let long = VALID.replace(
+        "\"name\": \"t\"",
+        &format!("\"name\": \"{}\"", "a".repeat(300)),
+    );
+    rejected(&long, "name", "1 to 100 letters");
+    let zero = VALID.replace(
+        "{ \"type\": \"closed-form\" }",
+        "{ \"type\": \"mitsuba\", \"file\": \"/dev/zero\" }",
+    );
+    rejected(&zero, "reference.file", "no Mitsuba values file");
+    let dir = scratch("fifo");
+    let fifo = dir.join("f.json");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        let o = run_with_timeout(&["check", &fifo.display().to_string()], 20);
+        assert!(
+            !o.status.success() && stderr(&o).contains("not a regular file"),
+            "{}",
+            stderr(&o)
+        );
+    }
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -4,7 +4,6 @@
 //! twice its nodes. Also the "lightquad vs Mitsuba vs closed form" rows.
 
 use std::collections::BTreeMap;
-use std::fs;
 
 use super::source::{Origin, Values, find_values};
 use super::spec::{ExperimentSpec, ReferenceSpec};
@@ -171,7 +170,7 @@ pub fn mitsuba_values<Q: Quantity>(
     quantities: &[Q],
 ) -> Result<Known<Q>, SpecError> {
     let at = "reference.file";
-    let text = fs::read_to_string(path).map_err(|e| {
+    let text = super::source::read_text(std::path::Path::new(path)).map_err(|e| {
         SpecError::at(
             at,
             format!("{path}: {e} (run scripts/reference.sh to generate it)"),

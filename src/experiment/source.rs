@@ -80,7 +80,7 @@ impl Source {
     /// The file's bytes.
     pub fn read(&self) -> Result<Vec<u8>, String> {
         match self {
-            Source::File(p) => fs::read(p).map_err(|e| e.to_string()),
+            Source::File(p) => read_regular(p),
             Source::Bundled(f) => bundled_experiments()
                 .iter()
                 .find(|(name, _)| name == f)
@@ -164,14 +164,14 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
     if let Origin::Folder(dir) = origin {
         if let Some(file) = named {
             let path = resolve(dir, file);
-            places.push((path.display().to_string(), fs::read_to_string(&path).ok()));
+            places.push((path.display().to_string(), read_text(&path).ok()));
         }
         let path = dir
             .join("..")
             .join("reference")
             .join("values")
             .join(format!("{name}.json"));
-        places.push((path.display().to_string(), fs::read_to_string(&path).ok()));
+        places.push((path.display().to_string(), read_text(&path).ok()));
     }
     places.push((
         format!("<bundled>/values/{name}.json"),
@@ -216,4 +216,39 @@ fn resolve(dir: &Path, file: &str) -> PathBuf {
     } else {
         dir.join(file)
     }
+}
+
+/// The largest experiment or values file read: far above any real one (the
+/// bundled ones are under 10 KiB), far below what would exhaust memory.
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
+
+/// The bytes of a regular file of at most [`MAX_FILE_BYTES`]: a FIFO,
+/// `/dev/zero` or a directory is refused at once instead of read forever.
+pub fn read_regular(path: &Path) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let meta = fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err(
+            "not a regular file (a FIFO, a device or a folder): expected a JSON file".into(),
+        );
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(format!(
+            "{} bytes: expected a file of at most {MAX_FILE_BYTES} bytes",
+            meta.len()
+        ));
+    }
+    let mut bytes = Vec::new();
+    fs::File::open(path)
+        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(format!("grew past {MAX_FILE_BYTES} bytes while read"));
+    }
+    Ok(bytes)
+}
+
+/// [`read_regular`] as UTF-8 text.
+pub fn read_text(path: &Path) -> Result<String, String> {
+    String::from_utf8(read_regular(path)?).map_err(|e| format!("not UTF-8: {e}"))
 }

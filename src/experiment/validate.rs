@@ -185,9 +185,15 @@ pub fn min_budget<F: Family>(
         .unwrap_or(1)
 }
 
+/// The longest experiment name: it names a folder, and file systems refuse
+/// names past 255 bytes (a 300-character name passed `check` and failed the
+/// run with an empty folder left).
+pub const MAX_NAME: usize = 100;
+
 /// Name, family tag, equation IDs, quantities, repeats and targets.
 fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
     let name_ok = !spec.name.is_empty()
+        && spec.name.len() <= MAX_NAME
         && spec
             .name
             .chars()
@@ -196,7 +202,7 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
         return Err(SpecError::at(
             "name",
             format!(
-                "{:?} is not a name of letters, digits, '-' and '_'",
+                "{:?} is not a name of 1 to {MAX_NAME} letters, digits, '-' and '_' (it names the report's folder)",
                 spec.name
             ),
         ));
