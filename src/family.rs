@@ -420,6 +420,20 @@ pub trait Family: Sized + Send + Sync + 'static {
         None
     }
 
+    /// About how many integrand evaluations one job of `quantity` with
+    /// `method` at `budget` costs, to refuse before running what would take
+    /// hours ([`crate::experiment::validate::MAX_JOB_EVALUATIONS`]). The
+    /// budget itself by default; a family whose evaluations nest (an inner
+    /// integral per outer node) says so here.
+    fn cost(
+        _scene: &Self::Scene,
+        _method: &Method<Self::Estimator>,
+        budget: usize,
+        _quantity: Self::Quantity,
+    ) -> f64 {
+        budget as f64
+    }
+
     /// Evaluates `quantities` with `method` at `budget`, drawing randomness from
     /// `rng` only.
     fn evaluate(

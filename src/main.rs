@@ -60,6 +60,10 @@ enum Command {
         /// Worker threads (default: all cores). Results do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        /// Run experiments whose jobs are estimated to cost more than 1e11
+        /// integrand evaluations each (refused by default, with the estimate).
+        #[arg(long)]
+        no_cost_limit: bool,
     },
     /// Validate experiment files without running them.
     Check {
@@ -116,7 +120,11 @@ fn run(command: Command) -> Result<(), Failure> {
             resume,
             shard,
             threads,
+            no_cost_limit,
         } => {
+            if no_cost_limit {
+                experiment::validate::lift_cost_limit();
+            }
             if let Some(t) = threads {
                 if !(1..=MAX_THREADS).contains(&t) {
                     return Err(format!(

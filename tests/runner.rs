@@ -1224,3 +1224,21 @@ fn long_names_and_files_that_are_not_regular_are_refused() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// The nested depth scheme at a budget of 1e6 was accepted and would have run
+/// for about 22 hours: a job's cost is estimated before anything runs
+/// (issue 10, item 4), refused with the estimate and the flag that lifts it.
+#[test]
+fn jobs_that_would_take_hours_are_refused_with_their_estimate() {
+    let nested = VALID
+        .replace("\"scene\": {", "\"scene\": { \"depth_scheme\": \"nested\",")
+        .replace("[4, 16, 64]", "[4, 1000000]");
+    // 1e6 outer nodes times 1e6 inner ones, per graded piece.
+    rejected(&nested, "budgets", "costs about");
+    rejected(&nested, "budgets", "--no-cost-limit");
+    let help = bin().args(["run", "--help"]).output().expect("runs");
+    assert!(String::from_utf8_lossy(&help.stdout).contains("--no-cost-limit"));
+    // The bundled suite is well inside the limit.
+    let o = bin().arg("check").output().expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -161,6 +161,7 @@ pub fn validate_from<F: Family>(
             ));
         }
     }
+    check_cost::<F>(&spec, &scene, &budgets)?;
     let known = known_values::<F>(&spec, &scene, hash, &origin)?;
     Ok(Experiment {
         spec,
@@ -183,6 +184,55 @@ pub fn min_budget<F: Family>(
         .map(|q| method.min_budget(F::dimension(scene, *q)))
         .max()
         .unwrap_or(1)
+}
+
+/// The most integrand evaluations one job may cost by its family's estimate
+/// ([`Family::cost`]): 1e11, minutes to hours at a nanosecond or more per
+/// evaluation. `run --no-cost-limit` lifts it ([`lift_cost_limit`]).
+pub const MAX_JOB_EVALUATIONS: f64 = 1e11;
+
+static COST_LIMIT_LIFTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Lets experiments whose jobs cost more than [`MAX_JOB_EVALUATIONS`] through
+/// (the command line's `--no-cost-limit`), for this process.
+pub fn lift_cost_limit() {
+    COST_LIMIT_LIFTED.store(true, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Refuses an experiment whose costliest job (the largest budget each rule
+/// runs at, every quantity) would pass [`MAX_JOB_EVALUATIONS`], with the
+/// estimate: the nested depth scheme at a budget of 1e6 was accepted and ran
+/// for about 22 hours.
+fn check_cost<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    budgets: &[usize],
+) -> Result<(), SpecError> {
+    if COST_LIMIT_LIFTED.load(std::sync::atomic::Ordering::Relaxed) {
+        return Ok(());
+    }
+    let Some(&largest) = budgets.last() else {
+        return Ok(());
+    };
+    for (i, m) in spec.rules.iter().enumerate() {
+        let cost: f64 = spec
+            .quantities
+            .iter()
+            .map(|&q| F::cost(scene, m, largest, q))
+            .sum();
+        if cost.is_nan() || cost > MAX_JOB_EVALUATIONS {
+            return Err(SpecError::at(
+                "budgets",
+                format!(
+                    "a job of rules[{i}] ({}) at budget {largest} costs about {cost:.1e} integrand \
+                     evaluations: expected at most {MAX_JOB_EVALUATIONS:.0e} per job (lower the \
+                     budget, or run with --no-cost-limit to go ahead)",
+                    m.label()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The longest experiment name: it names a folder, and file systems refuse

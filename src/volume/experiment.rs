@@ -372,6 +372,40 @@ impl Family for Volume {
         1
     }
 
+    /// Per smooth piece (graded at optical depths 1, 2, 4, ...: about
+    /// `1 + log2 D` pieces for a depth bound `D`), `n` nodes, times `n` more
+    /// where an integral nests in each node: the nested depth scheme (V-E,
+    /// V-L), shadow rays by quadrature (V-L). A tracker's walks cost about
+    /// `1 + D` density lookups each.
+    fn cost(
+        built: &Built,
+        method: &Method<Tracker>,
+        budget: usize,
+        quantity: VolumeQuantity,
+    ) -> f64 {
+        use VolumeQuantity::*;
+        let (_, depth) = built.scene.anchored().0.depth_bound();
+        let n = budget as f64;
+        if let Method::Estimator(_) = method {
+            return n * (1.0 + depth);
+        }
+        let pieces = 1.0 + depth.max(1.0).log2();
+        let nested = built.scheme == DepthScheme::Nested;
+        let shadow = built.shadow == ShadowMethod::Quadrature;
+        let per_node = match quantity {
+            Tau | LnTau | Background => 1.0,
+            Emission => {
+                if nested {
+                    n
+                } else {
+                    1.0
+                }
+            }
+            Light | Total => (if nested { n } else { 1.0 }) + if shadow { n } else { 1.0 },
+        };
+        pieces * n * per_node
+    }
+
     /// Delta tracking estimates every term a renderer's walk scores
     /// ([`super::tracking::radiance`]); ratio and residual ratio tracking
     /// estimate transmittance only, so `tau` and `I_B = I_b tau`. None
