@@ -1242,3 +1242,39 @@ fn jobs_that_would_take_hours_are_refused_with_their_estimate() {
     let o = bin().arg("check").output().expect("runs");
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// A ray that misses the sphere: every density-driven term is 0 (tau = 1,
+/// I_B = I_b), which the closed-form reference used to refuse ("no closed
+/// form for this scene"; issue 10, item 5).
+#[test]
+fn a_ray_that_misses_the_medium_has_closed_forms() {
+    let text = VALID
+        .replace("[-3.0, 0.3, 0.0]", "[-3.0, 5.0, 0.0]")
+        .replace(
+            "\"emission\": { \"type\": \"constant\", \"c\": 1.0 }",
+            "\"emission\": { \"type\": \"constant\", \"c\": 1.0 }, \"background\": 0.5, \
+             \"light\": { \"toward_light\": [0, 1, 0], \"intensity\": 2.0 }",
+        )
+        .replace(
+            "[\"tau\", \"I_E\"]",
+            "[\"tau\", \"I_E\", \"I_L\", \"I_B\", \"I\"]",
+        )
+        .replace(
+            "\"equations\": [\"V-tau\", \"V-E\"]",
+            "\"equations\": [\"V-I\"]",
+        );
+    let (dir, out, o) = run_text("miss", &text);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+    for (q, v) in [
+        ("tau", "1.0"),
+        ("I_E", "0.0"),
+        ("I_L", "0.0"),
+        ("I_B", "5.0"),
+        ("I", "5.0"),
+    ] {
+        let want = format!("## {q} (reference {v}");
+        assert!(report.contains(&want), "{want}: {report}");
+    }
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -740,6 +740,12 @@ fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
             }),
         _ => None,
     };
+    // A ray that misses the medium: the density-driven terms (emission by a
+    // map of the density, single scattering) are 0 along it.
+    let missed = scene
+        .medium
+        .as_ref()
+        .is_some_and(|m| m.support(&ray, scene.t_min, scene.t_max).is_empty());
     let emission = || -> Option<f64> {
         let Some(map) = &scene.emission else {
             return Some(0.0);
@@ -766,7 +772,7 @@ fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
             let absorbs = chord(scene.medium.as_deref()?)?;
             return Some(exact::emission_field_interval(sigma, absorbs, c, emits));
         }
-        if scene.medium.is_none() {
+        if scene.medium.is_none() || missed {
             return Some(0.0);
         }
         let (sigma, chord, _) = sphere?;
@@ -779,7 +785,7 @@ fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
         let Some(light) = scene.light else {
             return Some(0.0);
         };
-        if scene.medium.is_none() {
+        if scene.medium.is_none() || missed {
             return Some(0.0);
         }
         let (sigma, chord, whole) = sphere?;
