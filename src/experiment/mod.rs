@@ -162,35 +162,56 @@ fn load_all(registry: &Registry, files: &[Source]) -> Result<Vec<Input>, RunErro
     Ok(out)
 }
 
-/// Holds `<out>/.lightquad.lock` (one per shard for `run --shard`, which may
-/// share a folder) locked for as long as the run writes there: a second run
+/// Holds `<out>/.lightquad.lock` locked for as long as the run writes there
+/// (`run --shard` runs share it, each holding its shard's own lock alone, so
+/// shards may share a folder but a whole run or a merge may not join them): a second run
 /// into the same folder stops at once with an error instead of replacing the
 /// first's results file while the first keeps appending to the replaced one
 /// (528 jobs reported, 76 lines left). The lock is advisory and released by
 /// the operating system when the process ends, also after `kill -9`.
-fn lock_output(out: &Path, shard: Option<(usize, usize)>) -> Result<fs::File, RunError> {
-    let name = match shard {
-        None => ".lightquad.lock".to_string(),
-        Some((k, n)) => format!(".lightquad.shard-{k}-of-{n}.lock"),
+fn lock_output(out: &Path, shard: Option<(usize, usize)>) -> Result<Vec<fs::File>, RunError> {
+    let open = |name: String| {
+        let path = out.join(name);
+        fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .map(|f| (f, path.clone()))
+            .map_err(|e| io(&path, e))
     };
-    let path = out.join(name);
-    let file = fs::OpenOptions::new()
-        .create(true)
-        .truncate(false)
-        .write(true)
-        .open(&path)
-        .map_err(|e| io(&path, e))?;
-    match file.try_lock() {
-        Ok(()) => Ok(file),
-        Err(fs::TryLockError::WouldBlock) => Err(io(
+    let busy = |path: &Path| {
+        io(
             out,
             format!(
                 "another lightquad run or merge is writing into this folder (it holds {}): \
                  wait for it to finish or give another --out",
                 path.display()
             ),
-        )),
-        Err(fs::TryLockError::Error(e)) => Err(io(&path, format!("cannot lock: {e}"))),
+        )
+    };
+    let take = |(file, path): (fs::File, PathBuf), shared: bool| {
+        let got = if shared {
+            file.try_lock_shared()
+        } else {
+            file.try_lock()
+        };
+        match got {
+            Ok(()) => Ok(file),
+            Err(fs::TryLockError::WouldBlock) => Err(busy(&path)),
+            Err(fs::TryLockError::Error(e)) => Err(io(&path, format!("cannot lock: {e}"))),
+        }
+    };
+    // Shards share the folder lock (with each other, never with a whole run
+    // or a merge) and hold their own shard's lock alone.
+    let folder = open(".lightquad.lock".into())?;
+    match shard {
+        None => Ok(vec![take(folder, false)?]),
+        Some((k, n)) => {
+            let whole = take(folder, true)?;
+            let own = take(open(format!(".lightquad.shard-{k}-of-{n}.lock"))?, false)?;
+            Ok(vec![whole, own])
+        }
     }
 }
 
@@ -328,6 +349,39 @@ fn write_reports(
 /// the same or copied folders) into one results file and report per experiment.
 pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
     let mut by_name: BTreeMap<String, (Box<dyn Loaded>, Vec<JobResult>)> = BTreeMap::new();
+    // Shards still writing into an input would be merged half done.
+    let mut reading = Vec::new();
+    for input in inputs {
+        let shard_locks = fs::read_dir(input)
+            .map_err(|e| io(input, e))?
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| {
+                p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with(".lightquad.shard-"))
+            });
+        for lock in std::iter::once(input.join(".lightquad.lock")).chain(shard_locks) {
+            let Ok(file) = fs::File::open(&lock) else {
+                continue;
+            };
+            match file.try_lock_shared() {
+                Ok(()) => reading.push(file),
+                Err(fs::TryLockError::WouldBlock) => {
+                    return Err(io(
+                        input,
+                        format!(
+                            "a lightquad run is still writing into this folder (it holds {}): \
+                             merge it once the run has finished",
+                            lock.display()
+                        ),
+                    ));
+                }
+                Err(fs::TryLockError::Error(e)) => {
+                    return Err(io(&lock, format!("cannot lock: {e}")));
+                }
+            }
+        }
+    }
     for input in inputs {
         let mut dirs: Vec<PathBuf> = fs::read_dir(input)
             .map_err(|e| io(input, e))?
@@ -353,6 +407,8 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
         });
     }
     writable(out)?;
+    // The inputs have been read; `out` may be one of them.
+    drop(reading);
     let _lock = lock_output(out, None)?;
     let mut missing = Vec::new();
     let mut done = Vec::new();

@@ -237,9 +237,19 @@ fn row(
     }
     let count = measured.len() as f64;
     let channels = reference.len();
-    let value = (0..channels)
-        .map(|c| measured.iter().map(|m| channel(&m.value, c)).sum::<f64>() / count)
+    // Each value divided before the sum, so values near 1.8e308 average
+    // without overflow.
+    let value: Vec<f64> = (0..channels)
+        .map(|c| {
+            measured
+                .iter()
+                .map(|m| channel(&m.value, c) / count)
+                .sum::<f64>()
+        })
         .collect();
+    if value.iter().any(|v| !v.is_finite()) && !flags.contains(&RowFlag::NonFinite) {
+        flags.push(RowFlag::NonFinite);
+    }
     // True error: the root mean square over repeats and channels.
     let diffs = measured.iter().flat_map(|m| {
         (0..channels.max(m.value.len())).map(|c| channel(&m.value, c) - channel(reference, c))
@@ -247,9 +257,8 @@ fn row(
     let rel_error = rms(diffs.collect::<Vec<_>>().into_iter()) / scale;
     let rel_estimate = measured
         .iter()
-        .map(|m| rms(m.error.iter().copied()))
+        .map(|m| rms(m.error.iter().copied()) / count)
         .sum::<f64>()
-        / count
         / scale;
     let evaluations = measured.iter().map(|m| m.evaluations as f64).sum::<f64>() / count;
     if let Some(flag) = judge_estimate(&measured, reference, rel_error, rel_estimate, random) {

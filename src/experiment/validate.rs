@@ -226,7 +226,7 @@ fn check_cost<F: Family>(
                 format!(
                     "a job of rules[{i}] ({}) at budget {largest} costs about {cost:.1e} integrand \
                      evaluations: expected at most {MAX_JOB_EVALUATIONS:.0e} per job (lower the \
-                     budget, or run with --no-cost-limit to go ahead)",
+                     budget, or pass --no-cost-limit to check and run to go ahead)",
                     m.label()
                 ),
             ));

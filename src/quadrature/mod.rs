@@ -172,7 +172,12 @@ pub trait Rule {
             largest = largest.max(y.max_abs());
             Ok(y)
         })?;
-        if sound(&first) {
+        // An infinite error is a rule's "no estimate", unless the values are
+        // large enough for its squares to have overflowed (a Monte Carlo
+        // standard error of values near 1e308).
+        let overflowed_error = largest > 2f64.powi(500)
+            && (0..V::CHANNELS).any(|c| first.error.channel(c).is_infinite());
+        if sound(&first) && !overflowed_error {
             return Ok(first);
         }
         // 2^e >= largest |f|, so every scaled value is at most 1 in size.
