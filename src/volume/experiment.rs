@@ -321,9 +321,10 @@ impl Family for Volume {
             return Err(SpecError::at(
                 path,
                 format!(
-                    "the optical depth along the ray overflows f64 (lambda = {:e} times \
-                     the largest density, {sigma:e}, times the chord is {depth:e}): expected \
-                     a medium and a lambda whose optical depth along the ray stays below 1.8e308",
+                    "the optical depth along the ray overflows f64 (lambda = {:e}; the largest \
+                     extinction lambda v is {sigma:e}, and times the chord it bounds the depth \
+                     by {depth:e}): expected a medium and a lambda whose optical depth along the \
+                     ray stays below 1.8e308",
                     scene.lambda
                 ),
             ));
