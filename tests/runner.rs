@@ -1212,7 +1212,7 @@ fn long_names_and_files_that_are_not_regular_are_refused() {
         "{ \"type\": \"closed-form\" }",
         "{ \"type\": \"mitsuba\", \"file\": \"/dev/zero\" }",
     );
-    rejected(&zero, "reference.file", "no Mitsuba values file");
+    rejected(&zero, "reference.file", "/dev/zero (not a regular file");
     let dir = scratch("fifo");
     let fifo = dir.join("f.json");
     let made = Command::new("mkfifo").arg(&fifo).status();

@@ -163,8 +163,12 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
     let mut places: Vec<(String, Option<String>)> = Vec::new();
     if let Origin::Folder(dir) = origin {
         if let Some(file) = named {
+            // The file the experiment names: why it cannot be read is said.
             let path = resolve(dir, file);
-            places.push((path.display().to_string(), read_text(&path).ok()));
+            places.push(match read_text(&path) {
+                Ok(text) => (path.display().to_string(), Some(text)),
+                Err(why) => (format!("{} ({why})", path.display()), None),
+            });
         }
         let path = dir
             .join("..")
