@@ -76,7 +76,7 @@ const JS: &str = r#"
   }
   function num(s) {
     var m = /^[+-]?(\d+\.?\d*|\.\d+)(e[+-]?\d+)?/i.exec(s.replace(/\u2212/g, '-'));
-    return m ? parseFloat(m[0]) : NaN;
+    return m ? parseFloat(m[0]) : null;
   }
   document.querySelectorAll('table.sortable').forEach(function (table) {
     var heads = table.tHead ? table.tHead.rows[0].cells : [];
@@ -87,8 +87,8 @@ const JS: &str = r#"
         var rows = Array.prototype.slice.call(body.rows);
         var keys = rows.map(function (r) { return r.cells[col] ? key(r.cells[col]) : ''; });
         var nums = keys.map(num);
-        var numeric = nums.some(function (x) { return !isNaN(x); }) &&
-          keys.every(function (k, i) { return !isNaN(nums[i]) || !/\d/.test(k) || /^(not|below|rms)/.test(k); });
+        var numeric = nums.some(function (x) { return x !== null; }) &&
+          keys.every(function (k, i) { return nums[i] !== null || !/\d/.test(k) || /^(not|below|rms)/.test(k); });
         var dir = th.classList.contains('asc') ? -1 : 1;
         Array.prototype.forEach.call(heads, function (h) { h.classList.remove('asc', 'desc'); });
         th.classList.add(dir === 1 ? 'asc' : 'desc');
@@ -96,9 +96,9 @@ const JS: &str = r#"
         order.sort(function (a, b) {
           if (numeric) {
             var x = nums[a], y = nums[b];
-            if (isNaN(x) && isNaN(y)) return keys[a].localeCompare(keys[b]) || a - b;
-            if (isNaN(x)) return 1;
-            if (isNaN(y)) return -1;
+            if (x === null && y === null) return keys[a].localeCompare(keys[b]) || a - b;
+            if (x === null) return 1;
+            if (y === null) return -1;
             return dir * (x - y) || a - b;
           }
           var blankA = keys[a] === '' || keys[a] === '\u2014', blankB = keys[b] === '' || keys[b] === '\u2014';

@@ -348,7 +348,7 @@ pub const FIT_ROWS: usize = 4;
 /// floor and ten times the reference's own accuracy (`floor`); None below
 /// three such rows.
 pub fn order(rows: &[&Row], against: Against, floor: f64) -> Option<f64> {
-    order_and_scatter(rows, against, floor).map(|(o, _)| o)
+    order_and_scatter(rows, against, floor).map(|(o, _, _)| o)
 }
 
 /// Errors further than this factor from the fitted line: the slope is shown
@@ -357,8 +357,9 @@ pub fn order(rows: &[&Row], against: Against, floor: f64) -> Option<f64> {
 pub const ERRATIC: f64 = 2.0;
 
 /// [`order`] with the largest factor by which a fitted point lies off the
-/// line ([`super::fit::fitted_line`]).
-pub fn order_and_scatter(rows: &[&Row], against: Against, floor: f64) -> Option<(f64, f64)> {
+/// line ([`super::fit::fitted_line`]), and whether the error grew by more
+/// than 1.5x from one fitted point to the next.
+pub fn order_and_scatter(rows: &[&Row], against: Against, floor: f64) -> Option<(f64, f64, bool)> {
     let mut pts: Vec<(f64, f64)> = rows
         .iter()
         .filter(|r| r.rel_error > (100.0 * FLOOR).max(10.0 * floor))
@@ -379,8 +380,9 @@ pub fn order_and_scatter(rows: &[&Row], against: Against, floor: f64) -> Option<
         return None;
     }
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let tail = pts.len().saturating_sub(FIT_ROWS);
-    fitted_line(&pts[tail..])
+    let tail = &pts[pts.len().saturating_sub(FIT_ROWS)..];
+    let grew = tail.windows(2).any(|w| w[1].1 > 1.5 * w[0].1);
+    fitted_line(tail).map(|(slope, off)| (slope, off, grew))
 }
 
 /// The least median time among rows whose error meets `target`.
@@ -731,32 +733,22 @@ fn orders_and_plots(
         // A deterministic rule whose error grows with the budget inside the
         // fitted rows (a kink that moves between nodes) has no order either.
         let deterministic = !page.rules.get(i).is_some_and(|r| r.is_random);
-        let grew = deterministic && {
-            let fitted: Vec<f64> = mine
-                .iter()
-                .filter(|r| r.rel_error > (100.0 * FLOOR).max(10.0 * accuracy))
-                .map(|r| r.rel_error)
-                .collect();
-            let tail = &fitted[fitted.len().saturating_sub(FIT_ROWS)..];
-            tail.windows(2).any(|w| w[1] > 1.5 * w[0])
+        let limit = if deterministic {
+            ERRATIC
+        } else {
+            2.0 * ERRATIC
         };
         let slope = |against| match order_and_scatter(&mine, against, accuracy) {
             None => "—".into(),
-            Some((o, off))
-                if off
-                    > if deterministic {
-                        ERRATIC
-                    } else {
-                        2.0 * ERRATIC
-                    }
-                    || grew =>
-            {
-                format!(
-                    "{o:.2} (erratic: errors up to {off:.1}x off the line{}, not an order)",
-                    if grew { ", growing with n" } else { "" }
-                )
-            }
-            Some((o, _)) => format!("{o:.2}"),
+            Some((o, off, grew)) if off > limit || (deterministic && grew) => format!(
+                "{o:.2} (erratic: errors up to {off:.1}x off the line{}, not an order)",
+                if deterministic && grew {
+                    ", growing with n"
+                } else {
+                    ""
+                }
+            ),
+            Some((o, _, _)) => format!("{o:.2}"),
         };
         fits.push(Fit {
             label: label.clone(),

@@ -142,9 +142,9 @@ pub trait Rule {
 
     /// Estimates `int_{[0,1]^D} f(u) du` with a budget of about `n` evaluations,
     /// for an integrand that may fail: its first error stops the rule and is
-    /// returned as is. `n` above [`MAX_BUDGET`] is an error. A rule's sums, differences and squares of finite values
-    /// near the top of the f64 range can overflow into an infinite or NaN
-    /// estimate; then the integral is taken again of `f 2^-e`, with `2^e` the
+    /// returned as is. `n` above [`MAX_BUDGET`] is an error. A rule's sums,
+    /// differences and squares of finite values near the top of the f64 range
+    /// can overflow into an infinite or NaN estimate; then the integral is taken again of `f 2^-e`, with `2^e` the
     /// largest `|f|` seen (an exact scaling), and scaled back. An estimate that
     /// is still not finite is an error ([`QuadError::Overflow`]), never a
     /// silent NaN. The second pass's evaluations are counted.
@@ -251,15 +251,7 @@ pub fn per_axis<const D: usize>(n: usize, min: usize, name: &str) -> Result<usiz
             format!("a budget of at least {need} evaluations in {D} dimension(s)"),
         ));
     }
-    let mut m = (n as f64).powf(1.0 / D as f64).round() as usize;
-    // Correct the floating-point root to the exact integer root.
-    while m > 1 && m.checked_pow(D as u32).is_none_or(|p| p > n) {
-        m -= 1;
-    }
-    while (m + 1).checked_pow(D as u32).is_some_and(|p| p <= n) {
-        m += 1;
-    }
-    Ok(m.max(min))
+    Ok(integer_root(n, D).max(min))
 }
 
 /// Declares the rule modules and generates [`BaseRule`], its dispatch and the
