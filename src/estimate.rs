@@ -144,8 +144,8 @@ impl<V: Value> Estimate<V> {
 /// `t_dof(0.975) / 1.96`: the factor that turns `+- 1.96` standard errors
 /// estimated with `dof` degrees of freedom into the two-sided 95% Student-t
 /// interval (1.312 at 5, 1.087 at 15, 1.0001 at 10^4, 0.99998 in the
-/// normal limit); infinite for
-/// `dof <= 0`, where there is no estimate of the spread.
+/// normal limit); infinite for `dof <= 0`, where there is no estimate of
+/// the spread.
 pub fn t95_factor(dof: f64) -> f64 {
     use statrs::distribution::{ContinuousCDF, StudentsT};
     /// The normal quantile `z_0.975`.
@@ -163,10 +163,31 @@ pub fn t95_factor(dof: f64) -> f64 {
             + Z * (5.0 * z2 * z2 + 16.0 * z2 + 3.0) / (96.0 * nu * nu);
         return t / 1.96;
     }
-    match StudentsT::new(0.0, 1.0, dof) {
+    let exact = |nu: f64| match StudentsT::new(0.0, 1.0, nu) {
         Ok(t) => t.inverse_cdf(0.975) / 1.96,
         Err(_) => f64::INFINITY,
+    };
+    // Whole degrees of freedom up to TABLED from a table made once: the
+    // inversion costs about 1.3 us, as much as a small rule's whole work,
+    // and every random estimate asks for it. A fractional count (the
+    // Welch-Satterthwaite estimate) below 10 is computed; from 10 on it is
+    // interpolated linearly in 1/dof, in which the quantile is nearly linear
+    // (within 3.4e-5 relative, measured on a 0.05 grid from 1 to 1000).
+    const TABLED: usize = 1024;
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    if (1.0..=TABLED as f64).contains(&dof) {
+        let table = TABLE.get_or_init(|| (0..=TABLED).map(|k| exact(k as f64)).collect());
+        let k = dof.floor() as usize;
+        if k == TABLED || dof == k as f64 {
+            return table[k];
+        }
+        if k < 10 {
+            return exact(dof);
+        }
+        let w = (1.0 / k as f64 - 1.0 / dof) / (1.0 / k as f64 - 1.0 / (k + 1) as f64);
+        return table[k] + w * (table[k + 1] - table[k]);
     }
+    exact(dof)
 }
 
 #[cfg(test)]
@@ -191,6 +212,15 @@ mod tests {
         let (below, above) = (t95_factor(1e4), t95_factor(1e4 * (1.0 + 1e-9)));
         assert!((below - above).abs() < 1e-11, "{below} vs {above}");
         assert!((t95_factor(1e12) * 1.96 - 1.959_963_985).abs() < 1e-9);
+        // Fractional counts between the tabled whole ones.
+        for dof in [1.5, 7.25, 12.5, 333.3] {
+            use statrs::distribution::{ContinuousCDF, StudentsT};
+            let Ok(t) = StudentsT::new(0.0, 1.0, dof) else {
+                panic!("dof {dof} > 0")
+            };
+            let direct = t.inverse_cdf(0.975) / 1.96;
+            assert!((t95_factor(dof) / direct - 1.0).abs() < 5e-5, "dof {dof}");
+        }
         assert_eq!(t95_factor(0.0), f64::INFINITY);
         assert_eq!(t95_factor(f64::NAN), f64::INFINITY);
     }
