@@ -32,6 +32,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::{QuadError, SpecError};
+use crate::experiment::tagged::below;
 use crate::quadrature::{AnyRule, BaseRule, Product, Rule};
 
 /// A quantity a family computes (`tau`, `I_L`, a pixel image, ...).
@@ -182,9 +183,36 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
         // do not track paths below the tag, so a rule's parameters are read
         // by [`BaseRule::from_json`] and an estimator's at the estimator.
         if E::all().iter().any(|e| e.name() == tag) {
-            serde_json::from_value(value)
-                .map(Method::Estimator)
-                .map_err(D::Error::custom)
+            let estimator: E = serde_json::from_value(value.clone()).map_err(D::Error::custom)?;
+            // serde ignores unknown fields beside an internally tagged unit
+            // variant (`{"rule": "delta-tracking", "n": 3}` read as plain
+            // delta tracking), so every field given must be one the
+            // estimator writes back.
+            let known = serde_json::to_value(&estimator).map_err(D::Error::custom)?;
+            let unknown = value
+                .as_object()
+                .into_iter()
+                .flatten()
+                .map(|(k, _)| k)
+                .find(|k| known.get(k.as_str()).is_none());
+            match unknown {
+                None => Ok(Method::Estimator(estimator)),
+                Some(k) => {
+                    let fields: Vec<String> = known
+                        .as_object()
+                        .into_iter()
+                        .flatten()
+                        .map(|(k, _)| format!("`{k}`"))
+                        .collect();
+                    Err(below(
+                        k,
+                        &format!(
+                            "unknown field `{k}` of the estimator `{tag}`: expected only {}",
+                            fields.join(", ")
+                        ),
+                    ))
+                }
+            }
         } else if tag == "product" {
             product(&value).map(Method::Rule)
         } else if names.contains(&tag) {
@@ -199,20 +227,6 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
         }
     }
 }
-
-/// An error at `path` below the current one (none: at it).
-fn below<Er: serde::de::Error>(path: &str, message: &str) -> Er {
-    if path.is_empty() {
-        Er::custom(message)
-    } else {
-        Er::custom(format!("{SUB_PATH}{path}`: {message}"))
-    }
-}
-
-/// Marks the start of a path below the current one in an error message
-/// (`at `.outer`: ...`), which [`crate::experiment::validate`] moves into the
-/// error's JSON path.
-pub const SUB_PATH: &str = "at `.";
 
 /// `{"rule": "product", "outer": {..}, "inner": {..}}`, a fault in a factor
 /// reported below it (`.outer.rel_tol`).

@@ -103,7 +103,7 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
     rejected(
         &VALID.replace("\"repeats\": 2", "\"repeats\": \"two\""),
         "repeats",
-        "expected usize",
+        "invalid type: string \"two\", expected a whole number",
     );
     rejected(
         &VALID.replace("\"quantities\": [\"tau\", \"I_E\"],", ""),
@@ -178,8 +178,8 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
     );
     rejected(
         &VALID.replace("\"kappa\": 2.0", "\"kappa\": 2.0, \"sigma\": 1"),
-        "scene.medium",
-        "unknown field `sigma`",
+        "scene.medium.sigma",
+        "unknown field `sigma`, expected one of `centre`, `radius`, `kappa`",
     );
     rejected(
         &VALID.replace("[1.0, 0.0, 0.0] }", "[0.0, 0.0, 0.0] }"),
@@ -716,7 +716,7 @@ fn faults_inside_rules_and_references_are_named_where_they_are() {
             "{ \"rule\": \"gauss-kronrod\", \"rel_tol\": \"1e-3\" }",
         ),
         "rules[1].rel_tol",
-        "invalid type: string \"1e-3\", expected f64",
+        "invalid type: string \"1e-3\", expected a number",
     );
     rejected(
         &VALID.replace(
@@ -1077,15 +1077,125 @@ fn a_fault_inside_budgets_names_its_path() {
     rejected(
         &with("{ \"from\": 4, \"to\": 64, \"factor\": \"NaN\" }"),
         "budgets.factor",
-        "expected f64",
+        "invalid type: string \"NaN\", expected a number",
     );
-    rejected(&with("[4, \"x\", 16]"), "budgets[1]", "expected i64");
+    rejected(
+        &with("[4, \"x\", 16]"),
+        "budgets[1]",
+        "invalid type: string \"x\", expected a whole number",
+    );
     rejected(
         &with("{ \"from\": 4, \"to\": 64, \"factor\": 2, \"step\": 1 }"),
         "budgets.step",
         "unknown field",
     );
     rejected(&with("\"many\""), "budgets", "a list of budgets");
+}
+
+/// A fault inside an internally tagged object (a medium, an emission, a
+/// reference, a tracking estimator) names its own path, the value and what
+/// is accepted: serde's tagged enums reported `scene.medium` for
+/// `"kappa": "2.6"`, fixed-size lists said "expected fewer elements", number
+/// types were named as Rust types ("expected f64"), and an unknown field
+/// beside a tracking estimator was silently ignored.
+#[test]
+fn a_fault_inside_a_tagged_object_names_its_own_path() {
+    let medium = |m: &str| {
+        VALID.replace(
+            "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
+            m,
+        )
+    };
+    rejected(
+        &VALID.replace("\"kappa\": 2.0", "\"kappa\": \"2.6\""),
+        "scene.medium.kappa",
+        "invalid type: string \"2.6\", expected a number",
+    );
+    rejected(
+        &medium(
+            "{ \"type\": \"gaussian-blobs\", \"blobs\": [ { \"centre\": [0, 0, 0], \"amplitude\": 1, \"width\": 1 }, { \"centre\": [0, 0, 0], \"amplitude\": 1, \"width\": \"w\" } ] }",
+        ),
+        "scene.medium.blobs[1].width",
+        "expected a number",
+    );
+    rejected(
+        &medium("{ \"type\": \"cube\" }"),
+        "scene.medium.type",
+        "unknown variant \"cube\": expected one of `constant-sphere`, `gaussian-blobs`, `linear-gradient`, `voxel-grid`",
+    );
+    rejected(
+        &medium("{ \"radius\": 1 }"),
+        "scene.medium",
+        "missing field `type`: expected one of `constant-sphere`",
+    );
+    rejected(
+        &VALID.replace(
+            "\"direction\": [1.0, 0.0, 0.0]",
+            "\"direction\": [1.0, 0.0, 0.0, 0.0]",
+        ),
+        "scene.ray.direction",
+        "a list of 4 elements: expected exactly 3",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"constant\", \"c\": 1.0 }",
+            "{ \"type\": \"field\", \"field\": { \"type\": \"constant-sphere\", \"centre\": [0, 0, 0], \"radius\": 1, \"kappa\": [1] } }",
+        ),
+        "scene.emission.field.kappa",
+        "invalid type: sequence, expected a number",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"constant\", \"c\": 1.0 }",
+            "{ \"type\": \"table\", \"points\": [[0, 0], [1, 2, 3]] }",
+        ),
+        "scene.emission.points[1]",
+        "a list of 3 elements: expected exactly 2",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"value\", \"values\": { \"tau\": 0.5, \"I_E\": \"x\" } }",
+        ),
+        "reference.values.I_E",
+        "expected a number, or a list of numbers",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"value\", \"values\": { \"tau\": 0.5, \"I_X\": 1 } }",
+        ),
+        "reference.values.I_X",
+        "unknown variant `I_X`, expected one of `tau`",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"closed-form\", \"n\": 4 }",
+        ),
+        "reference.n",
+        "unknown field `n`",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"delta-tracking\", \"n\": 3 }",
+        ),
+        "rules[1].n",
+        "unknown field `n` of the estimator `delta-tracking`: expected only `rule`",
+    ); // An audit point named twice, or an empty list of them, is a slip.
+    let printed = |list: &str| {
+        VALID.replace(
+            "\"emission\": { \"type\": \"constant\", \"c\": 1.0 }",
+            &format!("\"emission\": {{ \"type\": \"constant\", \"c\": 1.0 }}, \"light\": {{ \"toward_light\": [0, 1, 0], \"intensity\": 1 }}, \"printed\": {list}"),
+        )
+    };
+    rejected(
+        &printed("[\"s\", \"s\"]"),
+        "scene.printed[1]",
+        "\"s\" is named twice",
+    );
+    rejected(&printed("[]"), "scene.printed", "an empty list");
 }
 
 /// Delta tracking with an emission field of its own is refused when the

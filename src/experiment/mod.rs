@@ -42,6 +42,7 @@ pub mod report;
 pub mod run;
 pub mod source;
 pub mod spec;
+pub mod tagged;
 pub mod validate;
 
 use std::collections::{BTreeMap, BTreeSet};

@@ -6,7 +6,9 @@
 use std::collections::BTreeMap;
 
 use super::source::{Origin, Values, find_values};
-use super::spec::{ExperimentSpec, ReferenceSpec};
+use super::spec::{
+    ConvergedReference, ExperimentSpec, MitsubaReference, ReferenceSpec, ValueReference,
+};
 use super::validate::{Experiment, literal_values};
 use crate::error::SpecError;
 use crate::family::{Family, Measured, Quantity};
@@ -55,10 +57,10 @@ pub fn known_values<F: Family>(
 ) -> Result<Option<Known<F::Quantity>>, SpecError> {
     Ok(Some(match &spec.reference {
         ReferenceSpec::ClosedForm {} => closed_forms(spec, scene)?,
-        ReferenceSpec::Value {
+        ReferenceSpec::Value(ValueReference {
             values,
             uncertainty,
-        } => {
+        }) => {
             if !(uncertainty.is_finite() && *uncertainty >= 0.0) {
                 return Err(SpecError::at(
                     "reference.uncertainty",
@@ -71,7 +73,7 @@ pub fn known_values<F: Family>(
                 note: format!("literal values, uncertainty {uncertainty:e}."),
             }
         }
-        ReferenceSpec::Mitsuba { file } => {
+        ReferenceSpec::Mitsuba(MitsubaReference { file }) => {
             // The harness writes one number per quantity.
             if let Some(q) = spec
                 .quantities
@@ -112,7 +114,7 @@ pub fn known_values<F: Family>(
                 }
             }
         }
-        ReferenceSpec::Converged { n } => {
+        ReferenceSpec::Converged(ConvergedReference { n }) => {
             if !(2..=100_000).contains(n) {
                 return Err(SpecError::at(
                     "reference.n",
@@ -277,7 +279,7 @@ pub fn rms(xs: impl Iterator<Item = f64> + Clone) -> f64 {
 
 /// The reference of a run.
 pub fn reference<F: Family>(exp: &Experiment<F>) -> Reference {
-    if let ReferenceSpec::Converged { n } = exp.spec.reference {
+    if let ReferenceSpec::Converged(ConvergedReference { n }) = exp.spec.reference {
         return converged_reference(exp, n);
     }
     let Some(known) = &exp.known else {
@@ -467,7 +469,7 @@ pub struct Crosscheck {
 /// scalars).
 pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
     let named = match &exp.spec.reference {
-        ReferenceSpec::Mitsuba { file } => Some(file.as_str()),
+        ReferenceSpec::Mitsuba(MitsubaReference { file }) => Some(file.as_str()),
         _ => None,
     };
     let (json, note) = match find_values(&exp.origin, &exp.spec.name, &exp.hash, named) {

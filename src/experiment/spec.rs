@@ -105,43 +105,78 @@ impl Literal {
     }
 }
 
-/// The reference values errors are measured against.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+/// The reference values errors are measured against: `{"type": <name>,
+/// <the variant's fields>}`.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 #[serde(
     tag = "type",
     rename_all = "kebab-case",
-    deny_unknown_fields,
-    bound(
-        serialize = "Q: Serialize + Ord",
-        deserialize = "Q: Deserialize<'de> + Ord"
-    )
+    bound(serialize = "Q: Serialize + Ord")
 )]
 pub enum ReferenceSpec<Q> {
     /// The family's closed forms (an error at validation when a quantity has none).
     ClosedForm {},
     /// Literal values per quantity, with their uncertainty.
-    Value {
-        /// Value per quantity name.
-        values: BTreeMap<Q, Literal>,
-        /// Absolute uncertainty (default 0).
-        #[serde(default)]
-        uncertainty: f64,
-    },
+    Value(ValueReference<Q>),
     /// Values written by the Mitsuba 3 harness (`reference/`), e.g.
     /// `../reference/values/<name>.json` for a file in `experiments/`; stale
     /// files (another experiment hash) are rejected.
-    Mitsuba {
-        /// Path of the values file, relative to the experiment file's folder.
-        file: String,
-    },
+    Mitsuba(MitsubaReference),
     /// The family's converged deterministic evaluation at `n` nodes per
     /// piece, checked against `2n`.
-    Converged {
-        /// Nodes per smooth piece (default 400).
-        #[serde(default = "four_hundred")]
-        #[schemars(range(min = 2, max = 100_000))]
-        n: usize,
-    },
+    Converged(ConvergedReference),
+}
+
+/// Reads the tag, then the variant's fields, so that a fault inside names
+/// its own path (`reference.values.tau`; see [`tagged`](super::tagged)).
+impl<'de, Q: serde::de::DeserializeOwned + Ord> Deserialize<'de> for ReferenceSpec<Q> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use super::tagged::{NoFields, split_tag, variant};
+        const NAMES: [&str; 4] = ["closed-form", "value", "mitsuba", "converged"];
+        let (tag, fields) = split_tag(serde_json::Value::deserialize(d)?, "type", &NAMES)?;
+        match tag.as_str() {
+            "closed-form" => variant::<NoFields, _>(fields).map(|_| ReferenceSpec::ClosedForm {}),
+            "value" => variant(fields).map(ReferenceSpec::Value),
+            "mitsuba" => variant(fields).map(ReferenceSpec::Mitsuba),
+            _ => variant(fields).map(ReferenceSpec::Converged),
+        }
+    }
+}
+
+/// Literal values per quantity, with their uncertainty.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(
+    deny_unknown_fields,
+    bound(
+        serialize = "Q: Serialize + Ord",
+        deserialize = "Q: serde::de::DeserializeOwned + Ord"
+    )
+)]
+pub struct ValueReference<Q> {
+    /// Value per quantity name.
+    #[serde(deserialize_with = "super::tagged::keyed")]
+    pub values: BTreeMap<Q, Literal>,
+    /// Absolute uncertainty (default 0).
+    #[serde(default)]
+    pub uncertainty: f64,
+}
+
+/// Values written by the Mitsuba 3 harness.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct MitsubaReference {
+    /// Path of the values file, relative to the experiment file's folder.
+    pub file: String,
+}
+
+/// The family's converged deterministic evaluation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConvergedReference {
+    /// Nodes per smooth piece (default 400).
+    #[serde(default = "four_hundred")]
+    #[schemars(range(min = 2, max = 100_000))]
+    pub n: usize,
 }
 
 fn four_hundred() -> usize {

@@ -107,16 +107,8 @@ impl<'de> serde::de::Visitor<'de> for StrictVisitor {
 
 /// A serde error at its JSON path (`.` for the root).
 fn path_error<E: std::fmt::Display>(e: serde_path_to_error::Error<E>) -> SpecError {
-    let mut path = e.path().to_string();
-    let mut message = e.inner().to_string();
-    // A path below the one serde tracked, named at the start of the message.
-    if let Some((below, rest)) = message
-        .strip_prefix(crate::family::SUB_PATH)
-        .and_then(|m| m.split_once("`: "))
-    {
-        path = format!("{path}.{below}");
-        message = rest.to_string();
-    }
+    let (path, message) = super::tagged::located(&e.path().to_string(), &e.inner().to_string());
+    let message = super::tagged::plain_words(&message);
     SpecError::at(if path.is_empty() { ".".into() } else { path }, message)
 }
 

@@ -19,6 +19,7 @@ use crate::domain::Vec3;
 use crate::error::{QuadError, SpecError};
 use crate::estimate::Estimate;
 use crate::exact::volume as exact;
+use crate::experiment::tagged;
 use crate::family::{self, Family, Flag, Measured, Method, Outcome};
 use crate::geometry::Ray;
 use crate::quadrature::GaussKronrod;
@@ -63,7 +64,7 @@ pub struct SceneSpec {
     /// Audit points of docs/EQUATIONS.md whose printed forms the report
     /// evaluates in this scene beside the corrected ones (constant sphere
     /// only; `s` and `exponent` need a light, `background` a background).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "tagged::non_empty")]
     pub printed: Vec<Printed>,
 }
 
@@ -72,51 +73,99 @@ pub struct SceneSpec {
 #[serde(deny_unknown_fields)]
 pub struct RaySpec {
     /// `e`.
+    #[serde(deserialize_with = "tagged::array")]
     pub origin: [f64; 3],
     /// `v` (normalised; t is arc length).
+    #[serde(deserialize_with = "tagged::array")]
     pub direction: [f64; 3],
 }
 
-/// A medium.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+/// A medium: `{"type": <name>, <the variant's fields>}`.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+#[serde(tag = "type", rename_all = "kebab-case")]
 pub enum MediumSpec {
     /// Constant density `kappa` in a sphere.
-    ConstantSphere {
-        /// Centre.
-        centre: [f64; 3],
-        /// Radius.
-        radius: f64,
-        /// Density.
-        kappa: f64,
-    },
+    ConstantSphere(ConstantSphereSpec),
     /// A sum of Gaussian blobs.
-    GaussianBlobs {
-        /// The blobs.
-        blobs: Vec<BlobSpec>,
-    },
+    GaussianBlobs(GaussianBlobsSpec),
     /// `max(0, base + gradient . (x - centre))` inside a sphere.
-    LinearGradient {
-        /// Centre of the bounding sphere.
-        centre: [f64; 3],
-        /// Its radius.
-        radius: f64,
-        /// Density at the centre.
-        base: f64,
-        /// Gradient.
-        gradient: [f64; 3],
-    },
+    LinearGradient(LinearGradientSpec),
     /// A voxel grid (values at voxel centres, trilinear, `[z][y][x]`).
-    VoxelGrid {
-        /// Lower corner.
-        min: [f64; 3],
-        /// Upper corner.
-        max: [f64; 3],
-        /// Voxels per axis.
-        resolution: [usize; 3],
-        /// Densities, x fastest.
-        data: Vec<f64>,
-    },
+    VoxelGrid(VoxelGridSpec),
+}
+
+/// Reads the tag, then the variant's fields, so that a fault inside names
+/// its own path (`scene.medium.kappa`; see [`tagged`]).
+impl<'de> Deserialize<'de> for MediumSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        const NAMES: [&str; 4] = [
+            "constant-sphere",
+            "gaussian-blobs",
+            "linear-gradient",
+            "voxel-grid",
+        ];
+        let (tag, fields) = tagged::split_tag(serde_json::Value::deserialize(d)?, "type", &NAMES)?;
+        match tag.as_str() {
+            "constant-sphere" => tagged::variant(fields).map(MediumSpec::ConstantSphere),
+            "gaussian-blobs" => tagged::variant(fields).map(MediumSpec::GaussianBlobs),
+            "linear-gradient" => tagged::variant(fields).map(MediumSpec::LinearGradient),
+            _ => tagged::variant(fields).map(MediumSpec::VoxelGrid),
+        }
+    }
+}
+
+/// Constant density `kappa` in a sphere.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantSphereSpec {
+    /// Centre.
+    #[serde(deserialize_with = "tagged::array")]
+    pub centre: [f64; 3],
+    /// Radius.
+    pub radius: f64,
+    /// Density.
+    pub kappa: f64,
+}
+
+/// A sum of Gaussian blobs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GaussianBlobsSpec {
+    /// The blobs.
+    pub blobs: Vec<BlobSpec>,
+}
+
+/// `max(0, base + gradient . (x - centre))` inside a sphere.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LinearGradientSpec {
+    /// Centre of the bounding sphere.
+    #[serde(deserialize_with = "tagged::array")]
+    pub centre: [f64; 3],
+    /// Its radius.
+    pub radius: f64,
+    /// Density at the centre.
+    pub base: f64,
+    /// Gradient.
+    #[serde(deserialize_with = "tagged::array")]
+    pub gradient: [f64; 3],
+}
+
+/// A voxel grid (values at voxel centres, trilinear, `[z][y][x]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct VoxelGridSpec {
+    /// Lower corner.
+    #[serde(deserialize_with = "tagged::array")]
+    pub min: [f64; 3],
+    /// Upper corner.
+    #[serde(deserialize_with = "tagged::array")]
+    pub max: [f64; 3],
+    /// Voxels per axis.
+    #[serde(deserialize_with = "tagged::array")]
+    pub resolution: [usize; 3],
+    /// Densities, x fastest.
+    pub data: Vec<f64>,
 }
 
 /// One Gaussian blob.
@@ -124,6 +173,7 @@ pub enum MediumSpec {
 #[serde(deny_unknown_fields)]
 pub struct BlobSpec {
     /// Centre.
+    #[serde(deserialize_with = "tagged::array")]
     pub centre: [f64; 3],
     /// Peak density.
     pub amplitude: f64,
@@ -131,37 +181,73 @@ pub struct BlobSpec {
     pub width: f64,
 }
 
-/// The emission of V-E: a map `c(v)` of the density, or a field of its own.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+/// The emission of V-E: a map `c(v)` of the density, or a field of its own;
+/// `{"type": <name>, <the variant's fields>}`.
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
+#[serde(tag = "type", rename_all = "kebab-case")]
 pub enum EmissionSpec {
     /// `c(v) = c` inside the medium (where the density is positive).
-    Constant {
-        /// The constant.
-        c: f64,
-    },
+    Constant(ConstantEmissionSpec),
     /// `c(v) = k v`.
-    Proportional {
-        /// The factor.
-        k: f64,
-    },
-    /// A transfer function: `c(v)` piecewise linear through `points`
-    /// `[[v0, c0], [v1, c1], ..]` (at least 2; `v` at least 0 and strictly
-    /// increasing; `c` finite, at least 0), held at `c0` below `v0` and at the
-    /// last `c` above the last `v`, and 0 where the density is 0 (a medium
-    /// emits where its density is positive).
-    Table {
-        /// The points `[v, c]`.
-        points: Vec<[f64; 2]>,
-    },
-    /// An emission field of its own, `Le(p)`, independent of the density:
-    /// `I_E = int tau(t_0, t) Le(r(t)) dt`, also where the density is 0.
-    Field {
-        /// The field's shape and values, written as a medium (`Le` is its
-        /// density): `constant-sphere`, `gaussian-blobs`, `linear-gradient`
-        /// or `voxel-grid`.
-        field: MediumSpec,
-    },
+    Proportional(ProportionalEmissionSpec),
+    /// A transfer function `c(v)`, piecewise linear.
+    Table(TableEmissionSpec),
+    /// An emission field of its own, `Le(p)`, independent of the density.
+    Field(FieldEmissionSpec),
+}
+
+/// Reads the tag, then the variant's fields (see [`MediumSpec`]'s reader).
+impl<'de> Deserialize<'de> for EmissionSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        const NAMES: [&str; 4] = ["constant", "proportional", "table", "field"];
+        let (tag, fields) = tagged::split_tag(serde_json::Value::deserialize(d)?, "type", &NAMES)?;
+        match tag.as_str() {
+            "constant" => tagged::variant(fields).map(EmissionSpec::Constant),
+            "proportional" => tagged::variant(fields).map(EmissionSpec::Proportional),
+            "table" => tagged::variant(fields).map(EmissionSpec::Table),
+            _ => tagged::variant(fields).map(EmissionSpec::Field),
+        }
+    }
+}
+
+/// `c(v) = c` inside the medium (where the density is positive).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantEmissionSpec {
+    /// The constant.
+    pub c: f64,
+}
+
+/// `c(v) = k v`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ProportionalEmissionSpec {
+    /// The factor.
+    pub k: f64,
+}
+
+/// A transfer function: `c(v)` piecewise linear through `points`
+/// `[[v0, c0], [v1, c1], ..]` (at least 2; `v` at least 0 and strictly
+/// increasing; `c` finite, at least 0), held at `c0` below `v0` and at the
+/// last `c` above the last `v`, and 0 where the density is 0 (a medium
+/// emits where its density is positive).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TableEmissionSpec {
+    /// The points `[v, c]`.
+    #[serde(deserialize_with = "tagged::arrays")]
+    pub points: Vec<[f64; 2]>,
+}
+
+/// An emission field of its own, `Le(p)`, independent of the density:
+/// `I_E = int tau(t_0, t) Le(r(t)) dt`, also where the density is 0.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct FieldEmissionSpec {
+    /// The field's shape and values, written as a medium (`Le` is its
+    /// density): `constant-sphere`, `gaussian-blobs`, `linear-gradient`
+    /// or `voxel-grid`.
+    pub field: MediumSpec,
 }
 
 /// A directional light.
@@ -169,6 +255,7 @@ pub enum EmissionSpec {
 #[serde(deny_unknown_fields)]
 pub struct LightSpec {
     /// Direction from a point toward the light.
+    #[serde(deserialize_with = "tagged::array")]
     pub toward_light: [f64; 3],
     /// Intensity `I_p`.
     pub intensity: f64,
@@ -340,14 +427,14 @@ impl Family for Volume {
                 ShadowSpec::Quadrature => ShadowMethod::Quadrature,
             },
             sphere_kappa: match spec.medium {
-                Some(MediumSpec::ConstantSphere { kappa, .. }) => Some(kappa),
+                Some(MediumSpec::ConstantSphere(ConstantSphereSpec { kappa, .. })) => Some(kappa),
                 _ => None,
             },
             printed: printed_forms(spec)?,
             field_sphere_value: match &spec.emission {
-                Some(EmissionSpec::Field {
-                    field: MediumSpec::ConstantSphere { kappa, .. },
-                }) => Some(*kappa),
+                Some(EmissionSpec::Field(FieldEmissionSpec {
+                    field: MediumSpec::ConstantSphere(ConstantSphereSpec { kappa, .. }),
+                })) => Some(*kappa),
                 _ => None,
             },
         })
@@ -852,15 +939,15 @@ fn non_negative(path: &str, x: f64) -> Result<f64, SpecError> {
 /// The medium (or emission field) of `spec`, errors anchored at `at`.
 fn medium(spec: &MediumSpec, at: &str) -> Result<Arc<dyn Medium>, SpecError> {
     Ok(match spec {
-        MediumSpec::ConstantSphere {
+        MediumSpec::ConstantSphere(ConstantSphereSpec {
             centre,
             radius,
             kappa,
-        } => Arc::new(
+        }) => Arc::new(
             ConstantSphere::new(vec3(*centre), *radius, *kappa)
                 .map_err(|e| SpecError::from_quad(at, e))?,
         ),
-        MediumSpec::GaussianBlobs { blobs } => Arc::new(
+        MediumSpec::GaussianBlobs(GaussianBlobsSpec { blobs }) => Arc::new(
             GaussianBlobs::new(
                 blobs
                     .iter()
@@ -873,21 +960,21 @@ fn medium(spec: &MediumSpec, at: &str) -> Result<Arc<dyn Medium>, SpecError> {
             )
             .map_err(|e| SpecError::from_quad(at, e))?,
         ),
-        MediumSpec::LinearGradient {
+        MediumSpec::LinearGradient(LinearGradientSpec {
             centre,
             radius,
             base,
             gradient,
-        } => Arc::new(
+        }) => Arc::new(
             LinearGradient::new(vec3(*centre), *radius, *base, vec3(*gradient))
                 .map_err(|e| SpecError::from_quad(at, e))?,
         ),
-        MediumSpec::VoxelGrid {
+        MediumSpec::VoxelGrid(VoxelGridSpec {
             min,
             max,
             resolution,
             data,
-        } => Arc::new(
+        }) => Arc::new(
             VoxelGrid::new(vec3(*min), vec3(*max), *resolution, data.clone())
                 .map_err(|e| SpecError::from_quad(at, e))?,
         ),
@@ -900,11 +987,11 @@ fn printed_forms(spec: &SceneSpec) -> Result<Option<(printed::Sphere, Vec<Printe
     if spec.printed.is_empty() {
         return Ok(None);
     }
-    let Some(MediumSpec::ConstantSphere {
+    let Some(MediumSpec::ConstantSphere(ConstantSphereSpec {
         centre,
         radius,
         kappa,
-    }) = spec.medium
+    })) = spec.medium
     else {
         return Err(SpecError::at(
             "scene.printed",
@@ -914,6 +1001,13 @@ fn printed_forms(spec: &SceneSpec) -> Result<Option<(printed::Sphere, Vec<Printe
         ));
     };
     for (i, p) in spec.printed.iter().enumerate() {
+        let name = serde_json::to_string(p).unwrap_or_default();
+        if spec.printed[..i].contains(p) {
+            return Err(SpecError::at(
+                format!("scene.printed[{i}]"),
+                format!("{name} is named twice: name each audit point once"),
+            ));
+        }
         let missing = match p {
             Printed::S | Printed::Exponent if spec.light.is_none() => Some("a light"),
             Printed::Background if spec.background.is_none() => Some("a background"),
@@ -923,7 +1017,7 @@ fn printed_forms(spec: &SceneSpec) -> Result<Option<(printed::Sphere, Vec<Printe
             return Err(SpecError::at(
                 format!("scene.printed[{i}]"),
                 format!(
-                    "{p:?} is a printed form of a term the scene does not have: give it {what}"
+                    "{name} is a printed form of a term the scene does not have: give it {what}"
                 ),
             ));
         }
@@ -972,18 +1066,17 @@ fn scene(s: &SceneSpec) -> Result<VolumeScene, SpecError> {
         None => None,
         // Emitted radiance is not negative (absorption belongs to sigma), as
         // for a table's values.
-        Some(EmissionSpec::Constant { c }) => {
+        Some(EmissionSpec::Constant(ConstantEmissionSpec { c })) => {
             Some(EmissionMap::Constant(non_negative("scene.emission.c", *c)?))
         }
-        Some(EmissionSpec::Proportional { k }) => Some(EmissionMap::Proportional(non_negative(
-            "scene.emission.k",
-            *k,
-        )?)),
-        Some(EmissionSpec::Table { points }) => Some(EmissionMap::Table(
+        Some(EmissionSpec::Proportional(ProportionalEmissionSpec { k })) => Some(
+            EmissionMap::Proportional(non_negative("scene.emission.k", *k)?),
+        ),
+        Some(EmissionSpec::Table(TableEmissionSpec { points })) => Some(EmissionMap::Table(
             TransferTable::new(points.iter().map(|p| (p[0], p[1])).collect())
                 .map_err(|e| SpecError::from_quad("scene.emission", e))?,
         )),
-        Some(EmissionSpec::Field { field }) => {
+        Some(EmissionSpec::Field(FieldEmissionSpec { field })) => {
             Some(EmissionMap::Field(medium(field, "scene.emission.field")?))
         }
     };
