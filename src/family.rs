@@ -448,6 +448,24 @@ pub trait Family: Sized + Send + Sync + 'static {
         budget as f64
     }
 
+    /// About how many bytes one job of `quantity` with `method` at `budget`
+    /// holds at once, to refuse before running what would exhaust the
+    /// machine ([`crate::experiment::validate::MAX_JOB_BYTES`]): the rule's
+    /// own [`Rule::memory`] in the quantity's dimension by default; a family
+    /// that holds several node tables at once (an inner rule per outer
+    /// node) says so here.
+    fn memory(
+        scene: &Self::Scene,
+        method: &Method<Self::Estimator>,
+        budget: usize,
+        quantity: Self::Quantity,
+    ) -> f64 {
+        match method {
+            Method::Rule(r) => r.memory(budget, Self::dimension(scene, quantity)),
+            Method::Estimator(_) => 0.0,
+        }
+    }
+
     /// Evaluates `quantities` with `method` at `budget`, drawing randomness from
     /// `rng` only.
     fn evaluate(

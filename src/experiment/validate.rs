@@ -183,6 +183,12 @@ pub fn min_budget<F: Family>(
 /// evaluation. `run --no-cost-limit` lifts it ([`lift_cost_limit`]).
 pub const MAX_JOB_EVALUATIONS: f64 = 1e11;
 
+/// The most bytes one job may hold by its family's estimate
+/// ([`Family::memory`]): 4 GiB, so that the default of one job per core fits
+/// a machine of 8 GiB a core (Gauss–Legendre at 1e8 nodes needs about 5.6
+/// GB). `--no-cost-limit` lifts it too.
+pub const MAX_JOB_BYTES: f64 = 4.0 * (1u64 << 30) as f64;
+
 static COST_LIMIT_LIFTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// Lets experiments whose jobs cost more than [`MAX_JOB_EVALUATIONS`] through
@@ -220,6 +226,24 @@ fn check_cost<F: Family>(
                      evaluations: expected at most {MAX_JOB_EVALUATIONS:.0e} per job (lower the \
                      budget, or pass --no-cost-limit to check and run to go ahead)",
                     m.label()
+                ),
+            ));
+        }
+        let bytes = spec
+            .quantities
+            .iter()
+            .map(|&q| F::memory(scene, m, largest, q))
+            .fold(0.0, f64::max);
+        if bytes.is_nan() || bytes > MAX_JOB_BYTES {
+            return Err(SpecError::at(
+                "budgets",
+                format!(
+                    "a job of rules[{i}] ({}) at budget {largest} needs about {:.1} GB of memory: \
+                     expected at most {:.1} GB per job (lower the budget, or pass --no-cost-limit \
+                     to check and run to go ahead)",
+                    m.label(),
+                    bytes / 1e9,
+                    MAX_JOB_BYTES / 1e9
                 ),
             ));
         }

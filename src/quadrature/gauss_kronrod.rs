@@ -245,6 +245,12 @@ impl Rule for GaussKronrod {
         Dimensions { min: 1, max: 1 }
     }
 
+    /// The list of pieces, one per 30 evaluations: 8 bytes an evaluation
+    /// bounds it (4.5 measured at 1e7 evaluations, 45 MB).
+    fn memory(&self, n: usize, _dim: usize) -> f64 {
+        8.0 * n as f64
+    }
+
     fn check(&self) -> Result<(), QuadError> {
         for (name, tol) in [("abs_tol", self.abs_tol), ("rel_tol", self.rel_tol)] {
             if !(tol.is_finite() && tol >= 0.0) {

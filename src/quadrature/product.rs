@@ -16,7 +16,7 @@ use rand::SeedableRng;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::{Dimensions, Rule, per_axis};
+use super::{Dimensions, Rule, integer_root, per_axis};
 use crate::error::QuadError;
 use crate::estimate::{ErrorKind, Estimate};
 use crate::value::Value;
@@ -102,6 +102,12 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
 
     fn dimensions(&self) -> Dimensions {
         Dimensions { min: 2, max: 2 }
+    }
+
+    /// Both factors' memory at their `floor(sqrt(n))` nodes each.
+    fn memory(&self, n: usize, _dim: usize) -> f64 {
+        let m = integer_root(n, 2);
+        self.outer.memory(m, 1) + self.inner.memory(m, 1)
     }
 
     fn check(&self) -> Result<(), QuadError> {

@@ -494,6 +494,27 @@ impl Family for Volume {
         pieces * n * per_node
     }
 
+    /// The rule's node table, and a second one of the same size under the
+    /// nested scheme (the inner optical depth's rule beside the outer one).
+    fn memory(
+        built: &Built,
+        method: &Method<Tracker>,
+        budget: usize,
+        quantity: VolumeQuantity,
+    ) -> f64 {
+        use VolumeQuantity::*;
+        let Method::Rule(rule) = method else {
+            return 0.0;
+        };
+        let nested =
+            built.scheme == DepthScheme::Nested || built.shadow == ShadowMethod::Quadrature;
+        let tables = match quantity {
+            Emission | Light | Total if nested => 2.0,
+            _ => 1.0,
+        };
+        tables * crate::quadrature::Rule::memory(rule, budget, 1)
+    }
+
     /// Delta tracking estimates every term a renderer's walk scores
     /// ([`super::tracking::radiance`]); ratio and residual ratio tracking
     /// estimate transmittance only, so `tau` and `I_B = I_b tau`. None

@@ -30,7 +30,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::nodes::{UnitNodes, product_sum};
-use super::{Rule, per_axis};
+use super::{Rule, integer_root, per_axis};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
@@ -396,6 +396,13 @@ impl Rule for GaussLegendre {
 
     fn about(&self) -> &'static str {
         "Gauss–Legendre of any order 1..=1e8 (product rule in D > 1); error estimate from the tail of Q_m - Q_(m-1), Q_(m-1) - Q_(m-2), checked against Q_m - Q_(m/2) from m = 16"
+    }
+
+    /// The m-node table per axis and the companion rule's beside it while
+    /// the estimate is computed: 56 bytes a node, from 552 MB of peak
+    /// resident memory measured at m = 1e7.
+    fn memory(&self, n: usize, dim: usize) -> f64 {
+        56.0 * integer_root(n, dim) as f64
     }
 
     fn integrate_unguarded<

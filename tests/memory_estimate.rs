@@ -1,0 +1,110 @@
+//! The memory a job holds, estimated before it runs (`Rule::memory`, issue
+//! 10 item 4: Gauss–Legendre at 1e8 nodes took 5 GB per job), against the
+//! peak resident memory the operating system measured for the real binary
+//! running that job, and the refusal of a budget past the limit.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use lightquad::quadrature::{GaussLegendre, Rule, Trapezoid};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lightquad"))
+}
+
+/// A one-job experiment: tau through the constant sphere with `rule` at `n`.
+fn experiment(rule: &str, n: usize) -> String {
+    format!(
+        r#"{{"name": "m", "family": "volume", "equations": ["V-tau"],
+  "scene": {{ "ray": {{ "origin": [-3.0, 0.3, 0.0], "direction": [1.0, 0.0, 0.0] }},
+    "medium": {{ "type": "constant-sphere", "centre": [0, 0, 0], "radius": 1.0, "kappa": 2.0 }} }},
+  "quantities": ["tau"], "rules": [{{ "rule": "{rule}" }}], "budgets": [{n}], "repeats": 1,
+  "reference": {{ "type": "closed-form" }} }}"#
+    )
+}
+
+fn scratch(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lightquad-mem-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch");
+    dir
+}
+
+/// Runs the job in a child process and returns the largest peak resident
+/// memory of any child waited for so far, in bytes (`getrusage`).
+#[cfg(target_os = "linux")]
+fn run_and_measure(rule: &str, n: usize) -> f64 {
+    let dir = scratch(&format!("{rule}-{n}"));
+    let file = dir.join("e.json");
+    std::fs::write(&file, experiment(rule, n)).expect("write");
+    let o = bin()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .args(["--threads", "1"])
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+    // SAFETY: getrusage writes one rusage struct, which lives on our stack.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    let rc = unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) };
+    assert_eq!(rc, 0, "getrusage failed");
+    usage.ru_maxrss as f64 * 1024.0
+}
+
+/// The estimates of the two rules whose tables grow with n are within a
+/// factor 1.5 of the peak memory measured (above the binary's own baseline,
+/// measured on a job of 16 nodes). Children run in increasing order of
+/// memory, since the measure is the largest child so far.
+#[cfg(target_os = "linux")]
+#[test]
+fn memory_estimates_match_the_measured_peak() {
+    let baseline = run_and_measure("trapezoid", 16);
+    let n = 4_000_000;
+    for (rule, estimate) in [
+        ("trapezoid", Trapezoid.memory(n, 1)),
+        ("gauss-legendre", GaussLegendre::default().memory(n, 1)),
+    ] {
+        let measured = run_and_measure(rule, n) - baseline;
+        let ratio = estimate / measured;
+        eprintln!(
+            "{rule} n = {n}: estimate {estimate:.3e} B, measured {measured:.3e} B, ratio {ratio:.2}"
+        );
+        assert!(
+            (1.0 / 1.5..=1.5).contains(&ratio),
+            "{rule} at n = {n}: estimate {estimate:.3e} B, measured {measured:.3e} B above a \
+             baseline of {baseline:.3e} B (ratio {ratio:.2})"
+        );
+    }
+}
+
+/// Gauss–Legendre at 1e8 nodes is refused at `check` with its memory
+/// estimate and the flag that lifts the limit; at 1e6 it passes.
+#[test]
+fn a_job_that_would_exhaust_memory_is_refused_with_its_estimate() {
+    let dir = scratch("refuse");
+    let file = dir.join("e.json");
+    std::fs::write(&file, experiment("gauss-legendre", 100_000_000)).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    let msg = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!o.status.success(), "accepted: {msg}");
+    for want in [
+        "at `budgets`",
+        "needs about 5.6 GB of memory",
+        "--no-cost-limit",
+    ] {
+        assert!(msg.contains(want), "no `{want}` in {msg}");
+    }
+    let o = bin()
+        .args(["check", "--no-cost-limit"])
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::write(&file, experiment("gauss-legendre", 1_000_000)).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}
