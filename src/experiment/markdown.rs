@@ -20,6 +20,39 @@ pub fn escape(s: &str) -> String {
     out
 }
 
+/// Text from a user's file (an experiment's description) as Markdown that
+/// renders as that text: every character Markdown gives a meaning to
+/// (emphasis, code, links, raw HTML, headings, tables, lists) is
+/// backslash-escaped, and paragraphs (blank lines) are kept.
+pub fn plain(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for (i, line) in s.lines().enumerate() {
+        if i > 0 {
+            out.push('\n');
+        }
+        let line = line.trim_start();
+        // A list marker opens a line: `-`, `+`, or digits then `.` or `)`.
+        let digits = line.len() - line.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+        let marker = if digits > 0 {
+            matches!(line[digits..].chars().next(), Some('.' | ')')).then_some(digits)
+        } else {
+            matches!(line.chars().next(), Some('-' | '+')).then_some(0)
+        };
+        for (j, c) in line.char_indices() {
+            if Some(j) == marker
+                || matches!(
+                    c,
+                    '\\' | '`' | '*' | '_' | '[' | ']' | '<' | '>' | '#' | '|' | '~'
+                )
+            {
+                out.push('\\');
+            }
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// One line of Markdown text as HTML: code spans and bold, the rest escaped.
 pub fn inline(s: &str) -> String {
     let mut out = String::new();
@@ -170,6 +203,17 @@ mod tests {
         assert!(html.contains("<code>x&lt;y</code>"), "{html}");
         assert!(html.contains("<strong>bold</strong>"), "{html}");
         assert!(!html.contains("<script>"), "{html}");
+    }
+
+    #[test]
+    fn plain_text_keeps_its_characters() {
+        let md = plain(
+            "A *star* | <b>x</b> `c`\n\n# not a heading\n- not a list, 1.5 V-E\n12. nor this",
+        );
+        assert_eq!(
+            md,
+            "A \\*star\\* \\| \\<b\\>x\\</b\\> \\`c\\`\n\n\\# not a heading\n\\- not a list, 1.5 V-E\n12\\. nor this"
+        );
     }
 
     #[test]

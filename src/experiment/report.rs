@@ -595,7 +595,12 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
 /// The page's title, settings, reference and provenance.
 fn header(page: &Page, results: &[JobResult]) -> String {
     let mut md = String::new();
-    let _ = writeln!(md, "# {}\n\n{}\n", page.name, page.description);
+    let _ = writeln!(
+        md,
+        "# {}\n\n{}\n",
+        page.name,
+        super::markdown::plain(page.description)
+    );
     let settings = if page.settings.is_empty() {
         String::new()
     } else {
@@ -886,7 +891,11 @@ pub fn write_index(
         "Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (1e-6 unless the experiment says otherwise); `not reached` means no budget got there.\n\n",
     );
     for (name, description, summary) in entries {
-        let _ = writeln!(md, "## [{name}]({name}/report.md)\n\n{description}\n");
+        let _ = writeln!(
+            md,
+            "## [{name}]({name}/report.md)\n\n{}\n",
+            super::markdown::plain(description)
+        );
         for (q, ranking) in summary {
             let list: Vec<String> = ranked(ranking)
                 .iter()
