@@ -327,13 +327,20 @@ fn names<F: Family>(exp: &Experiment<F>, why: &str) -> BTreeMap<String, String> 
         .collect()
 }
 
+/// The tightest relative change the converged reference asks for: the
+/// evaluation's own rounding (sums of thousands of terms, each with a
+/// relative error near 1e-16) leaves changes near 1e-14, so a goal below
+/// this would never be met; errors under it are flagged as at the
+/// reference's accuracy, and the note says when the floor was used.
+pub const CONVERGED_FLOOR: f64 = 1e-13;
+
 /// Doublings of `n` the converged reference may take past the spec's `n`.
 const MAX_DOUBLINGS: u32 = 6;
 
 /// The converged reference: the family's converged evaluation at `n`, `2n`,
 /// `4n`, ... nodes per piece until every quantity's relative change from one
 /// to the next is at most `goal` (a hundredth of the tightest target, but not
-/// below 1e-13) or `n` has doubled [`MAX_DOUBLINGS`] times. Each quantity
+/// below [`CONVERGED_FLOOR`]) or `n` has doubled [`MAX_DOUBLINGS`] times. Each quantity
 /// keeps the finest value and, as its accuracy, its own last change; one that
 /// did not get below the goal is named in the note. A quantity the family
 /// could not compute, or whose value is not finite, has no reference.
@@ -344,7 +351,7 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
         .iter()
         .copied()
         .fold(f64::INFINITY, f64::min);
-    let goal = (tightest / 100.0).max(1e-13);
+    let goal = (tightest / 100.0).max(CONVERGED_FLOOR);
     let failed = |e: String| {
         let why = format!("the converged evaluation failed: {e}");
         Reference {
@@ -418,11 +425,19 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
         .filter(|(_, c)| c.is_nan() || **c > goal)
         .map(|(q, c)| format!("{q} ({c:.1e})"))
         .collect();
+    let floor = if goal == CONVERGED_FLOOR {
+        format!(
+            " (the goal: a hundredth of the tightest target, {tightest:.0e}, but not below \
+             {CONVERGED_FLOOR:.0e}, the evaluation's own rounding)"
+        )
+    } else {
+        String::new()
+    };
     let verdict = if unconverged.is_empty() {
-        format!("every quantity converged to {goal:.0e} or better")
+        format!("every quantity converged to {goal:.0e} or better{floor}")
     } else {
         format!(
-            "NOT converged to {goal:.0e}: {}; errors below that are not resolved",
+            "NOT converged to {goal:.0e}{floor}: {}; errors below that are not resolved",
             unconverged.join(", ")
         )
     };

@@ -70,12 +70,19 @@ pub fn markdown() -> String {
     let Ok(medium) = ConstantSphere::new(Vec3::zeros(), r, 1.0) else {
         return out;
     };
-    for p in [
-        Vec3::new(0.1, 0.2, 0.3),
-        Vec3::new(-1.0, 0.5, 0.2),
-        Vec3::new(0.0, 0.0, 1.4),
-        d * 0.5,
+    // Three points off the line through the centre along d, and one on it
+    // (named as the multiple of d it is: its rounded coordinates are not on
+    // the line, and the printed forms are undefined there).
+    for (p, label) in [
+        (Vec3::new(0.1, 0.2, 0.3), None),
+        (Vec3::new(-1.0, 0.5, 0.2), None),
+        (Vec3::new(0.0, 0.0, 1.4), None),
+        (d * 0.5, Some("0.5 d, on the line through the centre")),
     ] {
+        let point = match label {
+            None => format!("({:.2}, {:.2}, {:.2})", p.x, p.y, p.z),
+            Some(l) => format!("{l}: ({:?}, {:?}, {:?})", p.x, p.y, p.z),
+        };
         let s_quad = Ray::new(p, d).ok().and_then(|ray| {
             let rule = AnyRule::by_name("gauss-legendre").ok()?;
             let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
@@ -99,10 +106,7 @@ pub fn markdown() -> String {
             }
         };
         out.push_str(&format!(
-            "| ({:.2}, {:.2}, {:.2}) | {} | {:.15} | {} | {} | {:.15} |\n",
-            p.x,
-            p.y,
-            p.z,
+            "| {point} | {} | {:.15} | {} | {} | {:.15} |\n",
             printed(s_printed(p, d)),
             s_corrected(p, d, r),
             s_quad.map_or("failed".into(), |s| format!("{s:.15}")),
