@@ -15,8 +15,8 @@ use super::markdown::{escape, inline, to_html};
 use super::plot;
 use super::reference::{Crosscheck, crosscheck_markdown};
 use super::report::{
-    EXACT_FROM_START, FLAG_LEGEND, Page, Row, RowFlag, SHARED, Section, Summary, cell, label,
-    provenance, ranked, show_value, skipped,
+    EXACT_FROM_START, FLAG_LEGEND, Page, Row, RowFlag, SHARED, Section, Summary, TIED, cell, label,
+    provenance, ranked, ranks, show_value, skipped,
 };
 use super::run::{JobResult, write_atomic};
 
@@ -541,18 +541,28 @@ pub fn write_index(
         let fastest: Vec<String> = summary
             .iter()
             .map(|(q, ranking)| {
-                let best = ranked(ranking)
-                    .into_iter()
-                    .next()
-                    .filter(|r| r.seconds.is_some());
-                match best {
-                    Some(r) => format!(
-                        "{}: <span class=\"sw\" style=\"background:{}\"></span>{}",
+                // The first, and any tied with it within timing noise.
+                let ranking = ranked(ranking);
+                let best: Vec<String> = ranking
+                    .iter()
+                    .zip(ranks(&ranking))
+                    .filter(|(r, rank)| *rank == 1 && r.seconds.is_some())
+                    .map(|(r, _)| {
+                        format!(
+                            "<span class=\"sw\" style=\"background:{}\"></span>{}",
+                            plot::rule_css(&r.label),
+                            escape(&r.label)
+                        )
+                    })
+                    .collect();
+                match best.len() {
+                    0 => format!("{}: none reached", escape(q)),
+                    1 => format!("{}: {}", escape(q), best[0]),
+                    _ => format!(
+                        "{}: {} (tied within timing noise)",
                         escape(q),
-                        plot::rule_css(&r.label),
-                        escape(&r.label)
+                        best.join(" = ")
                     ),
-                    None => format!("{}: none reached", escape(q)),
                 }
             })
             .collect();
@@ -607,22 +617,29 @@ pub fn write_index(
         }
         b.push_str("<details><summary>as a table</summary><div class=\"scroll\"><table class=\"sortable\"><thead><tr><th>quantity</th><th class=\"num\">rank</th><th>rule</th><th class=\"num\">time to target (s)</th><th>note</th></tr></thead><tbody>");
         for (q, ranking) in summary {
-            for (i, r) in ranked(ranking).iter().enumerate() {
+            let ranking = ranked(ranking);
+            let ranks = ranks(&ranking);
+            for (i, r) in ranking.iter().enumerate() {
                 let time = r
                     .seconds
                     .map_or("not reached".to_string(), |t| format!("{t:.1e}"));
+                let tied = i > 0 && ranks[i] == ranks[i - 1];
+                let note: Vec<&str> = [(tied, TIED), (r.exact_from_start, EXACT_FROM_START)]
+                    .into_iter()
+                    .filter_map(|(on, text)| on.then_some(text))
+                    .collect();
                 let _ = write!(
                     b,
                     "<tr><td>{}</td><td class=\"num\">{}</td>{}{}<td>{}</td></tr>",
                     escape(q),
-                    i + 1,
+                    if tied {
+                        format!("={}", ranks[i])
+                    } else {
+                        ranks[i].to_string()
+                    },
                     rule_cell(&r.label),
                     num_cell(&time, r.seconds.unwrap_or(f64::NAN)),
-                    if r.exact_from_start {
-                        EXACT_FROM_START
-                    } else {
-                        ""
-                    }
+                    note.join("; ")
                 );
             }
         }

@@ -518,6 +518,31 @@ pub fn ranked(ranking: &[Ranked]) -> Vec<Ranked> {
     ranked
 }
 
+/// Times closer than this factor are ranked as a tie: two runs of the
+/// bundled suite on one machine swapped rules whose times differed by 2%
+/// (5.6e-7 s and 5.7e-7 s), and timings on a shared machine move by 10-20%.
+pub const TIE_FACTOR: f64 = 1.25;
+
+/// The rank of each rule in `ranked` (sorted by [`ranked`]): 1, 2, ...,
+/// with a rule whose time is within [`TIE_FACTOR`] of the one before it
+/// sharing that one's rank (a tie within timing noise). Rules that did not
+/// reach the target rank after all that did.
+pub fn ranks(ranked: &[Ranked]) -> Vec<usize> {
+    let mut out: Vec<usize> = Vec::with_capacity(ranked.len());
+    for (i, r) in ranked.iter().enumerate() {
+        let tied = i > 0
+            && matches!(
+                (ranked[i - 1].seconds, r.seconds),
+                (Some(a), Some(b)) if b <= a * TIE_FACTOR
+            );
+        out.push(if tied { out[i - 1] } else { i + 1 });
+    }
+    out
+}
+
+/// Said of a rule whose rank it shares with the one before.
+pub const TIED: &str = "tied: within 25% of the time of the rule before, timing noise";
+
 /// Said of a rule ranked while exact from its first budget.
 pub const EXACT_FROM_START: &str = "at the error floor from its first budget: this integrand is \
 easy for it, the rank says little in general";
@@ -897,14 +922,19 @@ pub fn write_index(
             super::markdown::plain(description)
         );
         for (q, ranking) in summary {
-            let list: Vec<String> = ranked(ranking)
+            let ranking = ranked(ranking);
+            let ranks = ranks(&ranking);
+            let list: Vec<String> = ranking
                 .iter()
-                .map(|r| {
-                    let exact = if r.exact_from_start {
-                        format!(", {EXACT_FROM_START}")
-                    } else {
-                        String::new()
-                    };
+                .enumerate()
+                .map(|(i, r)| {
+                    let mut exact = String::new();
+                    if i > 0 && ranks[i] == ranks[i - 1] {
+                        exact.push_str(&format!(", {TIED}"));
+                    }
+                    if r.exact_from_start {
+                        exact.push_str(&format!(", {EXACT_FROM_START}"));
+                    }
                     match r.seconds {
                         Some(t) => format!("{} ({t:.1e} s{exact})", r.label),
                         None => format!("{} (not reached{exact})", r.label),
@@ -930,4 +960,34 @@ pub fn write_index(
     }
     write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())?;
     super::html::write_index(out, entries, crosscheck, audits, problems)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rule(label: &str, seconds: Option<f64>) -> Ranked {
+        Ranked {
+            label: label.into(),
+            seconds,
+            exact_from_start: false,
+        }
+    }
+
+    /// Times within 25% of the one before share its rank; a gap of more
+    /// starts a new rank at the position; rules that did not reach the
+    /// target are never tied.
+    #[test]
+    fn times_within_timing_noise_share_a_rank() {
+        let r = ranked(&[
+            rule("d", None),
+            rule("c", Some(2.0e-6)),
+            rule("b", Some(5.7e-7)),
+            rule("a", Some(5.6e-7)),
+            rule("e", None),
+        ]);
+        let labels: Vec<&str> = r.iter().map(|x| x.label.as_str()).collect();
+        assert_eq!(labels, ["a", "b", "c", "d", "e"]);
+        assert_eq!(ranks(&r), [1, 1, 3, 4, 5]);
+    }
 }

@@ -124,7 +124,7 @@ where
 }
 
 /// Reads a list of fixed-length arrays (`[[v, c], ...]`), a list of the
-/// wrong length named at its index, as [`array`] does.
+/// wrong length named at its index, as [`array()`] does.
 pub fn arrays<'de, D, T, const N: usize>(d: D) -> Result<Vec<[T; N]>, D::Error>
 where
     D: serde::Deserializer<'de>,
