@@ -18,6 +18,27 @@
 //! Shirley and Chiu is only piecewise smooth (kinks on the diagonals): both cut
 //! Gauss–Legendre down to algebraic convergence. Monte Carlo rules, which do
 //! not care, pay for the non-uniform density with a larger variance.
+//!
+//! ```
+//! use std::f64::consts::PI;
+//! use lightquad::domain::{Disk, Domain, Vec3, integrate_over};
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! // A disk light of radius 2 at height 1, facing down. Its area pi R^2 is the
+//! // integral of the Jacobian 2 pi R^2 u_1, and the second moment
+//! // int r^2 dA = pi R^4 / 2 is a polynomial in u_1: 8 x 8 nodes are exact.
+//! let (c, radius) = (Vec3::new(0.0, 0.0, 1.0), 2.0);
+//! let disk = Disk::new(c, -Vec3::z(), radius)?;
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let gl = GaussLegendre::default();
+//! let area = integrate_over(&gl, &disk, 64, &mut rng, |_p: Vec3| 1.0)?;
+//! let moment = integrate_over(&gl, &disk, 64, &mut rng, |p: Vec3| (p - c).norm_squared())?;
+//! assert!((area.value - PI * radius * radius).abs() < 1e-13);
+//! assert!((area.value - disk.measure()).abs() < 1e-13);
+//! assert!((moment.value - PI * radius.powi(4) / 2.0).abs() < 1e-12);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use super::{
     Domain, Frame, Vec3, azimuth_fraction, frame_around, invert_slack, require_finite_vec3,

@@ -1,4 +1,20 @@
 //! An orthonormal frame: local coordinates with `z` along a given normal.
+//!
+//! ```
+//! use lightquad::domain::{Frame, Vec3};
+//!
+//! // A shading frame around a normal: z along it, x and y tangent to the surface.
+//! let normal = Vec3::new(1.0, 2.0, 2.0); // length 3
+//! let f = Frame::from_normal(normal)?;
+//! assert!((f.n - normal / 3.0).norm() < 1e-15);
+//! assert!(f.s.dot(&f.t).abs() < 1e-15 && f.s.dot(&f.n).abs() < 1e-15);
+//! assert!((f.s.cross(&f.t) - f.n).norm() < 1e-15); // right-handed
+//! // The normal has local coordinates (0, 0, |normal|), and to_world undoes to_local.
+//! assert!((f.to_local(normal) - Vec3::new(0.0, 0.0, 3.0)).norm() < 1e-14);
+//! let w = Vec3::new(-0.3, 0.4, 5.0);
+//! assert!((f.to_world(f.to_local(w)) - w).norm() < 1e-14);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use super::Vec3;
 use crate::error::QuadError;

@@ -1,5 +1,26 @@
 //! The hemisphere of directions around a normal, measured in solid angle (or,
 //! with [`HemisphereMap::Projected`], in projected solid angle `cos theta d omega`).
+//!
+//! ```
+//! use std::f64::consts::PI;
+//! use lightquad::domain::{Domain, Hemisphere, Vec3, integrate_over};
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let gl = GaussLegendre::default();
+//! // Uniform map: int cos^2 theta d omega = 2 pi / 3 (cos theta = u_1, a polynomial).
+//! let uniform = Hemisphere::uniform();
+//! assert!((uniform.measure() - 2.0 * PI).abs() < 1e-15);
+//! let est = integrate_over(&gl, &uniform, 16, &mut rng, |w: Vec3| w.z * w.z)?;
+//! assert!((est.value - 2.0 * PI / 3.0).abs() < 1e-13);
+//! // Projected solid angle: the irradiance of a uniform sky of radiance L,
+//! // E = int L cos theta d omega = pi L, with the cosine in the measure.
+//! let radiance = 0.7;
+//! let irradiance = integrate_over(&gl, &Hemisphere::projected(), 4, &mut rng, |_w: Vec3| radiance)?;
+//! assert!((irradiance.value - PI * radiance).abs() < 1e-14);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use super::{Domain, Frame, Vec3};
 use std::f64::consts::PI;

@@ -6,6 +6,22 @@
 //! (a regular grid of samples at cell centres) is the midpoint product rule,
 //! W-Corner (samples at the pixel corners, shared with the neighbours) the
 //! trapezoid rule.
+//!
+//! ```
+//! use lightquad::domain::{Domain, Pixel, integrate_over};
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! // Box-filtered supersampling of the image f(x, y) = x y over pixel (10, 20):
+//! // the pixel value is the mean of f over the pixel, 10.5 * 20.5 for this
+//! // bilinear f, which 2 x 2 Gauss–Legendre nodes reproduce exactly.
+//! let pixel = Pixel::new(10.0, 20.0, 1.0, 1.0)?;
+//! assert_eq!(pixel.centre(), [10.5, 20.5]);
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let est = integrate_over(&GaussLegendre::default(), &pixel, 4, &mut rng, |p: [f64; 2]| p[0] * p[1])?;
+//! assert!((est.value / pixel.measure() - 10.5 * 20.5).abs() < 1e-12);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use super::{Domain, invert_slack, snap_unit};
 use crate::error::{QuadError, require_finite, require_positive};

@@ -4,6 +4,22 @@
 //! `p(u) = o + u_1 e_1 + u_2 e_2`, `|J| = |e_1 x e_2|` (constant: the map is
 //! affine, so a rule sees the integrand itself, and Gauss–Legendre integrates
 //! polynomials in `p` exactly).
+//!
+//! ```
+//! use lightquad::domain::{Rectangle, Vec3, integrate_over};
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! // The quad [0, 2] x [0, 3] at z = 1: area 6, normal +z, and
+//! // int x y dA = (2^2 / 2) (3^2 / 2) = 9, exact with 2 x 2 nodes (affine map).
+//! let quad = Rectangle::new(Vec3::z(), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0))?;
+//! assert_eq!(quad.area(), 6.0);
+//! assert_eq!(quad.normal(), Vec3::z());
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let est = integrate_over(&GaussLegendre::default(), &quad, 4, &mut rng, |p: Vec3| p.x * p.y)?;
+//! assert!((est.value - 9.0).abs() < 1e-14);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use super::{Domain, Vec3, invert_slack, require_finite_vec3, snap_unit, within};
 use crate::error::QuadError;

@@ -1,5 +1,23 @@
 //! A ray segment `[a, b]` of the ray parameter, with optional break points
 //! (medium boundaries, voxel faces) where the integrand is not smooth.
+//!
+//! ```
+//! use lightquad::domain::Segment;
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! // |t - 1| on [0, 3] has a kink at t = 1. Cut there, both pieces are linear,
+//! // and 2 Gauss–Legendre nodes per piece are exact: 1/2 + 2 = 5/2.
+//! let seg = Segment::with_breaks(0.0, 3.0, vec![1.0])?;
+//! assert_eq!(seg.pieces().collect::<Vec<_>>(), [(0.0, 1.0), (1.0, 3.0)]);
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let est = seg.integrate(&GaussLegendre::default(), 2, &mut rng, |t: f64| (t - 1.0).abs())?;
+//! assert!((est.value - 2.5).abs() < 1e-15);
+//! // Across the kink, the same rule is not exact.
+//! let whole = Segment::new(0.0, 3.0)?.integrate(&GaussLegendre::default(), 2, &mut rng, |t: f64| (t - 1.0).abs())?;
+//! assert!((whole.value - 2.5).abs() > 0.05);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use super::Domain;
 use crate::error::{QuadError, require_finite};

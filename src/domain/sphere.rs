@@ -14,6 +14,27 @@
 //! coordinates carry `sin theta = sqrt((1 - cos theta)(1 + cos theta))`, smooth
 //! inside the square but with a square-root singularity at the pole `u_1 = 0`
 //! (and at the antipode `u_1 = 1` for the whole sphere).
+//!
+//! ```
+//! use std::f64::consts::PI;
+//! use lightquad::domain::{Domain, SphericalCap, Vec3, integrate_over};
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let (c, r) = (Vec3::new(1.0, 2.0, 3.0), 0.5);
+//! // A sphere light: int (z - c_z)^2 dA = 4 pi R^4 / 3; the height is linear
+//! // in u_1 under the Archimedes map, so 4 x 4 nodes are exact.
+//! let sphere = SphericalCap::sphere(c, r)?;
+//! let est = integrate_over(&GaussLegendre::default(), &sphere, 16, &mut rng, |p: Vec3| {
+//!     (p.z - c.z).powi(2)
+//! })?;
+//! assert!((est.value - 4.0 * PI * r.powi(4) / 3.0).abs() < 1e-14);
+//! // The cap within 60 degrees of +z: area 2 pi R^2 (1 - cos 60°) = pi R^2.
+//! let cap = SphericalCap::new(c, Vec3::z(), r, 0.5)?;
+//! assert!((cap.measure() - PI * r * r).abs() < 1e-15);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use super::{
     Domain, Frame, Vec3, azimuth_fraction, frame_around, invert_slack, require_finite_vec3,

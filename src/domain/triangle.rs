@@ -11,6 +11,25 @@
 //! `p` becomes a polynomial of degree `k + 1` in `u_1` and `k` in `u_2`, which
 //! Gauss–Legendre with `m >= (k + 2) / 2` nodes per axis integrates exactly; a
 //! smooth integrand stays smooth, with no singularity at the collapsed vertex.
+//!
+//! ```
+//! use lightquad::domain::{Domain, Triangle, Vec3, integrate_over};
+//! use lightquad::quadrature::GaussLegendre;
+//! use rand::SeedableRng;
+//!
+//! // The right triangle (0,0), (2,0), (0,1): area 1, centroid x = 2/3, so
+//! // int x dA = 2/3; after the Duffy map it is a polynomial of degree 2 in u_1.
+//! let tri = Triangle::new(Vec3::zeros(), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0))?;
+//! assert!((tri.area() - 1.0).abs() < 1e-15);
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let est = integrate_over(&GaussLegendre::default(), &tri, 4, &mut rng, |p: Vec3| p.x)?;
+//! assert!((est.value - 2.0 / 3.0).abs() < 1e-15);
+//! // map and invert are inverses.
+//! let (p, _jacobian) = tri.map([0.5, 0.25]);
+//! let u = tri.invert(&p).ok_or("off the triangle")?;
+//! assert!((u[0] - 0.5).abs() < 1e-12 && (u[1] - 0.25).abs() < 1e-12);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use super::{Domain, Vec3, invert_slack, require_finite_vec3, snap_unit, within};
 use crate::error::QuadError;

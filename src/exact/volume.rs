@@ -1,6 +1,27 @@
 //! Closed forms of the volume-rendering terms (docs/EQUATIONS.md, V-*): V-tau for
 //! the constant-density sphere and for Gaussian blobs; V-E and V-L for the
 //! constant sphere, `sigma = lambda kappa` on a chord of length `L`.
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::exact::volume::{emission, emission_field_interval, gaussian_line_integral};
+//!
+//! // A unit Gaussian blob of width w, crossed through its centre: the line
+//! // integral over +-12 w is the whole Gaussian, w sqrt(2 pi); a line at
+//! // distance h from the centre sees it scaled by exp(-h^2 / (2 w^2)).
+//! let (w, h) = (0.25, 0.1);
+//! let whole = w * (2.0 * std::f64::consts::PI).sqrt();
+//! let through = gaussian_line_integral(Vec3::zeros(), w, Vec3::new(-5.0, 0.0, 0.0), Vec3::x(), 2.0, 8.0);
+//! assert!((through - whole).abs() < 1e-15);
+//! let offset = gaussian_line_integral(Vec3::zeros(), w, Vec3::new(-5.0, h, 0.0), Vec3::x(), 2.0, 8.0);
+//! assert!((offset - whole * (-h * h / (2.0 * w * w)).exp()).abs() < 1e-15);
+//! // An emission field covering exactly the absorbing chord [a, b] is V-E with
+//! // constant c: c (1 - e^{-sigma L}) / sigma.
+//! let (sigma, a, b, c): (f64, f64, f64, f64) = (1.5, 2.0, 4.0, 0.8);
+//! let want = c * (1.0 - (-sigma * (b - a)).exp()) / sigma;
+//! assert!((emission(sigma, b - a, c) - want).abs() < 1e-15);
+//! assert!((emission_field_interval(sigma, (a, b), c, (a, b)) - want).abs() < 1e-15);
+//! ```
 
 use std::f64::consts::PI;
 

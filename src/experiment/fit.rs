@@ -1,4 +1,23 @@
 //! Fitted convergence orders.
+//!
+//! ```
+//! use lightquad::experiment::fit::{fitted_line, fitted_order};
+//!
+//! // Errors of an order-2 rule, e = 3 n^-2, have slope -2 and lie on the line
+//! // (the largest factor a point is off it: 1).
+//! let law: Vec<(f64, f64)> = [4.0, 8.0, 16.0, 32.0].iter().map(|&n: &f64| (n, 3.0 / (n * n))).collect();
+//! let (slope, off) = fitted_line(&law).ok_or("no fit")?;
+//! assert!((slope + 2.0).abs() < 1e-12 && (off - 1.0).abs() < 1e-12);
+//! // An exact result (error 0) carries no slope and is left out; one point is no fit.
+//! let mut with_exact = law.clone();
+//! with_exact.push((64.0, 0.0));
+//! assert_eq!(fitted_order(&with_exact), Some(slope));
+//! assert_eq!(fitted_order(&law[..1]), None);
+//! // Errors that jump up and down by 1000x: a slope, but no order.
+//! let (_, off) = fitted_line(&[(1.0, 1.0), (2.0, 1e-3), (4.0, 1.0), (8.0, 1e-3)]).ok_or("no fit")?;
+//! assert!(off > 10.0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 /// Least-squares slope of `ln(error)` against `ln(cost)`: the observed order of
 /// convergence (`-2` for the trapezoid rule against nodes per axis, `-0.5` for

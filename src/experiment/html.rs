@@ -7,6 +7,26 @@
 //! The facts are those of the Markdown ([`super::report`] computes them once,
 //! as [`Section`]s); a rule has the same colour on every page
 //! ([`plot::rule_css`]).
+//!
+//! ```
+//! use lightquad::experiment::html::write_index;
+//! use lightquad::experiment::plot::rule_css;
+//! use lightquad::experiment::report::Ranked;
+//!
+//! // The top-level page of a report with one experiment whose description
+//! // holds markup: it is shown as text, and the page loads nothing from elsewhere.
+//! let out = std::env::temp_dir().join(format!("lightquad-doc-html-{}", std::process::id()));
+//! std::fs::create_dir_all(&out)?;
+//! let ranked = Ranked { label: "gauss-legendre".into(), seconds: Some(2e-6), exact_from_start: false };
+//! let entries = [("exp".to_string(), "e^u <b>& friends</b>".to_string(), vec![("exp", vec![ranked])])];
+//! write_index(&out, &entries, &[], &[], &[])?;
+//! let page = std::fs::read_to_string(out.join("index.html"))?;
+//! assert!(page.contains("e^u &lt;b&gt;&amp; friends&lt;/b&gt;") && !page.contains("<b>&"));
+//! assert!(page.contains(&rule_css("gauss-legendre"))); // the rule's colour
+//! assert!(!page.contains("src=\"http") && !page.contains("href=\"http"));
+//! std::fs::remove_dir_all(&out)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use std::fmt::Write as _;
 use std::path::Path;

@@ -3,6 +3,18 @@
 //! the flag legend): headings, paragraphs, `-` lists, pipe tables, code
 //! spans and bold. Every character of the input is escaped, so text from a
 //! user's file cannot inject markup.
+//!
+//! ```
+//! use lightquad::experiment::markdown::{escape, inline, to_html};
+//!
+//! // Text from a user's file is escaped, markup from lightquad's Markdown is not.
+//! assert_eq!(escape("a < b & 'c'"), "a &lt; b &amp; &#39;c&#39;");
+//! assert_eq!(inline("**V-tau** at `n < 8`"), "<strong>V-tau</strong> at <code>n &lt; 8</code>");
+//! let md = "# Audit\n\n| point | value |\n|---|---|\n| <script> | 0.5 |\n";
+//! let html = to_html(md, 1); // `#` becomes <h2>, below the page's <h1>
+//! assert!(html.contains("<h2") && html.contains("<table"));
+//! assert!(html.contains("&lt;script&gt;") && !html.contains("<script>"));
+//! ```
 
 /// `s` with `&`, `<`, `>`, `"` and `'` escaped, for HTML text and attribute values.
 pub fn escape(s: &str) -> String {

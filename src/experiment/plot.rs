@@ -1,6 +1,26 @@
 //! The plots of a report: error against time or evaluations on log-log
 //! axes, unresolved errors on a dashed floor line, and one colour per rule
 //! name that every page (Markdown SVGs and HTML alike) keeps.
+//!
+//! ```
+//! use lightquad::experiment::plot::{rule_css, svg};
+//!
+//! // A rule has its colour on every page: Gauss–Legendre is always red.
+//! assert_eq!(rule_css("gauss-legendre"), "#d62728");
+//! // Error against n on log-log axes, one curve per rule.
+//! let curve = |f: fn(f64) -> f64| [4.0, 16.0, 64.0].map(|n| (n, f(n))).to_vec();
+//! let series = vec![
+//!     ("trapezoid".to_string(), curve(|n| 0.1 / (n * n))),
+//!     ("monte-carlo".to_string(), curve(|n| 0.3 / n.sqrt())),
+//! ];
+//! let page = svg("I_E: error against n", "n", &series, 1e-16)?.ok_or("nothing to plot")?;
+//! assert!(page.contains("<svg") && page.contains("I_E: error against n"));
+//! let lower = page.to_lowercase();
+//! assert!(lower.contains(&rule_css("trapezoid")) && lower.contains(&rule_css("monte-carlo")));
+//! // No finite point, no plot.
+//! assert_eq!(svg("t", "n", &[("sobol".to_string(), vec![(4.0, f64::NAN)])], 1e-16)?, None);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use plotters::prelude::*;
 

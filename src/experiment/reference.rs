@@ -2,6 +2,26 @@
 //! family's closed forms, literal values, the Mitsuba 3 harness's values
 //! files, or the family's converged deterministic evaluation checked against
 //! twice its nodes. Also the "lightquad vs Mitsuba vs closed form" rows.
+//!
+//! ```
+//! use lightquad::calibration::Calibration;
+//! use lightquad::experiment::reference::{reference, relative_distance};
+//! use lightquad::experiment::validate::{deserialize, validate};
+//!
+//! // A converged reference: the family's most accurate deterministic evaluation
+//! // at n = 32 nodes, checked against 2n. For int_0^1 e^u du that is e - 1.
+//! let json = serde_json::json!({"name": "e", "family": "calibration", "scene": {},
+//!     "quantities": ["exp"], "rules": [{"rule": "trapezoid"}], "budgets": [8],
+//!     "reference": {"type": "converged", "n": 32}});
+//! let exp = validate::<Calibration>(deserialize(json)?, "hash")?;
+//! let r = reference(&exp);
+//! assert!(r.missing.is_empty());
+//! assert!((r.values["exp"][0] - (std::f64::consts::E - 1.0)).abs() < 1e-15);
+//! assert!(r.accuracy_of("exp") < 1e-14);
+//! // Errors are relative distances of channel vectors: rms(a - b) / rms(b).
+//! assert!((relative_distance(&[1.0, 2.0], &[1.0, 1.0]) - 0.5f64.sqrt()).abs() < 1e-15);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use std::collections::BTreeMap;
 

@@ -5,6 +5,30 @@
 //! A [`Registry`] holds one [`FamilyEntry`] per family, made by
 //! [`Registry::with`] from the family's type; [`crate::families::builtin`]
 //! is the crate's own, and a user's family plugs in with one more `with`.
+//!
+//! ```
+//! use lightquad::calibration::Calibration;
+//! use lightquad::experiment::Registry;
+//!
+//! // A registry of one family; a family of your own plugs in the same way.
+//! let registry = Registry::new().with::<Calibration>();
+//! assert!(registry.get("calibration").is_some() && registry.get("volume").is_none());
+//! let mut json = serde_json::json!({"name": "e", "family": "calibration", "scene": {},
+//!     "quantities": ["exp"], "rules": [{"rule": "gauss-legendre"}], "budgets": [8],
+//!     "repeats": 1, "reference": {"type": "closed-form"}});
+//! let exp = registry.load(json.clone(), "hash")?;
+//! // The loaded experiment hides its family: jobs run through the trait object.
+//! assert_eq!(exp.family(), "calibration");
+//! let jobs = exp.jobs(None); // (rule, budget, repeat)
+//! assert_eq!(jobs, [(0, 8, 0)]);
+//! let result = exp.run_job(jobs[0]);
+//! assert!((result.quantities["exp"].value[0] - (std::f64::consts::E - 1.0)).abs() < 1e-15);
+//! // A family the registry lacks is refused, naming those it has.
+//! json["family"] = "volume".into();
+//! let e = registry.load(json, "hash").err().ok_or("accepted")?;
+//! assert!(e.to_string().contains("calibration"), "{e}");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use std::path::Path;
 

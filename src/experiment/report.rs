@@ -6,6 +6,36 @@
 //! Nothing here knows a family: a page is described by a [`Page`], and values
 //! are channel vectors (a scalar, RGB, an image), compared by their root mean
 //! square.
+//!
+//! ```
+//! use std::collections::BTreeMap;
+//! use lightquad::experiment::report::{Against, RuleInfo, order, rows};
+//! use lightquad::quadrature::{Rule, Trapezoid};
+//!
+//! let text = r#"{"name": "doc-report", "family": "calibration", "scene": {}, "quantities": ["exp"],
+//!   "rules": [{"rule": "trapezoid"}], "budgets": [8, 16, 32, 64, 128], "repeats": 1,
+//!   "reference": {"type": "closed-form"}}"#;
+//! let exp = lightquad::families::builtin().load(serde_json::from_str(text)?, "hash")?;
+//! let results: Vec<_> = exp.jobs(None).into_iter().map(|job| exp.run_job(job)).collect();
+//! // One row per (rule, budget) against the reference e - 1, and the order fitted
+//! // against the resolution a budget buys (n - 1 intervals): -2 for the trapezoid rule.
+//! let intervals: BTreeMap<usize, f64> = [8, 16, 32, 64, 128].map(|n| (n, Trapezoid.resolution(n, 1))).into();
+//! let rule = RuleInfo { label: "trapezoid".into(), is_random: false, min_budget: 2,
+//!     resolution: BTreeMap::from([(1, intervals.clone())]) };
+//! let table = rows(&[rule], &results, "exp", &[std::f64::consts::E - 1.0]);
+//! assert_eq!(table.len(), 5);
+//! let against = Against::Resolution { dimension: 1, by_budget: Some(&intervals) };
+//! let slope = order(&table.iter().collect::<Vec<_>>(), against, 0.0).ok_or("no fit")?;
+//! assert!((slope + 2.0).abs() < 0.01, "{slope}");
+//! // The page itself: report.md, SVG plots, results.csv and index.html.
+//! let dir = std::env::temp_dir().join(format!("lightquad-doc-report-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir)?;
+//! exp.write_report(&dir, &results)?;
+//! assert!(std::fs::read_to_string(dir.join("report.md"))?.contains("trapezoid"));
+//! assert!(dir.join("results.csv").exists() && dir.join("index.html").exists());
+//! std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

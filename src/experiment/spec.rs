@@ -2,6 +2,30 @@
 //! tag, the family's scene, its quantities, the rules and estimators to
 //! compare, the budgets and the reference. Unknown fields are rejected; every
 //! error names the JSON path of the fault.
+//!
+//! ```
+//! use lightquad::calibration::Calibration;
+//! use lightquad::experiment::spec::{BudgetRange, Budgets, ConvergedReference, ExperimentSpec, ReferenceSpec};
+//! use lightquad::experiment::validate::deserialize;
+//!
+//! let json = serde_json::json!({
+//!     "name": "e", "family": "calibration", "scene": {}, "quantities": ["exp"],
+//!     "rules": [{"rule": "gauss-legendre"}, {"rule": "monte-carlo"}],
+//!     "budgets": {"from": 4, "to": 64, "factor": 4},
+//!     "reference": {"type": "converged", "n": 100}
+//! });
+//! let spec: ExperimentSpec<Calibration> = deserialize(json.clone())?;
+//! assert_eq!(spec.budgets, Budgets::Range(BudgetRange { from: 4, to: 64, factor: 4.0 }));
+//! assert_eq!(spec.reference, ReferenceSpec::Converged(ConvergedReference { n: 100 }));
+//! // Fields left out take their defaults: 3 repeats, targets 1e-3, 1e-6, 1e-9.
+//! assert_eq!((spec.repeats, spec.targets.as_slice()), (3, &[1e-3, 1e-6, 1e-9][..]));
+//! // Unknown fields are refused, with their JSON path.
+//! let mut typo = json;
+//! typo["reference"]["nodes"] = 100.into();
+//! let e = deserialize::<Calibration>(typo).err().ok_or("accepted")?;
+//! assert!(e.to_string().contains("reference") && e.to_string().contains("nodes"), "{e}");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use std::collections::BTreeMap;
 

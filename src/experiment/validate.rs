@@ -2,6 +2,26 @@
 //! checked once, here, with the JSON path of the fault in the error. The
 //! family checks its scene ([`Family::build`]); this module checks the rest,
 //! and that every rule and estimator can compute every quantity asked for.
+//!
+//! ```
+//! use lightquad::calibration::Calibration;
+//! use lightquad::experiment::validate::{deserialize, parse_json, validate};
+//!
+//! let text = r#"{"name": "e", "family": "calibration", "scene": {}, "quantities": ["exp"],
+//!   "rules": [{"rule": "gauss-legendre"}], "budgets": {"from": 2, "to": 32, "factor": 2},
+//!   "reference": {"type": "closed-form"}}"#;
+//! let exp = validate::<Calibration>(deserialize(parse_json(text)?)?, "hash")?;
+//! // The range expands to its budgets; the closed form e - 1 is known before any run.
+//! assert_eq!(exp.budgets, [2, 4, 8, 16, 32]);
+//! let known = exp.known.as_ref().ok_or("no reference values")?;
+//! let exact = known.values[&exp.spec.quantities[0]][0];
+//! assert!((exact - (std::f64::consts::E - 1.0)).abs() < 1e-15);
+//! // A fault names its JSON path.
+//! let bad = text.replace("\"factor\": 2", "\"factor\": 1");
+//! let e = validate::<Calibration>(deserialize(parse_json(&bad)?)?, "hash").err().ok_or("accepted")?;
+//! assert!(e.to_string().contains("budgets.factor"), "{e}");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use std::collections::BTreeMap;
 

@@ -15,6 +15,24 @@
 //!
 //! - printed: `exp(-lambda kappa (-<p,d>/<d,d>) + sqrt(<p,d>^2 - <p,p><d,d>)/<d,d>) I_p`
 //!   (the factor reaches only the first summand, audit point 2).
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::volume::audit::{light_corrected, light_printed, s_corrected, s_printed};
+//!
+//! // From p = (0.6, 0, 0) toward +y the unit sphere is left at s = sqrt(1 - 0.6^2)
+//! // = 0.8; the printed s(t), without the radius term, has no real value there.
+//! let (p, d) = (Vec3::new(0.6, 0.0, 0.0), Vec3::y());
+//! assert!((s_corrected(p, d, 1.0) - 0.8).abs() < 1e-15);
+//! assert!(s_printed(p, d).is_nan());
+//! // I_p = exp(-lambda kappa s) I_p, here with lambda kappa = 2, I_p = 3.
+//! assert!((light_corrected(p, d, 1.0, 2.0, 3.0) - 3.0 * (-1.6f64).exp()).abs() < 1e-15);
+//! // On the line through the centre the printed s is real but wrong: from
+//! // (0, -0.5, 0) it gives 0.5 where the exit is 1.5 away.
+//! let q = Vec3::new(0.0, -0.5, 0.0);
+//! assert!((s_corrected(q, d, 1.0) - 1.5).abs() < 1e-15 && (s_printed(q, d) - 0.5).abs() < 1e-15);
+//! assert!((light_printed(q, d, 2.0, 1.0) - (-1.0f64).exp()).abs() < 1e-15);
+//! ```
 
 use rand::SeedableRng;
 

@@ -1,5 +1,28 @@
 //! The documents' worked medium: a sphere of constant density `kappa`
 //! (docs/EQUATIONS.md, V-tau: `sigma = lambda kappa` inside, 0 outside).
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::volume::{ConstantSphere, Medium};
+//!
+//! // kappa inside, 0 outside. Along a ray at distance h from the centre the
+//! // support is the chord of length 2 sqrt(R^2 - h^2), and the line integral
+//! // is kappa times it.
+//! let (radius, kappa, h) = (2.0, 0.75, 1.2);
+//! let sphere = ConstantSphere::new(Vec3::new(0.0, 0.0, 5.0), radius, kappa)?;
+//! assert_eq!(sphere.density(Vec3::new(0.0, 1.0, 5.0)), kappa);
+//! assert_eq!(sphere.density(Vec3::zeros()), 0.0);
+//! let ray = Ray::new(Vec3::new(-10.0, h, 5.0), Vec3::x())?;
+//! let chord = 2.0 * (radius * radius - h * h).sqrt(); // 3.2
+//! let support = sphere.support(&ray, 0.0, f64::INFINITY);
+//! assert_eq!(support.len(), 1);
+//! assert!((support[0].start() - (10.0 - chord / 2.0)).abs() < 1e-14);
+//! assert!((support[0].end() - (10.0 + chord / 2.0)).abs() < 1e-14);
+//! let depth = sphere.density_integral(&ray, 0.0, 20.0).ok_or("no closed form")?;
+//! assert!((depth - kappa * chord).abs() < 1e-14); // tau = exp(-lambda depth)
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use super::medium::Medium;
 use crate::domain::{Segment, Vec3};

@@ -2,6 +2,31 @@
 //! layer sees it: the scene format of an experiment file (`"family":
 //! "volume"`), its quantities, the tracking estimators beside the rules, the
 //! closed forms and the converged reference.
+//!
+//! ```
+//! use lightquad::family::{Family, Method};
+//! use lightquad::volume::experiment::{SceneSpec, Volume, VolumeQuantity};
+//! use lightquad::volume::tracking::Tracker;
+//! use rand::SeedableRng;
+//!
+//! // A scene as an experiment file writes it, built and evaluated as a job is.
+//! let spec: SceneSpec = serde_json::from_value(serde_json::json!({
+//!     "ray": {"origin": [-3.0, 0.6, 0.0], "direction": [1.0, 0.0, 0.0]},
+//!     "medium": {"type": "constant-sphere", "centre": [0.0, 0.0, 0.0], "radius": 1.0, "kappa": 2.0}
+//! }))?;
+//! let built = Volume::build(&spec)?;
+//! // tau = exp(-kappa * chord), the chord 2 sqrt(1 - 0.6^2) = 1.6.
+//! let want = (-2.0 * 1.6f64).exp();
+//! assert!((Volume::closed_form(&built, VolumeQuantity::Tau).ok_or("none")?[0] - want).abs() < 1e-15);
+//! // A rule and a tracker, named as in the file's "rules".
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! for rule in [r#"{"rule": "gauss-legendre"}"#, r#"{"rule": "residual-ratio-tracking"}"#] {
+//!     let method: Method<Tracker> = serde_json::from_str(rule)?;
+//!     let out = Volume::evaluate(&built, &method, 8, &mut rng, &[VolumeQuantity::Tau])?;
+//!     assert!((out[&VolumeQuantity::Tau].value[0] - want).abs() < 1e-14, "{rule}");
+//! }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use std::sync::Arc;
 

@@ -9,6 +9,27 @@
 //!
 //! ([`crate::exact::volume::gaussian_line_integral`]). Blobs never vanish: the support is cut at
 //! 12 widths, where the density is below `e^-72 = 5e-32` of the peak.
+//!
+//! ```
+//! use std::f64::consts::PI;
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::volume::{GaussianBlob, GaussianBlobs, Medium};
+//!
+//! let blobs = GaussianBlobs::new(vec![
+//!     GaussianBlob { centre: Vec3::zeros(), amplitude: 2.0, width: 0.5 },
+//!     GaussianBlob { centre: Vec3::new(0.0, 1.0, 0.0), amplitude: 1.0, width: 0.25 },
+//! ])?;
+//! // At the first centre: 2 plus the second blob at distance 1, e^{-1/(2 w^2)} = e^-8.
+//! assert!((blobs.density(Vec3::zeros()) - (2.0 + (-8.0f64).exp())).abs() < 1e-15);
+//! // A ray through the first centre sees all of it, a w sqrt(2 pi), and the
+//! // second at distance h = 1 scaled by e^{-h^2/(2 w^2)}.
+//! let ray = Ray::new(Vec3::new(-10.0, 0.0, 0.0), Vec3::x())?;
+//! let want = 2.0 * 0.5 * (2.0 * PI).sqrt() + 0.25 * (2.0 * PI).sqrt() * (-8.0f64).exp();
+//! let depth = blobs.density_integral(&ray, 0.0, 20.0).ok_or("no closed form")?;
+//! assert!((depth - want).abs() < 1e-14);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use super::medium::Medium;
 use crate::domain::{Segment, Vec3};

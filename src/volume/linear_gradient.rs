@@ -16,6 +16,29 @@
 //! line integral over a piece `[a, b]` is the length times the midpoint value,
 //!
 //! `int_a^b v_r dt = (b - a) (gamma + beta ((a + b)/2 - t_c))`.
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::quadrature::GaussLegendre;
+//! use lightquad::volume::{LinearGradient, Medium};
+//! use rand::SeedableRng;
+//!
+//! // v = max(0, 1 + 2x) in the unit sphere. Along the x axis it is zero up to
+//! // x = -1/2 and linear after it: int v dx = [x + x^2] from -1/2 to 1 = 9/4.
+//! let medium = LinearGradient::new(Vec3::zeros(), 1.0, 1.0, Vec3::new(2.0, 0.0, 0.0))?;
+//! let ray = Ray::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::x())?; // x = t - 3
+//! let support = medium.support(&ray, 0.0, 10.0);
+//! assert_eq!(support.len(), 1); // cut at the kink t = 2.5, ends at the sphere
+//! assert!((support[0].start() - 2.5).abs() < 1e-15 && (support[0].end() - 4.0).abs() < 1e-15);
+//! let closed = medium.density_integral(&ray, 0.0, 10.0).ok_or("no closed form")?;
+//! assert!((closed - 2.25).abs() < 1e-14);
+//! // Linear on its piece, so 2 Gauss–Legendre nodes are exact.
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let gl = support[0].integrate(&GaussLegendre::default(), 2, &mut rng, |t| medium.density(ray.at(t)))?;
+//! assert!((gl.value - 2.25).abs() < 1e-14);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use super::medium::Medium;
 use crate::domain::{Segment, Vec3};

@@ -5,6 +5,31 @@
 //! not smooth, so quadrature only ever sees smooth pieces; it may know its line
 //! integral in closed form, and it bounds its density for the tracking
 //! estimators.
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::quadrature::GaussLegendre;
+//! use lightquad::volume::{ConstantSphere, Medium};
+//! use rand::SeedableRng;
+//!
+//! // The optical depth of any medium by quadrature over the smooth pieces of
+//! // its support along a ray, the way every volume term starts.
+//! fn depth(m: &dyn Medium, ray: &Ray, rng: &mut rand_pcg::Pcg64) -> Result<f64, lightquad::QuadError> {
+//!     let mut total = 0.0;
+//!     for piece in m.support(ray, 0.0, f64::INFINITY) {
+//!         let est = piece.integrate(&GaussLegendre::default(), 4, rng, |t| m.density(ray.at(t)))?;
+//!         total += est.value;
+//!     }
+//!     Ok(total)
+//! }
+//! // Density 2 on the chord 2 sqrt(1 - 0.6^2) = 1.6 of a unit sphere: 3.2.
+//! let sphere = ConstantSphere::new(Vec3::zeros(), 1.0, 2.0)?;
+//! let ray = Ray::new(Vec3::new(-3.0, 0.6, 0.0), Vec3::x())?;
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! assert!((depth(&sphere, &ray, &mut rng)? - 3.2).abs() < 1e-14);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use crate::domain::{Segment, Vec3};
 use crate::geometry::Ray;

@@ -16,6 +16,30 @@
 //! Point 2 (the exponent multiplies only the first summand,
 //! `exp(-lambda kappa (-<p,d>/<d,d>) + sqrt(.)/<d,d>)`) and point 3 (the
 //! printed `I_B = tau(t_n, t_f) I_b - int sigma dt`) are real either way.
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::volume::printed::{Printed, Sphere, evaluate};
+//! use lightquad::volume::{DirectionalLight, VolumeScene};
+//!
+//! // A ray at height 0.6 through a unit sphere of sigma = 1 (chord [0, 1.6]),
+//! // the light straight ahead, a background of 1.
+//! let mut scene = VolumeScene::new(Ray::new(Vec3::new(-0.8, 0.6, 0.0), Vec3::x())?);
+//! scene.light = Some(DirectionalLight::new(Vec3::x(), 1.0, None)?);
+//! scene.background = Some(1.0);
+//! let sphere = Sphere { centre: Vec3::zeros(), radius: 1.0, kappa: 1.0 };
+//! let v = evaluate(&scene, &sphere, &[Printed::S, Printed::Background], (0.0, 1.6))?;
+//! // Corrected: I_L = I_p L e^{-sigma L} (crate::exact::volume::light_ahead). The
+//! // printed s(t) has a negative radicand on the whole chord: no real value.
+//! let light = v.light.ok_or("no I_L")?;
+//! assert!((light.corrected - 1.6 * (-1.6f64).exp()).abs() < 1e-12);
+//! assert!(light.real.is_none() && light.negative_share == 1.0);
+//! // Point 3: the printed I_B = tau I_b - sigma L, where tau I_b is meant.
+//! let (printed, defined) = v.background.ok_or("no I_B")?;
+//! assert!((defined - (-1.6f64).exp()).abs() < 1e-15 && (printed - (defined - 1.6)).abs() < 1e-15);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};

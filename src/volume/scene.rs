@@ -1,6 +1,31 @@
 //! A volume-rendering scene along one eye ray: only the parts it has.
 //! (docs/EQUATIONS.md, V-*: a medium, an emission map, a background, a directional
 //! light, optionally with single scattering.)
+//!
+//! ```
+//! use std::sync::Arc;
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::volume::{ConstantSphere, EmissionMap, TransferTable, VolumeScene};
+//!
+//! // An eye ray from x = -3 through a unit sphere, emitting through a transfer
+//! // function c(v) linear from (0, 0) to (2, 1), in front of a background.
+//! let mut scene = VolumeScene::new(Ray::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::x())?);
+//! scene.medium = Some(Arc::new(ConstantSphere::new(Vec3::zeros(), 1.0, 0.5)?));
+//! let table = TransferTable::new(vec![(0.0, 0.0), (2.0, 1.0)])?;
+//! assert_eq!(table.at(0.5), 0.25);
+//! scene.emission = Some(EmissionMap::Table(table));
+//! scene.background = Some(1.0);
+//! scene.validate()?;
+//! // A medium emits only where its density is positive: c(0) = 0.
+//! assert_eq!(EmissionMap::Constant(2.0).at(0.0), 0.0);
+//! // Re-anchored at the start of the medium's support (t* = 2): the same
+//! // integrals, with the chord's parameters small and their rounding with them.
+//! let (anchored, shift) = scene.anchored();
+//! assert!((shift - 2.0).abs() < 1e-15);
+//! assert!((anchored.ray.origin - Vec3::new(-1.0, 0.0, 0.0)).norm() < 1e-15);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use std::sync::Arc;
 

@@ -24,6 +24,33 @@
 //! outer node already visited below it, with 6-point Gauss–Legendre panels on
 //! the gap (cost ~ 6 n for rules that visit their nodes in order). Terms a
 //! scene does not have are not evaluated at all.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::quadrature::GaussLegendre;
+//! use lightquad::volume::{ConstantSphere, DepthScheme, EmissionMap, ShadowMethod, VolumeScene, evaluate};
+//! use rand::SeedableRng;
+//!
+//! // Along the diameter (L = 2) of a unit sphere with sigma = 2, emitting c in
+//! // front of a background I_b: I_E = c (1 - tau) / sigma, I_B = tau I_b.
+//! let (sigma, c, ib) = (2.0, 0.5, 3.0);
+//! let mut scene = VolumeScene::new(Ray::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::x())?);
+//! scene.medium = Some(Arc::new(ConstantSphere::new(Vec3::zeros(), 1.0, sigma)?));
+//! scene.emission = Some(EmissionMap::Constant(c));
+//! scene.background = Some(ib);
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let r = evaluate(&scene, &GaussLegendre::default(), 16, DepthScheme::Cumulative,
+//!                  ShadowMethod::ClosedFormWhereAvailable, &mut rng)?;
+//! let tau = (-sigma * 2.0f64).exp();
+//! assert_eq!(r.evaluated, ["V-tau", "V-E", "V-B", "V-I"]);
+//! assert!((r.log_transmittance + sigma * 2.0).abs() < 1e-14);
+//! let emission = r.emission.ok_or("no V-E")?;
+//! assert!((emission.value - c * (1.0 - tau) / sigma).abs() < 1e-14);
+//! assert!((r.total - (c * (1.0 - tau) / sigma + tau * ib)).abs() < 1e-14);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use std::cell::Cell;
 use std::collections::BTreeMap;

@@ -21,6 +21,31 @@
 //! per piece integrates it exactly. The support is the ray–box chord cut at
 //! those crossings. There is no closed-form line integral
 //! ([`Medium::density_integral`] is `None`).
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::quadrature::GaussLegendre;
+//! use lightquad::volume::{Medium, VoxelGrid};
+//! use rand::SeedableRng;
+//!
+//! // Two voxels along x over the box [0, 2] x [0, 1] x [0, 1], values 1 and 3
+//! // at their centres x = 0.5 and 1.5: the field is 1, then linear 1 -> 3, then 3.
+//! let grid = VoxelGrid::new(Vec3::zeros(), Vec3::new(2.0, 1.0, 1.0), [2, 1, 1], vec![1.0, 3.0])?;
+//! assert_eq!(grid.density(Vec3::new(1.0, 0.5, 0.5)), 2.0);
+//! // Along the box's axis: int v dx = 0.5 * 1 + 1 * 2 + 0.5 * 3 = 4, on three
+//! // pieces cut at the centre planes; 2 Gauss–Legendre nodes per piece are exact.
+//! let ray = Ray::new(Vec3::new(-1.0, 0.5, 0.5), Vec3::x())?;
+//! let pieces = grid.support(&ray, 0.0, f64::INFINITY);
+//! assert_eq!(pieces.iter().map(|s| s.pieces().count()).sum::<usize>(), 3);
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let mut depth = 0.0;
+//! for s in &pieces {
+//!     depth += s.integrate(&GaussLegendre::default(), 2, &mut rng, |t| grid.density(ray.at(t)))?.value;
+//! }
+//! assert!((depth - 4.0).abs() < 1e-14);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
 
 use super::medium::Medium;
 use crate::domain::{Segment, Vec3};
