@@ -12,4 +12,5 @@
 //! assert!((emission(0.5, 2.0, 3.0) - want).abs() < 1e-14);
 //! ```
 
+pub mod rendering;
 pub mod volume;
