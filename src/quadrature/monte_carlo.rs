@@ -27,9 +27,10 @@
 //! (25% at 16); `x^-0.6` 72-86% covered unflagged before, 7-10% neither
 //! from 64 on; `x^-0.45` (finite variance) 6-8%. Smooth integrands (x,
 //! e^x, sin(pi x), x^2, sqrt x) are flagged in 0.1-1.9% of runs at 16
-//! samples and in none from 64 on; steep or peaked ones (e^{10x}, a
-//! Gaussian of width 0.05) are flagged at 16 and 64 samples, where their
-//! intervals cover only 83-93%, and not from 256 on. What no finite sample
+//! samples and in none from 64 on (in 2-D, e^{x+y}: 5.6% at 16); steep or
+//! peaked ones are flagged at 16 samples (`1/(1 + 25 x^2)`: 16%, covered
+//! 93%) and 64 (e^{10x}: 43%, a Gaussian of width 0.05: 56%; covered 83-93%
+//! at 16 and 64), and not from 256 on. What no finite sample
 //! can show is not caught: a rare event or a tail no sample reached on top
 //! of an integrand that varies (the samples then look like a
 //! well-behaved one's).
