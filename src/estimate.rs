@@ -40,8 +40,12 @@ pub enum ErrorKind {
 /// deterministic ones (`kind` says which); `f64::INFINITY` when the rule has no
 /// information to estimate it (a one-node rule). `reliable` is false when the
 /// rule saw that the assumption behind its estimate does not hold (differences
-/// that do not shrink the way the estimate assumes): reports flag such an
-/// estimate instead of presenting it as trustworthy. Reports put the error
+/// that do not shrink the way the estimate assumes; for a random rule,
+/// samples that were all alike, so that a standard error of 0 says nothing
+/// about values not seen, or a sample variance carried by a few samples, as
+/// with infinite-variance integrands and rare events: see
+/// [`crate::quadrature::monte_carlo`]): reports flag such an estimate instead
+/// of presenting it as trustworthy. Reports put the error
 /// beside the true error.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate<V: Value> {

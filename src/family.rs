@@ -289,7 +289,11 @@ pub enum Flag {
     },
     /// The rule doubted its own error estimate: the differences it is built
     /// from did not behave as the estimate assumes (algebraic instead of
-    /// geometric convergence, a jump or a kink in the integrand).
+    /// geometric convergence, a jump or a kink in the integrand); for a
+    /// random rule, every sample alike (a standard error of 0 that says
+    /// nothing about values not seen: a constant integrand is flagged too)
+    /// or a sample variance carried by a few samples (an infinite-variance
+    /// integrand, an event hit by few samples).
     UnreliableEstimate,
     /// Every walk of a tracking estimator scored alike: the sample variance
     /// is 0, which says nothing about outcomes not yet seen, so the error is

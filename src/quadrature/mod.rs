@@ -19,9 +19,9 @@
 //! | `simpson` | composite Simpson, product in D > 1 | Richardson, half step; observed order from the quarter step when nested |
 //! | `gauss-legendre` | Gauss–Legendre of any order, product in D > 1 | tail of the differences of `Q_m, Q_{m-1}, Q_{m-2}`, checked against `Q_m - Q_{m/2}` from m = 16 |
 //! | `gauss-kronrod` | adaptive Gauss–Kronrod G7–K15 (D = 1) | embedded G7 |
-//! | `monte-carlo` | plain Monte Carlo | standard error |
-//! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of neighbouring cells |
-//! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles, times t_{R-1}(0.975)/1.96 |
+//! | `monte-carlo` | plain Monte Carlo | standard error; doubted when all samples agree or the sample variance is carried by a few samples (kurtosis) |
+//! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of every three neighbouring cells; doubted when none varies |
+//! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles, times t_{R-1}(0.975)/1.96; doubted when the scrambles agree or the points fail the Monte Carlo tail check |
 //! | `product` | iterated 2-D rule from any two 1-D rules (`AnyRule::by_name("product(A,B)")` in the library) | outer estimate + integrated inner estimates |
 //!
 //! ```
