@@ -166,7 +166,7 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
             "{ \"rule\": \"sobol\", \"replicates\": 1 }",
         ),
         "rules[1].replicates",
-        "an integer >= 2",
+        "an integer in 2..=1000000",
     );
     rejected(
         &VALID.replace(
@@ -708,7 +708,7 @@ fn faults_inside_rules_and_references_are_named_where_they_are() {
         )
         .replace("[\"tau\", \"I_E\"]", "[\"tau\"]"),
         "rules[1].inner.replicates",
-        "an integer >= 2",
+        "an integer in 2..=1000000",
     );
     rejected(
         &VALID.replace(
@@ -749,7 +749,21 @@ fn faults_inside_rules_and_references_are_named_where_they_are() {
     let disk = r#"{ "name": "c", "family": "calibration", "scene": {}, "quantities": ["gaussian-disk"],
         "rules": [{ "rule": "product", "outer": { "rule": "gauss-legendre" }, "inner": { "rule": "sobol", "replicates": 1 } }],
         "budgets": [64], "reference": { "type": "closed-form" } }"#;
-    rejected(disk, "rules[0].inner.replicates", "an integer >= 2");
+    rejected(
+        disk,
+        "rules[0].inner.replicates",
+        "an integer in 2..=1000000",
+    );
+    // A replicate count no budget can hold is refused at the count, not at
+    // `budgets` as "no budget reaches" it.
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"sobol\", \"replicates\": 1000000000000 }",
+        ),
+        "rules[1].replicates",
+        "invalid replicates = 1000000000000: expected an integer in 2..=1000000",
+    );
 }
 
 /// A medium whose extinction or optical depth overflows f64 is refused at

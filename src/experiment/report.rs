@@ -138,7 +138,10 @@ pub const FLAG_LEGEND: &str = "Flags: `failed` (the job's reason follows); `non-
 `outside 4 standard errors` (a random estimate whose standard error misses the true error: \
 the root mean square over channels of error / standard error above 4); \
 `estimate off by more than 10x` (a deterministic error estimate, above the rounding floor); \
-`error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
+`error estimate unreliable (rule's own check)` (the rule doubts its own estimate: a \
+deterministic rule whose differences do not shrink the way its order says, or a random one whose \
+samples were all alike, a constant integrand included, since nothing was seen to vary, or whose \
+sample variance is carried by a few samples); `error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
 parts); `underflows: log space` (the value is below the smallest f64; its logarithm is exact: ask for `ln_tau`); \
 `at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
 scored alike` (a tracking estimate with zero sample variance: its error is a Wilson half-width \

@@ -133,6 +133,10 @@ pub fn owen_scramble(x: u32, seed: u32) -> u32 {
     r.reverse_bits()
 }
 
+/// The most scrambles: each needs a point of the budget, and a replicate
+/// count of 1e12 was refused only as "no budget reaches" it, at `budgets`.
+pub const MAX_REPLICATES: usize = 1_000_000;
+
 /// A 32-bit fraction to the centre of its cell in `[0, 1)`.
 #[inline]
 fn to_unit(x: u32) -> f64 {
@@ -162,11 +166,14 @@ impl Rule for Sobol {
     }
 
     fn check(&self) -> Result<(), QuadError> {
-        if self.replicates < 2 {
+        if !(2..=MAX_REPLICATES).contains(&self.replicates) {
             return Err(QuadError::invalid(
                 "replicates",
                 self.replicates,
-                "an integer >= 2 (the standard error needs two scrambles)",
+                format!(
+                    "an integer in 2..={MAX_REPLICATES} (the standard error needs two scrambles, \
+                     and each scramble at least one point of the budget)"
+                ),
             ));
         }
         Ok(())
