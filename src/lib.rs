@@ -59,6 +59,7 @@ pub mod families;
 pub mod family;
 pub mod geometry;
 pub mod quadrature;
+pub mod rendering;
 pub mod sum;
 pub mod value;
 pub mod volume;

@@ -1,0 +1,1 @@
+//! BRDFs of the rendering family (R-H, R-A, R-rec).
