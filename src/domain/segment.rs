@@ -93,6 +93,19 @@ impl Segment {
         &self.breaks
     }
 
+    /// The midpoint of the smooth piece `[t_i, t_{i+1}]` that holds `x`:
+    /// a parameter well inside that piece, where its smooth field can be
+    /// told apart from its neighbours' ([`crate::volume::Medium::density_on`]),
+    /// also for an `x` in a sub-interval so short that its own midpoint's
+    /// point rounds onto the piece's end. `x` on a break point belongs to the
+    /// piece above it.
+    pub fn smooth_mid(&self, x: f64) -> f64 {
+        let i = self.breaks.partition_point(|&b| b <= x);
+        let lo = if i == 0 { self.a } else { self.breaks[i - 1] };
+        let hi = self.breaks.get(i).copied().unwrap_or(self.b);
+        0.5 * (lo + hi)
+    }
+
     /// The smooth pieces `[t_i, t_{i+1}]` between break points (no allocation).
     pub fn pieces(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
         let starts = std::iter::once(self.a).chain(self.breaks.iter().copied());

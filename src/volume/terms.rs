@@ -215,6 +215,11 @@ struct DepthAlong<'a, R: Rule> {
     n: usize,
     /// The gap rule's nodes on [0, 1], fetched once per evaluation.
     gap: Arc<UnitNodes>,
+    /// The support piece being integrated (smooth between its break points):
+    /// its smooth pieces' midpoints tell the medium which field a node
+    /// belongs to (a gap or a graded sub-piece near the entry point can be
+    /// so short that its own midpoint rounds outside the medium).
+    support: Segment,
     /// Visited `t -> depth from the piece start` (cumulative scheme), each
     /// depth carried with its rounding error (a compensated sum), so a chain
     /// of `n` gaps does not accumulate `n` roundings.
@@ -237,7 +242,8 @@ impl Ord for Key {
 }
 
 impl<R: Rule> DepthAlong<'_, R> {
-    fn start_piece(&mut self, piece: &Segment) {
+    fn start_piece(&mut self, piece: &Segment, support: &Segment) {
+        self.support = support.clone();
         self.checkpoints.clear();
         self.checkpoints
             .insert(Key(piece.start()), Compensated::new());
@@ -259,7 +265,7 @@ impl<R: Rule> DepthAlong<'_, R> {
         for b in inner.chain(std::iter::once(hi)) {
             let panels = ((b - a) / longest).ceil().max(1.0) as usize;
             let width = (b - a) / panels as f64;
-            let mid = 0.5 * (a + b);
+            let mid = self.support.smooth_mid(0.5 * (a + b));
             // Panel j is [p_j, p_{j+1}] with p_0 = a, p_panels = b and its
             // length the difference of the ends as stored, so the lengths
             // telescope to b - a: a chain of n gaps then carries no rounding
@@ -286,13 +292,13 @@ impl<R: Rule> DepthAlong<'_, R> {
         rng: &mut Rg,
     ) -> Result<f64, QuadError> {
         let lambda = self.lambda;
-        let (medium, ray) = (self.medium, self.ray);
+        let (medium, ray, support) = (self.medium, self.ray, &self.support);
         match self.scheme {
             DepthScheme::Nested => {
                 let part = piece.restrict(piece.start(), t)?;
                 Ok(part
                     .try_integrate_pieces(self.rule, self.n, rng, |s, mid| {
-                        Ok(lambda * medium.density(&ray, s, mid))
+                        Ok(lambda * medium.density(&ray, s, support.smooth_mid(mid)))
                     })?
                     .value)
             }
@@ -588,6 +594,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
             rule,
             n,
             gap: unit_nodes(GAP_NODES)?,
+            support: Segment::new(0.0, 0.0)?,
             checkpoints: BTreeMap::new(),
         };
         let mut total = Estimate::zero();
@@ -595,14 +602,18 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         let mut before = Compensated::<f64>::new();
         for piece in pieces {
             for sub in graded(medium, scene.lambda, &ray, piece) {
-                along.start_piece(&sub);
+                along.start_piece(&sub, piece);
                 // The outer rule's own rng stream is derived so the inner calls
                 // can use the caller's.
                 let mut outer_rng =
                     <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(rng.next_u64());
+                // The witness of the smooth piece: the support piece's own
+                // midpoint between its breaks, not the graded sub-piece's
+                // (a sub-piece of optical depth 1 at sigma = 1e100 is 1e-100
+                // long, and its midpoint's point rounds onto the entry).
                 let est = sub.try_integrate_pieces(rule, n, &mut outer_rng, |t, mid| {
                     let d = along.depth_to(&sub, t, rng)?;
-                    Ok((-(before.total() + d)).exp() * h(t, mid, rng)?)
+                    Ok((-(before.total() + d)).exp() * h(t, piece.smooth_mid(mid), rng)?)
                 })?;
                 total = total.combine(est);
                 before.add(along.depth_to(&sub, sub.end(), rng)?);
