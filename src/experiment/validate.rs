@@ -229,6 +229,37 @@ fn check_cost<F: Family>(
     if COST_LIMIT_LIFTED.load(std::sync::atomic::Ordering::Relaxed) {
         return Ok(());
     }
+    // The converged reference runs before the report: adaptive
+    // Gauss–Kronrod capped at 15 + 30 n evaluations a piece, at n and 2n at
+    // least (then doubled until it converges; its tolerance usually stops it
+    // far below the cap, so the cap of the first two evaluations is the
+    // bound checked). A scene of radius 1e308 with n = 1e5 passed and ran
+    // without end.
+    if let super::spec::ReferenceSpec::Converged(c) = &spec.reference
+        && let Ok(gk) = crate::quadrature::AnyRule::by_name("gauss-kronrod")
+    {
+        let budget = c.n.saturating_mul(60).saturating_add(15);
+        let method = Method::Rule(gk);
+        let cost: f64 = 1.5
+            * spec
+                .quantities
+                .iter()
+                .map(|&q| F::cost(scene, &method, budget, q))
+                .sum::<f64>();
+        if cost.is_nan() || cost > MAX_JOB_EVALUATIONS {
+            return Err(SpecError::at(
+                "reference.n",
+                format!(
+                    "the converged reference's first evaluations, at n = {} and {}, cost up \
+                     to about {cost:.1e} integrand evaluations: expected at most \
+                     {MAX_JOB_EVALUATIONS:.0e} (lower n, or pass --no-cost-limit to check and \
+                     run to go ahead)",
+                    c.n,
+                    2 * c.n
+                ),
+            ));
+        }
+    }
     let Some(&largest) = budgets.last() else {
         return Ok(());
     };

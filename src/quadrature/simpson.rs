@@ -12,7 +12,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::{Rule, integer_root};
-use super::nodes::{Composite, UnitNodes};
+use super::nodes::{Composite, MAX_POINTS, UnitNodes};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
@@ -23,7 +23,7 @@ const COMPOSITE: Composite = Composite {
     name: "simpson",
     min_points: 5,
     usable: |m| m - (m - 1) % 4,
-    nodes: unit_nodes,
+    nodes: table,
     order: 4,
 };
 
@@ -57,7 +57,17 @@ fn weights(m: usize, h: f64, stride: usize) -> Vec<f64> {
 /// The m-point Simpson rule on `[0, 1]` (m odd, >= 3), with the `2h` companion
 /// (a Simpson rule itself when `m = 4k + 1`, which the rule uses), and the
 /// `4h` Simpson rule when `m = 8k + 1`.
-pub fn unit_nodes(m: usize) -> UnitNodes {
+/// Checked: `m` outside the rule's point counts (or above [`MAX_POINTS`],
+/// whose table would not fit in memory) is an error, not a panic.
+pub fn unit_nodes(m: usize) -> Result<UnitNodes, QuadError> {
+    if !(m % 2 == 1 && (3..=MAX_POINTS).contains(&m)) {
+        return Err(QuadError::invalid("m", m, format!("an odd number of points in 3..={MAX_POINTS}")));
+    }
+    Ok(table(m))
+}
+
+/// The table itself, for counts the rule has checked.
+fn table(m: usize) -> UnitNodes {
     let intervals = (m - 1) as f64;
     let h = 1.0 / intervals;
     UnitNodes {

@@ -23,7 +23,7 @@ const COMPOSITE: Composite = Composite {
     name: "trapezoid",
     min_points: 3,
     usable: |m| if m % 2 == 0 { m - 1 } else { m },
-    nodes: unit_nodes,
+    nodes: table,
     order: 2,
 };
 
@@ -34,7 +34,17 @@ pub struct Trapezoid;
 
 /// The m-point trapezoid rule on `[0, 1]` (m odd, >= 3) with the `2h`
 /// companion, and the `4h` rule when `m = 4k + 1`.
-pub fn unit_nodes(m: usize) -> UnitNodes {
+/// Checked: `m` outside the rule's point counts (or above [`MAX_POINTS`],
+/// whose table would not fit in memory) is an error, not a panic.
+pub fn unit_nodes(m: usize) -> Result<UnitNodes, QuadError> {
+    if !(m % 2 == 1 && (3..=MAX_POINTS).contains(&m)) {
+        return Err(QuadError::invalid("m", m, format!("an odd number of points in 3..={MAX_POINTS}")));
+    }
+    Ok(table(m))
+}
+
+/// The table itself, for counts the rule has checked.
+fn table(m: usize) -> UnitNodes {
     let intervals = (m - 1) as f64;
     let h = 1.0 / intervals;
     let u = (0..m).map(|i| i as f64 / intervals).collect();

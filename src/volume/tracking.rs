@@ -168,9 +168,17 @@ fn wilson_unseen(n: u64) -> f64 {
 /// Wilson score interval, `z/(n + z^2) sqrt(k (n - k)/n + z^2/4)`, divided
 /// by `z`. Up to O(1/n) it is the standard error `sqrt(p (1 - p) / n)` once
 /// `k` and `n - k` are large; at `k = 0` or `k = n` it is `W(n)`, not 0.
-pub fn wilson_error(k: u64, n: u64) -> f64 {
+/// `k > n` or `n = 0` is an error.
+pub fn wilson_error(k: u64, n: u64) -> Result<f64, QuadError> {
+    if n == 0 || k > n {
+        return Err(QuadError::invalid(
+            "k",
+            format!("{k} of n = {n}"),
+            "0 <= k <= n successes of n >= 1 trials",
+        ));
+    }
     let (k, n) = (k as f64, n as f64);
-    (k * (n - k) / n + 0.25 * Z * Z).sqrt() / (n + Z * Z)
+    Ok((k * (n - k) / n + 0.25 * Z * Z).sqrt() / (n + Z * Z))
 }
 
 /// Walk scores summed as the tracking errors need them.
@@ -218,10 +226,11 @@ impl Scores {
     fn binary(&self, evaluations: u64) -> Tracked {
         let n = self.walks.count();
         let x = self.walks.mean();
-        let k = (x * n as f64).round() as u64;
+        // n >= 2 walks (checked on entry) and 0 <= k <= n by construction.
+        let k = ((x * n as f64).round() as u64).min(n);
         Tracked {
             value: x,
-            error: wilson_error(k, n),
+            error: wilson_error(k, n.max(1)).unwrap_or(f64::INFINITY),
             evaluations,
             walks: n,
             all_alike: self.alike,
@@ -234,18 +243,24 @@ fn check(lambda: f64, t0: f64, t1: f64, n: usize) -> Result<(), QuadError> {
     if !(lambda.is_finite() && lambda >= 0.0) {
         return Err(QuadError::invalid("lambda", lambda, "a finite number >= 0"));
     }
-    if t0.is_nan() || t1.is_nan() || t1 < t0 {
+    if t0.is_nan() {
+        return Err(QuadError::invalid("t0", t0, "a number <= t1"));
+    }
+    if t1.is_nan() || t1 < t0 {
         return Err(QuadError::invalid(
             "t1",
             t1,
             format!("a number >= t0 = {t0}"),
         ));
     }
-    if n < 2 {
+    // The rules' budget limit holds for walks too: usize::MAX walks ran
+    // without end (the hostile review of issue 10).
+    let max = crate::quadrature::MAX_BUDGET;
+    if !(2..=max).contains(&n) {
         return Err(QuadError::invalid(
             "n",
             n,
-            "at least 2 walks (a standard error needs two)",
+            format!("2 to 2^40 = {max} walks (a standard error needs two)"),
         ));
     }
     Ok(())
