@@ -555,6 +555,44 @@ fn integrands_near_the_top_of_the_f64_range_give_finite_estimates() {
     }
 }
 
+/// A channel's scale is its own: beside a channel near 1.7e308, a channel of
+/// 2.2e-308 was scaled by the large one's 2^-e to 0 and came back as 0 with
+/// an error of 0 (Monte Carlo, stratified, Sobol', Gauss–Kronrod); and an
+/// integrand near 1e-300 had its squared deviations underflow, a standard
+/// error of 0 (the hostile review of issue 10). Integrals: `int_0^1 1.7e308 x
+/// = 8.5e307`, `int 2.2e-308 = 2.2e-308`, `int 1e-300 x = 5e-301`.
+#[test]
+fn every_channel_keeps_its_own_scale_from_1e_minus_300_to_1e308() {
+    let mut rng = rng(9);
+    for rule in every_rule() {
+        let name = rule.label();
+        let Ok(e) = rule.integrate::<1, lightquad::Rgb, _, _>(64, &mut rng, |u| {
+            lightquad::Rgb::new(1.7e308 * u[0], f64::MIN_POSITIVE, 1e-300 * u[0])
+        }) else {
+            assert!(!rule.dimensions().contains(1), "{name} refused");
+            continue;
+        };
+        let [big, small, tiny] = [0, 1, 2].map(|c| e.value[c]);
+        let [_, _, tiny_error] = [0, 1, 2].map(|c| e.error[c]);
+        assert!(((big - 8.5e307) / 8.5e307).abs() < 0.5, "{name}: {e:?}");
+        assert!(
+            ((small - f64::MIN_POSITIVE) / f64::MIN_POSITIVE).abs() < 1e-12,
+            "{name}: the small channel {small:e}"
+        );
+        // The tiny channel: a finite, non-zero error for the random rules,
+        // which covers the true error within 10x (stratified, Sobol' and
+        // Monte Carlo of a linear integrand at 64 samples).
+        if rule.is_random() {
+            assert!(
+                tiny_error > 0.0 && (tiny - 5e-301).abs() <= 10.0 * tiny_error,
+                "{name}: tiny channel {tiny:e} +- {tiny_error:e}"
+            );
+        } else {
+            assert!(((tiny - 5e-301) / 5e-301).abs() < 1e-12, "{name}: {tiny:e}");
+        }
+    }
+}
+
 #[test]
 fn budgets_beyond_two_to_the_forty_are_refused_at_once() {
     // n = usize::MAX used to loop for centuries (the trapezoid) or wrap.

@@ -176,27 +176,42 @@ pub trait Rule {
                 format!("a budget of at most 2^40 = {MAX_BUDGET} evaluations"),
             ));
         }
-        let mut largest = 0.0f64;
+        // The largest |f| seen, per channel.
+        let mut largest = V::zero();
         let first = self.integrate_unguarded(n, rng, |u| {
             let y = f(u)?;
-            largest = largest.max(y.max_abs());
+            largest = largest.zip(y, |l, y| l.max(y.abs()));
             Ok(y)
         })?;
         // An infinite error is a rule's "no estimate", unless the values are
         // large enough for its squares to have overflowed (a Monte Carlo
         // standard error of values near 1e308).
-        let overflowed_error = largest > 2f64.powi(500)
-            && (0..V::CHANNELS).any(|c| first.error.channel(c).is_infinite());
-        if sound(&first) && !overflowed_error {
+        let overflowed_error = (0..V::CHANNELS)
+            .any(|c| largest.channel(c) > HUGE && first.error.channel(c).is_infinite());
+        // Values below 2^-500 have squares and differences that underflow:
+        // a random rule's standard error of an integrand near 1e-300 came
+        // out as 0.
+        let tiny = (0..V::CHANNELS).any(|c| largest.channel(c) > 0.0 && largest.channel(c) < TINY);
+        if sound(&first) && !overflowed_error && !tiny {
             return Ok(first);
         }
-        // 2^e >= largest |f|, so every scaled value is at most 1 in size.
-        let e = largest.log2().ceil().clamp(0.0, 1023.0) as i32;
-        let (down, up) = (2f64.powi(-e), 2f64.powi(e));
-        let second = self.integrate_unguarded(n, rng, |u| Ok(f(u)?.map(|y| y * down)))?;
+        // Per channel, 2^e >= the largest |f|, so every scaled value is at
+        // most 1 in size, and a tiny channel's at least 1/2; channels
+        // between TINY and 1 keep e = 0 (scaling all channels by the largest
+        // one's 2^-e flushed a channel of 2.2e-308 beside one of 1.7e308 to
+        // 0, with an error of 0).
+        let e = largest.map(|l| {
+            if l > 0.0 && l < TINY {
+                l.log2().ceil().max(-1074.0)
+            } else {
+                l.log2().ceil().clamp(0.0, 1023.0)
+            }
+        });
+        let second =
+            self.integrate_unguarded(n, rng, |u| Ok(f(u)?.zip(e, |y, e| times_pow2(y, -e))))?;
         let scaled = Estimate {
-            value: second.value.map(|v| v * up),
-            error: second.error.map(|x| x * up),
+            value: second.value.zip(e, times_pow2),
+            error: second.error.zip(e, times_pow2),
             evaluations: first.evaluations + second.evaluations,
             ..second
         };
@@ -206,7 +221,7 @@ pub trait Rule {
             Err(QuadError::Overflow {
                 rule: self.name(),
                 value: format!("{:?}", second.value),
-                exponent: e,
+                exponent: e.max_abs() as i32,
             })
         }
     }
@@ -227,6 +242,19 @@ pub trait Rule {
 /// from an unchecked computation) is refused at once instead of looping for
 /// centuries.
 pub const MAX_BUDGET: usize = 1 << 40;
+
+/// `x 2^e` exactly (while representable), in two steps so that each power
+/// of two is a normal number for every `e` in `-1074..=1023`.
+fn times_pow2(x: f64, e: f64) -> f64 {
+    let half = (e / 2.0).trunc() as i32;
+    x * 2f64.powi(half) * 2f64.powi(e as i32 - half)
+}
+
+/// Magnitudes whose squares overflow ([`Rule::try_integrate`] rescales).
+const HUGE: f64 = 3.273390607896142e150; // 2^500
+
+/// Magnitudes whose squares underflow ([`Rule::try_integrate`] rescales).
+const TINY: f64 = 3.054936363499605e-151; // 2^-500
 
 /// A finite value and an error that is a number (an infinite error is a
 /// rule's way of saying it has no estimate, not an overflow).

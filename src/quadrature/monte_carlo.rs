@@ -72,6 +72,8 @@ pub struct MonteCarlo;
 pub struct Welford<V: Value> {
     count: u64,
     mean: V,
+    /// `M2 / u^2` (in the unit too: squares of values near 1e-300 underflow
+    /// and gave a standard error of 0).
     m2: V,
     /// `M3 / u^3`.
     m3: V,
@@ -123,7 +125,7 @@ impl<V: Value> Welford<V> {
         let scaled = |i: usize| {
             let (u_old, u) = (self.unit.channel(i), unit.channel(i));
             let r = if u_old > 0.0 { u_old / u } else { 0.0 };
-            let m2 = if u > 0.0 { self.m2.channel(i) / u / u } else { 0.0 };
+            let m2 = self.m2.channel(i) * r * r;
             let d = if u > 0.0 { delta.channel(i) / u / k } else { 0.0 };
             let t = d * k * d * (k - 1.0);
             (m2, self.m3.channel(i) * r * r * r, self.m4.channel(i) * (r * r) * (r * r), d, t)
@@ -137,7 +139,13 @@ impl<V: Value> Welford<V> {
             m3 + t * d * (k - 2.0) - 3.0 * d * m2
         });
         self.m2 = V::from_fn(|i| {
-            self.m2.channel(i) + (x.channel(i) - old.channel(i)) * (x.channel(i) - new.channel(i))
+            let (m2, _, _, _, _) = scaled(i);
+            let u = unit.channel(i);
+            if u > 0.0 {
+                m2 + ((x.channel(i) - old.channel(i)) / u) * ((x.channel(i) - new.channel(i)) / u)
+            } else {
+                0.0
+            }
         });
         self.m3 = m3;
         self.m4 = m4;
@@ -163,7 +171,6 @@ impl<V: Value> Welford<V> {
             if self.count < 2 || m2 == 0.0 || u == 0.0 {
                 return f64::INFINITY;
             }
-            let m2 = m2 / u / u;
             let b2 = k * self.m4.channel(i) / (m2 * m2);
             ((b2 - 1.0).max(0.0) / k).sqrt()
         })
@@ -189,13 +196,15 @@ impl<V: Value> Welford<V> {
         self.mean
     }
 
-    /// Standard error of the mean, `sqrt(m2 / ((k - 1) k))`; infinite below two samples.
+    /// Standard error of the mean, `sqrt(M2 / ((k - 1) k))`, computed as
+    /// `u sqrt((M2 / u^2) / ((k - 1) k))` so that it neither underflows nor
+    /// overflows; infinite below two samples.
     pub fn standard_error(&self) -> V {
         let k = self.count as f64;
         if self.count < 2 {
             return V::zero().map(|_| f64::INFINITY);
         }
-        self.m2.map(|m2| (m2 / ((k - 1.0) * k)).sqrt())
+        self.m2.zip(self.unit, |m2, u| u * (m2 / ((k - 1.0) * k)).sqrt())
     }
 
     /// [`standard_error`](Self::standard_error) times
