@@ -1493,3 +1493,54 @@ fn means_and_standard_errors_near_the_top_of_the_f64_range_stay_finite() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// `--resume` reads every line on its own and says which it does not reuse:
+/// one line that is not UTF-8 in the middle of results.jsonl ended the
+/// reading, and every later line was dropped and re-run in silence (the
+/// hostile review of issue 10).
+#[test]
+fn resume_reads_past_a_bad_line_and_says_what_it_does_not_reuse() {
+    let (dir, out, o) = run_text("badline", VALID);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let path = out.join("t/results.jsonl");
+    let text = fs::read(&path).expect("results");
+    let lines: Vec<&[u8]> = text
+        .split(|&b| b == b'\n')
+        .filter(|l| !l.is_empty())
+        .collect();
+    let total = lines.len();
+    // A line of invalid UTF-8 after the second line.
+    let mut broken = Vec::new();
+    for (i, l) in lines.iter().enumerate() {
+        broken.extend_from_slice(l);
+        broken.push(b'\n');
+        if i == 1 {
+            broken.extend_from_slice(b"\xff\xfe not a result\n");
+        }
+    }
+    fs::write(&path, &broken).expect("write");
+    let o = bin()
+        .args(["run", "--resume", "--out"])
+        .arg(&out)
+        .arg(dir.join("e.json"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let msg = stderr(&o);
+    assert!(
+        msg.contains(
+            "--resume does not reuse 1 unreadable line(s), 0 result(s) of another version"
+        ),
+        "{msg}"
+    );
+    // Every job's line is back, none run twice: the lines after the bad
+    // one were reused.
+    let after = fs::read_to_string(&path).expect("results");
+    assert_eq!(after.lines().count(), total, "{after}");
+    // Reused lines are kept verbatim (a job run again has another time).
+    for l in &lines {
+        let l = String::from_utf8_lossy(l);
+        assert!(after.lines().any(|a| a == l), "not reused: {l}");
+    }
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -315,15 +315,42 @@ pub fn jobs<F: Family>(exp: &Experiment<F>, shard: Option<(usize, usize)>) -> Ve
 
 /// Reads the complete, parseable lines of a results file for `hash`.
 pub fn read_results(path: &Path, hash: Option<&str>) -> Vec<JobResult> {
+    read_results_counted(path, hash).0
+}
+
+/// Lines of a results file that were not read back.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Unread {
+    /// Lines that are not a job's result (torn by a kill, edited, not UTF-8).
+    pub unreadable: usize,
+    /// Results of another version of the experiment file (another hash).
+    pub other_version: usize,
+}
+
+/// [`read_results`], and how many lines it passed over: each line on its
+/// own, so one bad line (torn, or not UTF-8) no longer ends the reading and
+/// silently drops every line after it.
+pub fn read_results_counted(path: &Path, hash: Option<&str>) -> (Vec<JobResult>, Unread) {
+    let mut unread = Unread::default();
     let Ok(file) = File::open(path) else {
-        return Vec::new();
+        return (Vec::new(), unread);
     };
-    BufReader::new(file)
-        .lines()
-        .map_while(Result::ok)
-        .filter_map(|l| serde_json::from_str::<JobResult>(&l).ok())
-        .filter(|r| hash.is_none_or(|h| r.experiment_hash == h))
-        .collect()
+    let mut out = Vec::new();
+    for line in BufReader::new(file).split(b'\n') {
+        let Ok(line) = line else {
+            unread.unreadable += 1;
+            break;
+        };
+        if line.iter().all(u8::is_ascii_whitespace) {
+            continue;
+        }
+        match serde_json::from_slice::<JobResult>(&line) {
+            Err(_) => unread.unreadable += 1,
+            Ok(r) if hash.is_some_and(|h| r.experiment_hash != h) => unread.other_version += 1,
+            Ok(r) => out.push(r),
+        }
+    }
+    (out, unread)
 }
 
 /// Writes `text` to `path` atomically (a temporary file, then a rename), so a
@@ -364,10 +391,28 @@ pub fn run_experiment(
         // Lines of this experiment file and this lightquad version only, one per
         // job (the last wins).
         let mut by_key = BTreeMap::new();
-        for r in read_results(&path, Some(exp.hash())) {
+        let (read, unread) = read_results_counted(&path, Some(exp.hash()));
+        let mut other_release = 0;
+        for r in read {
             if r.version == env!("CARGO_PKG_VERSION") {
                 by_key.insert(r.key(), r);
+            } else {
+                other_release += 1;
             }
+        }
+        // Lines not reused are said, not dropped in silence (their jobs run
+        // again).
+        if unread != Unread::default() || other_release > 0 {
+            eprintln!(
+                "{}: --resume does not reuse {} unreadable line(s), {} result(s) of another \
+                 version of the experiment file and {} of another lightquad release in {}: \
+                 their jobs run again",
+                exp.name(),
+                unread.unreadable,
+                unread.other_version,
+                other_release,
+                path.display()
+            );
         }
         by_key.into_values().collect()
     } else {
