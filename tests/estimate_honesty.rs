@@ -13,6 +13,16 @@
 //! smooth, endpoint-singular, kinked and discontinuous integrands. Every exact
 //! value below is an elementary antiderivative evaluated at the ends, stated
 //! beside the integrand; none comes from the code under test.
+//!
+//! What is and is not detectable. A rule sees an integrand only at its
+//! nodes. A feature no node comes near (a Gaussian of width 1e-4 between
+//! the nodes of a 256-evaluation rule) reads as zero everywhere and no rule
+//! can report it: those cases are not asserted. A feature the nodes see but
+//! do not resolve (one node carrying most of the sum, as at a narrow
+//! Lorentzian) is flagged; where the nodes resolve it, the estimate must be
+//! honest. Node sets that nest a single coarser rule (composite rules at
+//! `n = 2^k - 1`) cannot show a chance agreement of two differences; the
+//! cusp sweep runs at nested budgets.
 
 mod common;
 use common::rng;
@@ -440,5 +450,261 @@ fn estimates_at_random_jump_and_kink_positions_rarely_lie() {
             share <= allowed,
             "{name}: {lies} of {total} estimates below a tenth of the true error, unflagged"
         );
+    }
+}
+
+/// Counts `(lies, total)` over `cases`: a lie is an estimate below a tenth
+/// of the true error (above 1e-13 relative to `max(1, |I|)`) that the rule
+/// does not doubt.
+fn tally(cases: impl Iterator<Item = (lightquad::Estimate<f64>, f64)>) -> (usize, usize) {
+    let (mut lies, mut total) = (0, 0);
+    for (e, exact) in cases {
+        let truth = (e.value - exact).abs();
+        if truth > ROUNDING * exact.abs().max(1.0) {
+            total += 1;
+            if e.reliable && (e.error.is_nan() || e.error < HONEST * truth) {
+                lies += 1;
+            }
+        }
+    }
+    (lies, total)
+}
+
+/// An interior square-root cusp `|x - c|^0.5` at 200 random `c`, at every
+/// budget `2^k + 1` from 17 to 16385 (node sets that nest the 4h and 8h
+/// rules): `int_0^1 |x - c|^0.5 dx = (2/3) (c^1.5 + (1 - c)^1.5)` (the
+/// antiderivative `-(2/3)(c - x)^1.5` below `c`, `(2/3)(x - c)^1.5` above).
+/// Its error oscillates with `h`, so `Q_h` and `Q_2h` can agree by chance:
+/// the single-ratio check let trapezoid estimates fall to 1.4e-3 of the
+/// truth and Simpson's to 1.6e-4 (c = 0.5663, n = 2049); measured now:
+/// no lie, smallest estimate/true 0.2, for the composite rules;
+/// Gauss–Legendre and Gauss–Kronrod one each (below; Gauss–Kronrod's is
+/// its QUADPACK panel estimate, not changed here). The bounds hold those
+/// figures, so a regression fails. (Budgets whose
+/// node sets nest only the 2h rule, `n = 2^k - 1`, are not covered: one
+/// difference cannot show a chance agreement; see `richardson`.)
+#[test]
+fn estimates_at_random_square_root_cusps_do_not_lie() {
+    use lightquad::quadrature::AnyRule;
+    use rand::{RngExt, SeedableRng};
+    let mut pick = rand_pcg::Pcg64::seed_from_u64(7);
+    let cusps: Vec<f64> = (0..200).map(|_| pick.random_range(0.01..0.99)).collect();
+    // Gauss–Legendre: one lie, at n = 17, c = 0.0105 (a cusp that close
+    // to an end is half an endpoint singularity; estimate/true 0.025).
+    for (name, allowed) in [
+        ("trapezoid", 0),
+        ("simpson", 0),
+        ("gauss-legendre", 1),
+        ("gauss-kronrod", 1),
+    ] {
+        let rule = AnyRule::by_name(name).expect("a rule");
+        let cases = cusps.iter().flat_map(|&c| {
+            let rule = &rule;
+            (4..=14).map(move |k| {
+                let n = (1usize << k) + 1;
+                let exact = 2.0 / 3.0 * (c.powf(1.5) + (1.0 - c).powf(1.5));
+                let e = rule
+                    .integrate::<1, f64, _, _>(n, &mut rng(0), |p: [f64; 1]| {
+                        (p[0] - c).abs().sqrt()
+                    })
+                    .expect("finite");
+                (e, exact)
+            })
+        });
+        let (lies, total) = tally(cases);
+        assert!(
+            lies <= allowed,
+            "{name}: {lies} of {total} cusp estimates lie unflagged"
+        );
+    }
+}
+
+/// Narrow interior peaks, Lorentzians `1/(w^2 + (x - c)^2)` of width `w` =
+/// 1e-2, 1e-3, 1e-4 at 50 random `c` (never on a node), budgets 17 to 60
+/// and `2^k +- 1` up to 16385:
+/// `int_0^1 = (atan((1 - c)/w) + atan(c/w)) / w` (antiderivative
+/// `atan((x - c)/w)/w`). Where the nodes do not resolve the peak the true
+/// error is up to its whole mass `~pi/w`, which no difference of rules on
+/// those nodes bounds: the rules doubt the estimate (one node carries the
+/// sum). Gauss–Legendre on `1/(1e-8 + (x - 0.3)^2)` at n = 18..50 and
+/// Simpson lied unflagged by up to 1e-9 and 1e-7 before (GL 64, 341 and
+/// 1583 lies at the three widths, Simpson 376, 1447, 2699, over 50 centres
+/// and n = 2..60 and 17..16385). Measured now, of about 3200 each: no lie
+/// for Gauss–Legendre; trapezoid 1 (w = 1e-2, n = 511, a node set nesting
+/// one difference only, 0.019); Simpson 1 (w = 1e-3) and 4 (w = 1e-4);
+/// Gauss–Kronrod none for w >= 1e-3 and 18 of 1194 at w = 1e-4 (run from
+/// n = 45: below it, with one to two panels, 51 more lie, the peak between
+/// nodes that all lie in its tails). The bounds hold these figures, so a
+/// regression fails.
+#[test]
+fn estimates_on_narrow_interior_peaks_are_honest_or_doubted() {
+    use lightquad::quadrature::AnyRule;
+    use rand::{RngExt, SeedableRng};
+    let mut pick = rand_pcg::Pcg64::seed_from_u64(7);
+    let centres: Vec<f64> = (0..50).map(|_| pick.random_range(0.01..0.99)).collect();
+    let budgets: Vec<usize> = (17..=60)
+        .chain((5..=14).flat_map(|k| [(1usize << k) - 1, (1 << k) + 1]))
+        .collect();
+    for name in ["trapezoid", "simpson", "gauss-legendre", "gauss-kronrod"] {
+        let rule = AnyRule::by_name(name).expect("a rule");
+        let from = if name == "gauss-kronrod" { 45 } else { 17 };
+        for w in [1e-2, 1e-3, 1e-4] {
+            let cases = centres.iter().flat_map(|&c| {
+                let (rule, budgets) = (&rule, &budgets);
+                budgets.iter().filter(move |&&n| n >= from).map(move |&n| {
+                    let exact = (((1.0 - c) / w).atan() + (c / w).atan()) / w;
+                    let e = rule
+                        .integrate::<1, f64, _, _>(n, &mut rng(0), |p: [f64; 1]| {
+                            1.0 / (w * w + (p[0] - c) * (p[0] - c))
+                        })
+                        .expect("finite");
+                    (e, exact)
+                })
+            });
+            let (lies, total) = tally(cases);
+            // The measured counts (module doc above) are the bounds.
+            let allowed = match (name, w) {
+                ("trapezoid", 1e-2) | ("simpson", 1e-3) => 1,
+                ("simpson", 1e-4) => 4,
+                ("gauss-kronrod", 1e-4) => 18,
+                _ => 0,
+            };
+            assert!(
+                lies <= allowed,
+                "{name}, w = {w}: {lies} of {total} peak estimates lie unflagged"
+            );
+        }
+    }
+    // The probe's case: GL on 1/(1e-8 + (x - 0.3)^2), n = 18..50.
+    let exact = (0.7e4f64.atan() + 0.3e4f64.atan()) * 1e4;
+    let cases = (18..=50).map(|n| {
+        let e = GaussLegendre::default()
+            .integrate(n, &mut rng(0), |p: [f64; 1]| {
+                1.0 / (1e-8 + (p[0] - 0.3).powi(2))
+            })
+            .expect("finite");
+        (e, exact)
+    });
+    assert_eq!(tally(cases).0, 0);
+}
+
+/// Gauss–Legendre below 16 nodes on kinks `|x - c|` and jumps (200 random
+/// `c`, m = 2..15): `int |x - c| = (c^2 + (1 - c)^2)/2`, `int [x >= c] =
+/// 1 - c`. The consecutive orders agree by chance (estimates of exactly 0
+/// against errors of 1e-4 and 1e-2, 301 and 205 of 2800 lies before): no
+/// check holds at these orders, and the estimate is doubted.
+#[test]
+fn gauss_legendre_below_sixteen_nodes_is_doubted_on_kinks_and_jumps() {
+    use rand::{RngExt, SeedableRng};
+    let mut pick = rand_pcg::Pcg64::seed_from_u64(7);
+    let mut total = 0;
+    for _ in 0..200 {
+        let c: f64 = pick.random_range(0.01..0.99);
+        for m in 2..16 {
+            let kink = GaussLegendre::default()
+                .integrate(m, &mut rng(0), |p: [f64; 1]| (p[0] - c).abs())
+                .expect("finite");
+            let jump = GaussLegendre::default()
+                .integrate(m, &mut rng(0), |p: [f64; 1]| step(p[0], c))
+                .expect("finite");
+            let (l, t) = tally([(kink, kink_integral(c)), (jump, 1.0 - c)].into_iter());
+            assert_eq!(l, 0, "c = {c}, m = {m}");
+            total += t;
+        }
+    }
+    assert!(total > 5000, "{total} cases above rounding");
+}
+
+/// Product rules in two dimensions on a diagonal jump `[x + y < s]` and a
+/// diagonal kink `|x + y - s|`, s in {0.37, 0.731, 0.9, 1.234, 1.5}, 5 to
+/// 70 nodes per axis. With `t = x + y` (density `t` on [0, 1], `2 - t` on
+/// [1, 2]): the area below the line is `s^2/2` for `s <= 1` and
+/// `1 - (2 - s)^2/2` above (0.405 at s = 0.9); `int int |x + y - s| =
+/// (1 - s) + 2 int_{t<s} (s - t) t dt = 1 - s + s^3/3` for `s <= 1`
+/// (0.343 at 0.9), and `s - 1 + (2 - s)^3/3` above by the symmetry
+/// `t -> 2 - t`. Measured: no lie on the jump for trapezoid, Simpson and
+/// Gauss–Legendre (smallest estimate/true 0.11, 0.20, 0.25); on the kink
+/// trapezoid none, Simpson 4 of 355 (m = 37..40, node sets that nest one
+/// ratio only, smallest 0.094) and Gauss–Legendre 1 of 355 (m = 21,
+/// 0.066): the bound allows those, so a regression fails.
+#[test]
+fn product_rules_on_diagonal_jumps_and_kinks_rarely_lie() {
+    use lightquad::quadrature::AnyRule;
+    for (name, allowed_jump, allowed_kink) in [
+        ("trapezoid", 0, 0),
+        ("simpson", 0, 4),
+        ("gauss-legendre", 0, 1),
+    ] {
+        let rule = AnyRule::by_name(name).expect("a rule");
+        let (mut jump, mut kink) = (Vec::new(), Vec::new());
+        for s in [0.9f64, 0.37, 0.731, 1.234, 1.5] {
+            let area = if s <= 1.0 {
+                s * s / 2.0
+            } else {
+                1.0 - (2.0 - s) * (2.0 - s) / 2.0
+            };
+            let mean = if s <= 1.0 {
+                1.0 - s + s.powi(3) / 3.0
+            } else {
+                s - 1.0 + (2.0 - s).powi(3) / 3.0
+            };
+            for m in 5..=70usize {
+                let n = m * m;
+                let e = rule
+                    .integrate::<2, f64, _, _>(n, &mut rng(0), |p: [f64; 2]| {
+                        if p[0] + p[1] < s { 1.0 } else { 0.0 }
+                    })
+                    .expect("finite");
+                jump.push((e, area));
+                let e = rule
+                    .integrate::<2, f64, _, _>(n, &mut rng(0), |p: [f64; 2]| {
+                        (p[0] + p[1] - s).abs()
+                    })
+                    .expect("finite");
+                kink.push((e, mean));
+            }
+        }
+        let (lj, tj) = tally(jump.into_iter());
+        let (lk, tk) = tally(kink.into_iter());
+        assert!(lj <= allowed_jump, "{name} diagonal jump: {lj} of {tj} lie");
+        assert!(lk <= allowed_kink, "{name} diagonal kink: {lk} of {tk} lie");
+    }
+}
+
+/// Gauss–Kronrod spends its budget (with no tolerance) even where every
+/// node reads zero, so a narrow Gaussian `exp(-((x - c)/w)^2)` is found once
+/// the budget's even refinement puts a node on it:
+/// `int_0^1 = w sqrt(pi)/2 (erf((1 - c)/w) + erf(c/w)) = w sqrt(pi)` to
+/// f64 precision for `w <= 1e-3` and `c` in [0.1, 0.9] (`erfc(100) < 1e-4000`).
+/// A Gaussian narrower than every node spacing of the budget reads zero at
+/// every node and is undetectable by any rule: not asserted.
+#[test]
+fn gauss_kronrod_spends_the_budget_and_finds_a_narrow_gaussian() {
+    use rand::{RngExt, SeedableRng};
+    let w = 1e-3;
+    let exact = w * std::f64::consts::PI.sqrt();
+    let mut pick = rand_pcg::Pcg64::seed_from_u64(7);
+    for _ in 0..50 {
+        let c: f64 = 0.1 + 0.8 * pick.random_range(0.0..1.0);
+        for n in [256usize, 1000, 4096] {
+            let e = GaussKronrod::default()
+                .integrate(n, &mut rng(0), |p: [f64; 1]| {
+                    (-((p[0] - c) / w).powi(2)).exp()
+                })
+                .expect("finite");
+            // Two panels a bisection: the budget is spent to within 29.
+            assert!(
+                e.evaluations as usize + 30 > n && e.evaluations as usize <= n,
+                "{n}: {}",
+                e.evaluations
+            );
+            let truth = (e.value - exact).abs();
+            assert!(
+                truth <= 0.1 * exact && (e.error >= HONEST * truth || !e.reliable),
+                "c = {c}, n = {n}: value {} (exact {exact}), estimate {:.2e}",
+                e.value,
+                e.error
+            );
+        }
     }
 }

@@ -56,7 +56,7 @@ fn weights(m: usize, h: f64, stride: usize) -> Vec<f64> {
 
 /// The m-point Simpson rule on `[0, 1]` (m odd, >= 3), with the `2h` companion
 /// (a Simpson rule itself when `m = 4k + 1`, which the rule uses), and the
-/// `4h` Simpson rule when `m = 8k + 1`.
+/// `4h` Simpson rule when `m = 8k + 1` and the `8h` one when `m = 16k + 1`.
 /// Checked: `m` outside the rule's point counts (or above [`MAX_POINTS`],
 /// whose table would not fit in memory) is an error, not a panic.
 pub fn unit_nodes(m: usize) -> Result<UnitNodes, QuadError> {
@@ -76,6 +76,8 @@ fn table(m: usize) -> UnitNodes {
         companion: Some(weights(m, h, 2)),
         // The 4h Simpson rule on every fourth point, when the points nest it.
         companion4: (m % 8 == 1).then(|| weights(m, h, 4)),
+        // The 8h Simpson rule, kept only at its own points (entry j for 8j).
+        companion8: (m % 16 == 1).then(|| weights(m, h, 8).into_iter().step_by(8).collect()),
     }
 }
 

@@ -33,7 +33,8 @@ const COMPOSITE: Composite = Composite {
 pub struct Trapezoid;
 
 /// The m-point trapezoid rule on `[0, 1]` (m odd, >= 3) with the `2h`
-/// companion, and the `4h` rule when `m = 4k + 1`.
+/// companion, the `4h` rule when `m = 4k + 1` and the `8h` rule when
+/// `m = 8k + 1`.
 /// Checked: `m` outside the rule's point counts (or above [`MAX_POINTS`],
 /// whose table would not fit in memory) is an error, not a panic.
 pub fn unit_nodes(m: usize) -> Result<UnitNodes, QuadError> {
@@ -68,11 +69,19 @@ fn table(m: usize) -> UnitNodes {
             })
             .collect()
     });
+    // The 8h rule on every eighth point (entry j for point 8j).
+    let companion8 = (m % 8 == 1).then(|| {
+        let k = (m - 1) / 8;
+        (0..=k)
+            .map(|j| if j == 0 || j == k { 4.0 * h } else { 8.0 * h })
+            .collect()
+    });
     UnitNodes {
         u,
         w,
         companion: Some(companion),
         companion4,
+        companion8,
     }
 }
 
