@@ -139,7 +139,9 @@ pub const FLAG_LEGEND: &str = "Flags: `failed` (the job's reason follows); `non-
 the root mean square over channels of error / standard error above 4); \
 `estimate off by more than 10x` (a deterministic error estimate, above the rounding floor); \
 `error estimate unreliable (rule's own check)` (the rule doubts its own estimate: a \
-deterministic rule whose differences do not shrink the way its order says, or a random one whose \
+deterministic rule too small to check it (below 16 Gauss–Legendre nodes or 17 composite points \
+per axis), whose differences do not shrink the way its order says, or whose sum one node \
+carries; or a random one whose \
 samples were all alike, a constant integrand included, since nothing was seen to vary, or whose \
 sample variance is carried by a few samples); `error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
 parts); `underflows: log space` (the value is below the smallest f64; its logarithm is exact: ask for `ln_tau`); \
