@@ -77,9 +77,25 @@ impl QuadError {
     ) -> Self {
         QuadError::InvalidParameter {
             name: name.into(),
-            value: value.to_string(),
+            value: shortened(value.to_string()),
             accepted: accepted.into(),
         }
+    }
+}
+
+/// A value as a person reads it in a message: a long number in scientific
+/// notation (1e200 was echoed as its 201 digits), and any other text cut
+/// after 200 characters (a 10 MB name was echoed whole).
+pub fn shortened(value: String) -> String {
+    const LONGEST: usize = 200;
+    if value.len() > 24
+        && let Ok(x) = value.parse::<f64>()
+    {
+        return format!("{x:e}");
+    }
+    match value.char_indices().nth(LONGEST) {
+        Some((cut, _)) => format!("{}... ({} bytes)", &value[..cut], value.len()),
+        None => value,
     }
 }
 

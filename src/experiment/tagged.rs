@@ -150,6 +150,12 @@ where
 /// types (`expected f64`, `expected usize`).
 pub fn plain_words(message: &str) -> String {
     let mut m = message.to_string();
+    // A Rust struct's name means nothing to a user: "expected struct
+    // SceneSpec" (or "... with 11 elements", when a list was given).
+    if let Some(i) = m.find("expected struct ") {
+        let head = m[..i].replace("invalid length", "a list of length");
+        m = format!("{head}expected an object ({{\"field\": value, ...}})");
+    }
     for (rust, words) in [
         ("expected f64", "expected a number"),
         ("expected f32", "expected a number"),
@@ -159,8 +165,11 @@ pub fn plain_words(message: &str) -> String {
         ("expected u64", "expected a whole number >= 0"),
         ("expected u32", "expected a whole number >= 0"),
     ] {
+        // The Rust type ends the message or is followed by a note.
         if let Some(head) = m.strip_suffix(rust) {
             m = format!("{head}{words}");
+        } else {
+            m = m.replace(&format!("{rust} "), &format!("{words} "));
         }
     }
     m

@@ -357,7 +357,16 @@ macro_rules! registry {
             /// Reads `{"rule": "<name>", <parameters>}`; a fault is returned with
             /// the path of its field below the rule (`rel_tol`) and what is wrong.
             pub fn from_json(value: &serde_json::Value) -> Result<BaseRule, (String, String)> {
-                let mut params = value.as_object().cloned().unwrap_or_default();
+                let Some(object) = value.as_object() else {
+                    return Err((
+                        String::new(),
+                        format!(
+                            "{value} is not a rule: expected {{\"rule\": <name>, <parameters>}}, the name one of {}",
+                            [$($name),+].join(", ")
+                        ),
+                    ));
+                };
+                let mut params = object.clone();
                 let tag = params.remove("rule");
                 match tag.as_ref().and_then(|t| t.as_str()) {
                     $(Some($name) => parameters::<$rule>(params).map(BaseRule::$rule),)+

@@ -55,6 +55,12 @@ pub struct GaussianBlob {
     pub width: f64,
 }
 
+/// The narrowest blob width accepted.
+pub const MIN_WIDTH: f64 = 1e-150;
+
+/// The widest blob width accepted.
+pub const MAX_WIDTH: f64 = 1e150;
+
 /// A sum of Gaussian blobs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GaussianBlobs {
@@ -73,11 +79,16 @@ impl GaussianBlobs {
                     "a finite density >= 0",
                 ));
             }
-            if !(b.width.is_finite() && b.width > 0.0) {
+            // |x - c|^2 / (2 w^2) must not overflow or divide by an
+            // underflowed w^2: a width of 1e200 gave NaN at every node (and
+            // 1e-300 a density that is 0 but at the centre).
+            if !(b.width.is_finite() && (MIN_WIDTH..=MAX_WIDTH).contains(&b.width)) {
                 return Err(QuadError::invalid(
                     format!("blobs[{i}].width"),
                     b.width,
-                    "a finite width > 0",
+                    format!(
+                        "a width in [{MIN_WIDTH:e}, {MAX_WIDTH:e}] (its square is then a normal number)"
+                    ),
                 ));
             }
         }
