@@ -40,7 +40,10 @@ fn nodes_and_weights_match_40_digit_tables_for_n_up_to_100() {
             // The table only has x rounded to f64, so 1 - |x| is known to
             // an absolute ulp here (the large-n test checks it relatively).
             let k = if x[i] < 0.0 { i + 1 } else { n - i };
-            assert!((half_node(n, k).one_minus_x - (1.0 - x[i].abs())).abs() <= EPS);
+            assert!(
+                (half_node(n, k).expect("valid node").one_minus_x - (1.0 - x[i].abs())).abs()
+                    <= EPS
+            );
         }
     }
 }
@@ -66,7 +69,7 @@ fn sampled_nodes_match_40_digit_values_for_large_n() {
                     t.x[i],
                     sign * x
                 );
-                let got = half_node(n, k).one_minus_x;
+                let got = half_node(n, k).expect("valid node").one_minus_x;
                 assert!(
                     rel(got, y) <= 2.0 * EPS,
                     "n={n} k={k}: 1-|x| {got} vs {y} ({:.1} ulps)",
@@ -93,7 +96,7 @@ fn shifted_monomial(t: &lightquad::quadrature::gauss_legendre::Table, d: i32) ->
     let n = t.x.len();
     lightquad::sum::sum_f64(t.x.iter().zip(&t.w).enumerate().map(|(i, (x, w))| {
         let k = if *x < 0.0 { i + 1 } else { n - i };
-        let y = half_node(n, k).one_minus_x;
+        let y = half_node(n, k).expect("valid node").one_minus_x;
         let power = if *x < 0.0 {
             (0.5 * y).powi(d)
         } else {
@@ -248,4 +251,17 @@ fn the_error_estimate_tracks_the_truth_for_algebraic_and_geometric_convergence()
             );
         }
     }
+}
+
+/// `half_node` refuses what has no node (it returned NaN for n = 0 and a
+/// node outside [-1, 1] for k past the middle; the hostile review of issue
+/// 10), and its last valid k is the middle node, 0 for odd n.
+#[test]
+fn half_node_refuses_orders_and_indices_that_have_no_node() {
+    for (n, k, field) in [(0, 0, "n"), (5, 0, "k"), (5, 4, "k"), (4, 3, "k")] {
+        let e = half_node(n, k).expect_err("refused").to_string();
+        assert!(e.contains(&format!("invalid {field} =")), "{n} {k}: {e}");
+    }
+    let middle = half_node(5, 3).expect("the middle node");
+    assert_eq!(middle.one_minus_x, 1.0);
 }

@@ -66,8 +66,23 @@ pub fn check_order(n: usize) -> Result<usize, QuadError> {
     }
 }
 
-/// The k-th node from `x = +1` (k in 1..=ceil(n/2)).
-pub fn half_node(n: usize, k: usize) -> HalfNode {
+/// The k-th node from `x = +1` of the n-node rule; `n` outside
+/// `1..=MAX_ORDER` or `k` outside `1..=ceil(n/2)` is an error (`half_node(0,
+/// 0)` was NaN, and `k` past the middle gave a node outside `[-1, 1]`).
+pub fn half_node(n: usize, k: usize) -> Result<HalfNode, QuadError> {
+    let n = check_order(n)?;
+    if !(1..=n.div_ceil(2)).contains(&k) {
+        return Err(QuadError::invalid(
+            "k",
+            k,
+            format!("a node index in 1..={} for n = {n}", n.div_ceil(2)),
+        ));
+    }
+    Ok(node_unchecked(n, k))
+}
+
+/// [`half_node`] for an `n` and `k` the caller has checked.
+fn node_unchecked(n: usize, k: usize) -> HalfNode {
     let mut node = bogaert::node(n, k);
     if n <= NEWTON_MAX_ORDER {
         node = newton::node(n, k, node);
@@ -115,7 +130,7 @@ fn fill_symmetric(
             bessel::TABULATED.saturating_sub(first_k - 1).min(len)
         };
         for i in 0..special {
-            store(i, half_node(n, first_k + i));
+            store(i, node_unchecked(n, first_k + i));
         }
         // Four nodes per step in lock step (SIMD lanes), then the remainder.
         macro_rules! bulk {
@@ -160,7 +175,7 @@ fn fill_symmetric(
     }
     // The middle node of an odd rule.
     if let (Some(xm), Some(wm)) = (x_mid.first_mut(), w_mid.first_mut()) {
-        let node = half_node(n, lower + 1);
+        let node = node_unchecked(n, lower + 1);
         *xm = place(&node).1;
         *wm = scale * node.weight;
     }
