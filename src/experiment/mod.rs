@@ -311,6 +311,14 @@ fn write_reports(
     let mut problems = missing;
     for (exp, results) in done {
         let dir = out.join(exp.name());
+        // A converged reference is computed now, after the jobs: say so, or
+        // a long one looks like a hang (a scene of radius 1e308 took minutes).
+        if let Some(n) = exp.converged_reference() {
+            eprintln!(
+                "{}: computing the converged reference (n = {n}, doubled until it converges)",
+                exp.name()
+            );
+        }
         let written = exp.write_report(&dir, results).map_err(|e| io(&dir, e))?;
         entries.push((
             exp.name().to_string(),

@@ -59,6 +59,9 @@ pub trait Loaded: Send + Sync {
     fn run_job(&self, key: JobKey) -> JobResult;
     /// Writes its report page from `results` into `dir`.
     fn write_report(&self, dir: &Path, results: &[JobResult]) -> Result<Written, String>;
+    /// The `n` of a converged reference, which the report computes first
+    /// (it can take longer than the jobs; the runner says so).
+    fn converged_reference(&self) -> Option<usize>;
 }
 
 impl<F: Family> Loaded for Experiment<F> {
@@ -82,6 +85,12 @@ impl<F: Family> Loaded for Experiment<F> {
     }
     fn run_job(&self, key: JobKey) -> JobResult {
         run_job(self, key)
+    }
+    fn converged_reference(&self) -> Option<usize> {
+        match &self.spec.reference {
+            super::spec::ReferenceSpec::Converged(c) => Some(c.n),
+            _ => None,
+        }
     }
     fn write_report(&self, dir: &Path, results: &[JobResult]) -> Result<Written, String> {
         let reference = reference(self);
