@@ -1544,3 +1544,32 @@ fn resume_reads_past_a_bad_line_and_says_what_it_does_not_reuse() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A value near the top of the range against a reference of the other sign:
+/// their difference overflowed, and the report showed a true error of `inf`
+/// where it is |I_E - r| / |r| = 1.38 (the hostile review of issue 10, M4).
+/// I_E = c (1 - e^{-sigma L}) / sigma with c = 1.7e308, sigma = 2, L = 2
+/// sqrt(1 - 0.3^2), against the literal reference -1.7e308.
+#[test]
+fn true_errors_near_the_top_of_the_range_do_not_overflow() {
+    let text = VALID
+        .replace("\"c\": 1.0", "\"c\": 1.7e308")
+        .replace("[\"tau\", \"I_E\"]", "[\"I_E\"]")
+        .replace("[4, 16, 64]", "[16]")
+        .replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"value\", \"values\": { \"I_E\": -1.7e308 } }",
+        );
+    let (dir, out, o) = run_text("toperr", &text);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+    let chord = 2.0 * (1.0f64 - 0.09).sqrt();
+    let exact = 1.7e308 / 2.0 * (1.0 - (-2.0 * chord).exp());
+    let want = format!("| {:.2e} |", exact / 1.7e308 + 1.0);
+    let row = report
+        .lines()
+        .find(|l| l.starts_with("| gauss-legendre | 16 |"))
+        .expect("row");
+    assert!(row.contains(&want), "{want} in {row}");
+    let _ = fs::remove_dir_all(&dir);
+}

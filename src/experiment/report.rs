@@ -285,11 +285,21 @@ fn row(
     if value.iter().any(|v| !v.is_finite()) && !flags.contains(&RowFlag::NonFinite) {
         flags.push(RowFlag::NonFinite);
     }
-    // True error: the root mean square over repeats and channels.
+    // True error: the root mean square over repeats and channels. Near the
+    // top of the range the halves are subtracted and the result doubled
+    // (exact for normal numbers): 1.7e308 against -1.7e308 overflowed to an
+    // error of inf.
+    let huge = reference.iter().any(|r| r.abs() > f64::MAX / 2.0)
+        || measured
+            .iter()
+            .flat_map(|m| &m.value)
+            .any(|v| v.abs() > f64::MAX / 2.0);
+    let (halve, double) = if huge { (0.5, 2.0) } else { (1.0, 1.0) };
     let diffs = measured.iter().flat_map(|m| {
-        (0..channels.max(m.value.len())).map(|c| channel(&m.value, c) - channel(reference, c))
+        (0..channels.max(m.value.len()))
+            .map(move |c| channel(&m.value, c) * halve - channel(reference, c) * halve)
     });
-    let rel_error = rms(diffs.collect::<Vec<_>>().into_iter()) / scale;
+    let rel_error = rms(diffs.collect::<Vec<_>>().into_iter()) / scale * double;
     let rel_estimate = measured
         .iter()
         .map(|m| rms(m.error.iter().copied()) / count)
