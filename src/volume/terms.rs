@@ -206,7 +206,7 @@ fn depth_by_quadrature<R: Rule, Rg: rand::Rng + ?Sized>(
 
 /// The optical depth from the start of `pieces` to `t`, for the outer nodes of
 /// V-E and V-L, by either scheme.
-struct DepthAlong<'a, R: Rule> {
+struct DepthAlong<'a, 'p, R: Rule> {
     medium: &'a Counted<'a>,
     lambda: f64,
     ray: Ray,
@@ -219,7 +219,7 @@ struct DepthAlong<'a, R: Rule> {
     /// its smooth pieces' midpoints tell the medium which field a node
     /// belongs to (a gap or a graded sub-piece near the entry point can be
     /// so short that its own midpoint rounds outside the medium).
-    support: Segment,
+    support: Option<&'p Segment>,
     /// Visited `t -> depth from the piece start` (cumulative scheme), each
     /// depth carried with its rounding error (a compensated sum), so a chain
     /// of `n` gaps does not accumulate `n` roundings.
@@ -241,12 +241,18 @@ impl Ord for Key {
     }
 }
 
-impl<R: Rule> DepthAlong<'_, R> {
-    fn start_piece(&mut self, piece: &Segment, support: &Segment) {
-        self.support = support.clone();
+impl<'p, R: Rule> DepthAlong<'_, 'p, R> {
+    fn start_piece(&mut self, piece: &Segment, support: &'p Segment) {
+        self.support = Some(support);
         self.checkpoints.clear();
         self.checkpoints
             .insert(Key(piece.start()), Compensated::new());
+    }
+
+    /// The smooth midpoint of the support piece around `t` (`t` itself
+    /// before a piece is started).
+    fn witness(&self, t: f64) -> f64 {
+        self.support.map_or(t, |p| p.smooth_mid(t))
     }
 
     /// `lambda int_lo^hi v_r` with the gap rule on panels no longer than
@@ -265,7 +271,7 @@ impl<R: Rule> DepthAlong<'_, R> {
         for b in inner.chain(std::iter::once(hi)) {
             let panels = ((b - a) / longest).ceil().max(1.0) as usize;
             let width = (b - a) / panels as f64;
-            let mid = self.support.smooth_mid(0.5 * (a + b));
+            let mid = self.witness(0.5 * (a + b));
             // Panel j is [p_j, p_{j+1}] with p_0 = a, p_panels = b and its
             // length the difference of the ends as stored, so the lengths
             // telescope to b - a: a chain of n gaps then carries no rounding
@@ -292,13 +298,14 @@ impl<R: Rule> DepthAlong<'_, R> {
         rng: &mut Rg,
     ) -> Result<f64, QuadError> {
         let lambda = self.lambda;
-        let (medium, ray, support) = (self.medium, self.ray, &self.support);
+        let (medium, ray, support) = (self.medium, self.ray, self.support);
         match self.scheme {
             DepthScheme::Nested => {
                 let part = piece.restrict(piece.start(), t)?;
                 Ok(part
                     .try_integrate_pieces(self.rule, self.n, rng, |s, mid| {
-                        Ok(lambda * medium.density(&ray, s, support.smooth_mid(mid)))
+                        let mid = support.map_or(mid, |p| p.smooth_mid(mid));
+                        Ok(lambda * medium.density(&ray, s, mid))
                     })?
                     .value)
             }
@@ -594,7 +601,7 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
             rule,
             n,
             gap: unit_nodes(GAP_NODES)?,
-            support: Segment::new(0.0, 0.0)?,
+            support: None,
             checkpoints: BTreeMap::new(),
         };
         let mut total = Estimate::zero();
