@@ -29,7 +29,7 @@ use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::nodes::{UnitNodes, dominated, product_sum};
+use super::nodes::{ROUNDING_ULPS, UnitNodes, dominated, product_sum};
 use super::{Rule, integer_root, per_axis};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
@@ -297,9 +297,6 @@ fn tail_estimate(q: f64, q1: f64, q2: f64) -> f64 {
 /// with it from 16, 0 once an inconsistent tail also takes `|d1|`).
 pub const HYBRID_FROM: usize = 16;
 
-/// A difference of two rules at most this many `eps` times `sum |w f|` is
-/// rounding: the rule has converged.
-const ROUNDING_ULPS: f64 = 128.0;
 
 /// The error of `Q_m` (`m >= 16`) from the consecutive orders `m-1, m-2` and
 /// the half order `h = ceil(m/2)`: `q = [Q_m, Q_{m-1}, Q_{m-2}, Q_h]`,
