@@ -19,6 +19,7 @@
 //! | `simpson` | composite Simpson, product in D > 1 | Richardson, half step; observed order from the quarter step when nested |
 //! | `gauss-legendre` | Gauss–Legendre of any order, product in D > 1 | tail of the differences of `Q_m, Q_{m-1}, Q_{m-2}`, checked against `Q_m - Q_{m/2}` from m = 16 |
 //! | `gauss-kronrod` | adaptive Gauss–Kronrod G7–K15 (D = 1) | embedded G7 |
+//! | `genz-malik` | adaptive Genz–Malik degree-7 cubature (2 <= D <= 6), bisecting the worst box (as HCubature) | embedded degree-5 rule |
 //! | `monte-carlo` | plain Monte Carlo | standard error; doubted when all samples agree or the sample variance is carried by a few samples (kurtosis) |
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of every three neighbouring cells; doubted when none varies |
 //! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles, times t_{R-1}(0.975)/1.96; doubted when the scrambles agree or the points fail the Monte Carlo tail check |
@@ -433,6 +434,7 @@ registry! {
     simpson::Simpson = "simpson",
     gauss_legendre::GaussLegendre = "gauss-legendre",
     gauss_kronrod::GaussKronrod = "gauss-kronrod",
+    genz_malik::GenzMalik = "genz-malik",
     monte_carlo::MonteCarlo = "monte-carlo",
     stratified::Stratified = "stratified",
     sobol::Sobol = "sobol",
