@@ -175,17 +175,19 @@ fn genz_malik_box<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Quad
     let f0 = eval(centre)?;
     seen(f0, w7[0], &mut class[0]);
     let mut fourth = [0.0; D];
-    for i in 0..D {
+    for (i, slot) in fourth.iter_mut().enumerate() {
         let (a, b) = (eval(at(&[(i, L2)]))?, eval(at(&[(i, -L2)]))?);
         let (c, d) = (eval(at(&[(i, L3)]))?, eval(at(&[(i, -L3)]))?);
         for (y, k) in [(a, 1), (b, 1), (c, 2), (d, 2)] {
             seen(y, w7[k], &mut class[k]);
         }
         let ratio = (L2 / L3) * (L2 / L3);
-        fourth[i] = (0..V::CHANNELS)
+        *slot = (0..V::CHANNELS)
             .map(|ch| {
-                let (f0, a, b, c, d) = (f0.channel(ch), a.channel(ch), b.channel(ch), c.channel(ch), d.channel(ch));
-                (a + b - 2.0 * f0 - ratio * (c + d - 2.0 * f0)).abs()
+                let centre = 2.0 * f0.channel(ch);
+                let inner = a.channel(ch) + b.channel(ch) - centre;
+                let outer = c.channel(ch) + d.channel(ch) - centre;
+                (inner - ratio * outer).abs()
             })
             .fold(0.0, f64::max);
     }
