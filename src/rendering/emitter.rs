@@ -570,14 +570,17 @@ impl<V: Value> Emitter<V> for SphereLight<V> {
 
     /// The nearer root of the robust ray–sphere roots beyond `t_min`: `L_e`
     /// when it is the entering root (`x` outside), zero from inside. A ray
-    /// that misses by at most `RIM_TOL R` touches the sphere at the foot of
-    /// the perpendicular from the centre, `t = (c - x) . w`.
+    /// that misses by at most `RIM_TOL R + 16 eps d` (`d = |c - x|`: the
+    /// rounding of a unit direction, `~eps` rad, moves the ray by `eps d` at
+    /// the sphere) touches the sphere at the foot of the perpendicular from
+    /// the centre, `t = (c - x) . w`.
     fn hit(&self, x: Vec3, w: Vec3, t_min: f64) -> Option<EmitterHit<V>> {
         let Some((t0, t1)) = self.shape.line_roots(x, w) else {
             let to_centre = self.shape.centre - x;
             let t = to_centre.dot(&w);
             let h = (to_centre - w * t).norm();
-            return (h <= self.shape.radius * (1.0 + RIM_TOL) && t > t_min).then_some(EmitterHit {
+            let slack = self.shape.radius * RIM_TOL + 16.0 * f64::EPSILON * to_centre.norm();
+            return (h <= self.shape.radius + slack && t > t_min).then_some(EmitterHit {
                 distance: t,
                 radiance: self.radiance,
             });
