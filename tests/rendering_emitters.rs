@@ -59,7 +59,10 @@ fn triangle_solid_angle(a: Vec3, b: Vec3, c: Vec3) -> f64 {
 
 /// The lights of the sampling tests with the solid angle each subtends
 /// from the origin (for the environment: the hemisphere about `+z`).
-fn lights() -> Result<Vec<(&'static str, AnyEmitter<f64>, f64)>, QuadError> {
+/// A named light with the solid angle it subtends.
+type Light = (&'static str, AnyEmitter<f64>, f64);
+
+fn lights() -> Result<Vec<Light>, QuadError> {
     let (o, e1, e2) = (v(-0.5, 0.2, 1.5), v(0.3, 1.1, 0.4), v(1.2, -0.2, -0.1));
     let rect = RectangleLight::new(o, e1, e2, 1.0)?;
     let rect_omega =
