@@ -128,8 +128,8 @@ fn cases() -> Result<Vec<Case>, QuadError> {
     });
     // Phong under a sphere on the normal: L k_s int_cone cos^(n+1) theta d w
     // = L k_s 2 pi (1 - cos^(n+2) alpha) / (n + 2).
-    let (d, r) = (3.0, 1.0);
-    let cos_alpha = ((d * d - r * r) as f64).sqrt() / d;
+    let (d, r): (f64, f64) = (3.0, 1.0);
+    let cos_alpha = (d * d - r * r).sqrt() / d;
     out.push(Case {
         name: "phong n=30, sphere on the normal",
         scene: Scene::new(vec![SphereLight::new(v(0.0, 0.0, d), r, l)?.into()], vec![]),
