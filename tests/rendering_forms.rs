@@ -661,3 +661,37 @@ fn bad_input_is_named() {
         "wo"
     );
 }
+
+/// The integrands are plain closures over the domains of
+/// `lightquad::domain`: `integrate_over` takes them with any rule (here
+/// scrambled Sobol' on R-A over a triangle's Duffy map and on R-H over the
+/// projected hemisphere), and an emitter index past the scene is an error
+/// naming `k`.
+#[test]
+fn integrands_are_closures_for_integrate_over() -> Result<(), QuadError> {
+    use lightquad::domain::integrate_over;
+    use lightquad::quadrature::Sobol;
+    use lightquad::rendering::emitter::Emitter;
+    let case = triangle_case()?;
+    let (scene, x) = (&case.scene, &case.receiver);
+    let sobol = AnyRule::by_name("sobol")?;
+    let domain = scene.emitters()[0].surface(x)?;
+    let g = forms::area_integrand(scene, x, &Irradiance, 0)?;
+    let a = integrate_over(&sobol, &domain, 1 << 12, &mut rng(50), g)?;
+    let hemisphere = x.hemisphere(HemisphereMap::Projected);
+    let g = forms::hemispherical_integrand(scene, x, &Irradiance, HemisphereMap::Projected);
+    let h = integrate_over(&Sobol::default(), &hemisphere, 1 << 14, &mut rng(51), g)?;
+    for (label, e) in [("R-A sobol", a), ("R-H sobol", h)] {
+        eprintln!(
+            "{label}: rel {:.1e} z {:+.2}",
+            rel(e.value, case.exact),
+            (e.value - case.exact) / e.error
+        );
+        assert!((e.value - case.exact).abs() < 4.0 * e.error, "{label}");
+    }
+    match forms::area_integrand(scene, x, &Irradiance, 1) {
+        Err(QuadError::InvalidParameter { name, .. }) => assert_eq!(name, "k"),
+        _ => panic!("index 1 of a one-light scene accepted"),
+    }
+    Ok(())
+}

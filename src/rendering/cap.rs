@@ -1,8 +1,8 @@
 //! A spherical cap given by its height fraction `k = 1 - cos theta_max`
 //! rather than by `cos theta_max`: the visible cap of a sphere light seen
-//! from a point, and the cone of directions a light subtends (a cap of the
-//! unit sphere about the origin, whose points are directions and whose area
-//! is solid angle).
+//! from a point (a domain of R-A), and the cone of directions a light
+//! subtends (a cap of the unit sphere about the origin, whose points are
+//! directions and whose area is solid angle: a domain of R-H).
 //!
 //! The map is the area-uniform (Archimedes) map of
 //! [`crate::domain::SphericalCap`]:

@@ -285,18 +285,26 @@ pub fn cone_integrand<'a, V: Value, K: Kernel>(
 /// (y - x)/r`, `cos theta = n . wi`, `cos theta' = -n_y . wi`, each clamped
 /// at 0 (R-A, the geometry term `g` of R-3P); for a light at infinity, whose
 /// domain is its cap of directions, `w -> L_e K(w) cos theta V(x, w)`.
-/// Zero without a shadow ray where the cosines or the kernel vanish.
+/// Zero without a shadow ray where the cosines or the kernel vanish. An
+/// index `k` past the scene's emitters is an error naming `k`.
 pub fn area_integrand<'a, V: Value, K: Kernel>(
     scene: &'a Scene<V>,
     receiver: &'a Receiver,
     kernel: &'a K,
     k: usize,
-) -> impl Fn(Vec3) -> V + 'a {
+) -> Result<impl Fn(Vec3) -> V + 'a, QuadError> {
     let x = receiver.point();
-    let emitter = &scene.emitters()[k];
+    let count = scene.emitters().len();
+    let emitter = scene.emitters().get(k).ok_or_else(|| {
+        QuadError::invalid(
+            "k",
+            k,
+            format!("an emitter index below {count}, the scene's number of emitters"),
+        )
+    })?;
     let infinite = emitter.at_infinity();
     let radiance = emitter.radiance();
-    move |y: Vec3| {
+    Ok(move |y: Vec3| {
         if infinite {
             let cos = receiver.cos_theta(y);
             let weight = if cos > 0.0 { kernel.weight(y) } else { 0.0 };
@@ -323,7 +331,7 @@ pub fn area_integrand<'a, V: Value, K: Kernel>(
         }
         let g = weight * cos * cos_light / r2;
         radiance.map(|l| l * g)
-    }
+    })
 }
 
 /// R-H over the receiver's hemisphere with the map `map` and a budget of
@@ -404,7 +412,7 @@ pub fn area<V: Value, K: Kernel, R: Rule, G: rand::Rng + ?Sized>(
     let mut total = Estimate::zero();
     for (k, e) in scene.emitters().iter().enumerate() {
         let domain = e.surface(receiver)?;
-        let g = area_integrand(scene, receiver, kernel, k);
+        let g = area_integrand(scene, receiver, kernel, k)?;
         let part = integrate_over(rule, &domain, n, rng, g)?;
         total = total.combine(part);
     }
