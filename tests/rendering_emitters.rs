@@ -115,6 +115,16 @@ fn sample_density_matches_the_density_of_its_direction() -> Result<(), QuadError
                 if s.distance.is_finite() {
                     assert!((x.point() + s.wi * s.distance - s.point).norm() < 1e-12);
                 }
+                // pdf_w = pdf_A r^2 / cos theta' for area samples.
+                if let Some(pdf_area) = s.pdf_area {
+                    let cos_light = -light.normal_at(s.point).dot(&s.wi);
+                    let converted = pdf_area * s.distance * s.distance / cos_light;
+                    assert!(
+                        rel(converted, s.pdf) < 1e-12,
+                        "{name}: {converted} vs {}",
+                        s.pdf
+                    );
+                }
             }
             assert!(some > 0, "{name} {how:?}: no sample");
         }

@@ -112,6 +112,10 @@ pub struct LightSample<V: Value> {
     pub point: Vec3,
     /// The density in solid angle of the sampling map at `wi`.
     pub pdf: f64,
+    /// For area sampling of a finite light, the density per unit area
+    /// `pdf_A = 1 / |J(u)|` of the point (`pdf = pdf_A r^2 / cos theta'`);
+    /// `None` for cone sampling and lights at infinity.
+    pub pdf_area: Option<f64>,
     /// `L_e` toward the receiver (zero where a cone sample meets the back).
     pub radiance: V,
 }
@@ -249,6 +253,7 @@ pub trait Emitter<V: Value> {
                     distance: r,
                     point: y,
                     pdf: r * r / (jacobian * cos_light),
+                    pdf_area: Some(1.0 / jacobian),
                     radiance: self.radiance(),
                 })
             }
@@ -271,6 +276,7 @@ pub trait Emitter<V: Value> {
                         wi
                     },
                     pdf: 1.0 / jacobian,
+                    pdf_area: None,
                     radiance: hit.radiance,
                 })
             }
