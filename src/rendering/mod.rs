@@ -2,6 +2,24 @@
 //! emitters and occluders, and the hemispherical (R-H) and area (R-A)
 //! forms of reflected radiance and irradiance at a point.
 //!
+//! | module | what |
+//! |---|---|
+//! | [`brdf`] | `f_r` with sampling, pdf and inverse (Lambert, Phong, normalised Phong, GGX) |
+//! | [`emitter`] | Lambertian rectangle, disk, triangle and sphere lights, a uniform environment, a cap light; ray hits, surface maps, light sampling |
+//! | [`occluder`] | opaque spheres, disks, rectangles, triangles and their ray intersection |
+//! | [`receiver`] | the point `x` with its normal where `E` and `L_r` are evaluated |
+//! | [`scene`] | incident radiance `L_i(x, w)` and visibility `V(x, y)` |
+//! | [`forms`] | R-H and R-A integrands for any rule, over the hemisphere, a BRDF-sampled map, emitter cones and emitter surfaces |
+//! | [`mis`] | multiple importance sampling of light and BRDF samples (balance, power heuristics) |
+//! | [`cap`] | spherical caps and cones of directions given by `1 - cos theta_max` |
+//!
 //! Closed forms live in [`crate::exact::rendering`].
 
 pub mod brdf;
+pub mod cap;
+pub mod emitter;
+pub mod forms;
+pub mod mis;
+pub mod occluder;
+pub mod receiver;
+pub mod scene;

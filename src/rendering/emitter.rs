@@ -1,0 +1,866 @@
+//! Emitters of the rendering family: Lambertian area lights (rectangle,
+//! disk, triangle, sphere) of radiance `L_e`, a uniform environment and a
+//! spherical-cap light (uniform radiance from a cone of directions at
+//! infinity: a distant sphere, the sun), each of scalar or RGB radiance
+//! ([`Value`]).
+//!
+//! Each emitter can
+//!
+//! - say whether the ray from `x` along `w` hits it, at what distance and
+//!   with what radiance toward `x` ([`Emitter::hit`]: `L_e` on the emitting
+//!   side, 0 on the back of a one-sided planar light or from inside a
+//!   sphere);
+//! - give the domain of the area form R-A seen from a receiver
+//!   ([`Emitter::surface`]): its own surface through the parameterisations
+//!   of [`crate::domain`] (a rectangle, the polar map of a disk, the Duffy
+//!   map of a triangle) with their Jacobians, for a sphere the cap of it
+//!   visible from `x` ([`Cap`], uniform in area, `1 - cos = (d - R)/d`), for
+//!   lights at infinity their cap of directions (whose measure is solid
+//!   angle);
+//! - give the cone of directions from `x` that contains it
+//!   ([`Emitter::cone`]): exact for a sphere, a cap light and a disk seen
+//!   from its axis, the cone of a bounding sphere otherwise;
+//! - be sampled ([`Emitter::sample`]) by area through its surface map or by
+//!   its cone, uniformly in solid angle, with the density in solid angle
+//!   [`Emitter::pdf`]: by area `pdf_w = pdf_A r^2 / cos theta'` with
+//!   `pdf_A = 1 / |J(u)|` (R-A's change of variables `d omega = cos theta'
+//!   dA / r^2`), by cone `pdf_w = 1 / (2 pi (1 - cos alpha))`. Cone sampling
+//!   is the better one for a small or distant sphere, whose visible cap's
+//!   area samples have nearly equal weight only when `r` and `cos theta'`
+//!   vary little.
+//!
+//! Planar lights emit from the side their normal points to (rectangle: `e_1
+//! x e_2`; triangle `(b - a) x (c - b)`; disk: its normal) and block light
+//! on both sides.
+//!
+//! ```
+//! use std::f64::consts::PI;
+//! use lightquad::domain::Vec3;
+//! use lightquad::rendering::emitter::{DiskLight, Emitter, LightSampling};
+//! use lightquad::rendering::receiver::Receiver;
+//!
+//! // A disk light of radius 1 at height 1 facing down onto the origin.
+//! let disk = DiskLight::new(Vec3::new(0.0, 0.0, 1.0), -Vec3::z(), 1.0, 2.0)?;
+//! let hit = disk.hit(Vec3::zeros(), Vec3::z(), 0.0).ok_or(lightquad::QuadError::invalid("hit", 0, "a hit"))?;
+//! assert_eq!((hit.distance, hit.radiance), (1.0, 2.0));
+//! // Sampled through its cone (exact on the axis): pdf 1 / (2 pi (1 - cos 45°)).
+//! let x = Receiver::new(Vec3::zeros(), Vec3::z())?;
+//! let s = disk.sample(&x, LightSampling::Cone, [0.5, 0.5]).ok_or(lightquad::QuadError::invalid("u", 0, "a sample"))?;
+//! assert!((s.pdf * 2.0 * PI * (1.0 - 0.5f64.sqrt()) - 1.0).abs() < 1e-13);
+//! assert!((disk.pdf(&x, LightSampling::Cone, s.wi) - s.pdf).abs() < 1e-12 * s.pdf);
+//! // Negative radiance is an error naming the parameter.
+//! assert!(DiskLight::new(Vec3::zeros(), Vec3::z(), 1.0, -1.0).is_err());
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
+
+use crate::domain::{Disk, Domain, Rectangle, Triangle, Vec3};
+use crate::error::QuadError;
+use crate::geometry::{Sphere, normalize};
+use crate::rendering::cap::{Cap, one_minus_cos_between, one_minus_cos_from_sin};
+use crate::rendering::occluder::{
+    Occluder, intersect_disk, intersect_parallelogram, intersect_triangle,
+};
+use crate::rendering::receiver::Receiver;
+use crate::value::Value;
+
+/// The relative slack of an emitter's outline in [`Emitter::hit`]: a ray
+/// passing within `RIM_TOL R` outside the rim of a disk or sphere light (or
+/// `RIM_TOL k` outside a cap light's cone) counts as a hit. The outline of
+/// a light is closed, and a rule that puts nodes on the exact outline of its
+/// cone (trapezoid, Simpson: `u_1 = 1`) must see the limit from inside, not
+/// a coin flip of rounding (the trapezoid rule over a coaxial disk's cone
+/// kept 1.8e-3 relative error at 64 x 64 nodes from it). The light grows by
+/// at most `RIM_TOL` relative: far below the 1e-10 the tests ask.
+pub const RIM_TOL: f64 = 1e-12;
+
+/// Checks a radiance: every channel finite and `>= 0`.
+pub fn check_radiance<V: Value>(name: &str, radiance: V) -> Result<V, QuadError> {
+    if (0..V::CHANNELS).all(|c| {
+        let x = radiance.channel(c);
+        x.is_finite() && x >= 0.0
+    }) {
+        Ok(radiance)
+    } else {
+        Err(QuadError::invalid(
+            name,
+            format!("{radiance:?}"),
+            "a radiance with every channel finite and >= 0",
+        ))
+    }
+}
+
+/// Where a ray meets an emitter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EmitterHit<V: Value> {
+    /// Distance along the unit direction; `f64::INFINITY` for a light at
+    /// infinity.
+    pub distance: f64,
+    /// The radiance the emitter sends back along the ray: `L_e` on its
+    /// emitting side, zero on its back.
+    pub radiance: V,
+}
+
+/// A direction sampled toward an emitter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSample<V: Value> {
+    /// Unit world direction from the receiver toward the light.
+    pub wi: Vec3,
+    /// Distance to the light's surface (`f64::INFINITY` at infinity).
+    pub distance: f64,
+    /// The point on the light (`x + distance wi`; for a light at infinity,
+    /// `wi`).
+    pub point: Vec3,
+    /// The density in solid angle of the sampling map at `wi`.
+    pub pdf: f64,
+    /// For area sampling of a finite light, the density per unit area
+    /// `pdf_A = 1 / |J(u)|` of the point (`pdf = pdf_A r^2 / cos theta'`);
+    /// `None` for cone sampling and lights at infinity.
+    pub pdf_area: Option<f64>,
+    /// `L_e` toward the receiver (zero where a cone sample meets the back).
+    pub radiance: V,
+}
+
+/// How an emitter is sampled for light sampling and MIS.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LightSampling {
+    /// Through the surface map of [`Emitter::surface`], `pdf_w = r^2 /
+    /// (|J(u)| cos theta')` (R-A's change of variables).
+    Area,
+    /// Uniformly over the cone of [`Emitter::cone`], `pdf_w = 1 / (2 pi (1
+    /// - cos alpha))`.
+    Cone,
+}
+
+/// The domain of R-A for one emitter: its surface through a map of the
+/// unit square, or a cap of directions for a light at infinity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightDomain {
+    /// A parallelogram, `|J| = |e_1 x e_2|`.
+    Rectangle(Rectangle),
+    /// A disk, polar map, `|J| = 2 pi R^2 u_1`.
+    Disk(Disk),
+    /// A triangle, Duffy map, `|J| = 2 A u_1`.
+    Triangle(Triangle),
+    /// A cap of a sphere (or of the sphere of directions), `|J| = 2 pi R^2 k`.
+    Cap(Cap),
+}
+
+impl Domain<2> for LightDomain {
+    type Point = Vec3;
+
+    fn map(&self, u: [f64; 2]) -> (Vec3, f64) {
+        match self {
+            LightDomain::Rectangle(d) => d.map(u),
+            LightDomain::Disk(d) => d.map(u),
+            LightDomain::Triangle(d) => d.map(u),
+            LightDomain::Cap(d) => d.map(u),
+        }
+    }
+
+    fn invert(&self, p: &Vec3) -> Option<[f64; 2]> {
+        match self {
+            LightDomain::Rectangle(d) => d.invert(p),
+            LightDomain::Disk(d) => d.invert(p),
+            LightDomain::Triangle(d) => d.invert(p),
+            LightDomain::Cap(d) => d.invert(p),
+        }
+    }
+
+    fn measure(&self) -> f64 {
+        match self {
+            LightDomain::Rectangle(d) => d.measure(),
+            LightDomain::Disk(d) => d.measure(),
+            LightDomain::Triangle(d) => d.measure(),
+            LightDomain::Cap(d) => d.measure(),
+        }
+    }
+}
+
+/// The cone of directions from `x` that contains the sphere about `centre`
+/// of radius `radius`: `sin alpha = R / d`, or the whole sphere of
+/// directions for `x` inside it.
+fn bounding_cone(x: Vec3, centre: Vec3, radius: f64) -> Result<Cap, QuadError> {
+    let to_centre = centre - x;
+    let d = to_centre.norm();
+    if d <= radius {
+        return Cap::directions(Vec3::z(), 2.0);
+    }
+    Cap::directions(to_centre / d, one_minus_cos_from_sin(radius / d)?)
+}
+
+/// An emitter (R-H's `L_e`, R-A's emitting surface).
+pub trait Emitter<V: Value> {
+    /// The emitted radiance `L_e`.
+    fn radiance(&self) -> V;
+
+    /// True for lights at infinity (the environment, a cap light): they
+    /// have no surface in the scene, block nothing, and are reached by every
+    /// ray that no finite surface stops.
+    fn at_infinity(&self) -> bool {
+        false
+    }
+
+    /// The first point beyond `t_min` at which the ray `x + t w` (unit `w`)
+    /// meets the emitter, with the radiance it sends back along the ray.
+    fn hit(&self, x: Vec3, w: Vec3, t_min: f64) -> Option<EmitterHit<V>>;
+
+    /// The domain of R-A seen from the receiver (module documentation).
+    fn surface(&self, receiver: &Receiver) -> Result<LightDomain, QuadError>;
+
+    /// The unit normal of the emitting side at a point `y` of the surface
+    /// (for a light at infinity, `-y`, so that `cos theta' = 1`).
+    fn normal_at(&self, y: Vec3) -> Vec3;
+
+    /// The cone of directions from the receiver that contains the emitter
+    /// (module documentation).
+    fn cone(&self, receiver: &Receiver) -> Result<Cap, QuadError>;
+
+    /// The emitter as an occluder of other emitters' light (`None` at
+    /// infinity).
+    fn occluder(&self) -> Option<Occluder>;
+
+    /// A direction toward the emitter from `u` in `[0, 1]^2` by `how`, with
+    /// its density in solid angle; `None` where the map's point sends no
+    /// light toward `x` (the back of the light, its rim, a cone direction
+    /// that misses it) or the receiver's domain cannot be built (`x` inside
+    /// a sphere light).
+    ///
+    /// By area (R-A's change of variables): `y = map(u)`, `r = |y - x|`,
+    /// `pdf_w = r^2 / (|J(u)| cos theta')`; by cone: `w = map(u)`, `pdf_w =
+    /// 1 / |J|`.
+    fn sample(
+        &self,
+        receiver: &Receiver,
+        how: LightSampling,
+        u: [f64; 2],
+    ) -> Option<LightSample<V>> {
+        let x = receiver.point();
+        match how {
+            LightSampling::Area if !self.at_infinity() => {
+                let (y, jacobian) = self.surface(receiver).ok()?.map(u);
+                let d = y - x;
+                let r = d.norm();
+                if !(jacobian > 0.0 && r > 0.0) {
+                    return None;
+                }
+                let wi = d / r;
+                let cos_light = -self.normal_at(y).dot(&wi);
+                if cos_light <= 0.0 || cos_light.is_nan() {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    distance: r,
+                    point: y,
+                    pdf: r * r / (jacobian * cos_light),
+                    pdf_area: Some(1.0 / jacobian),
+                    radiance: self.radiance(),
+                })
+            }
+            _ => {
+                let domain = match how {
+                    LightSampling::Area => self.surface(receiver).ok()?,
+                    LightSampling::Cone => LightDomain::Cap(self.cone(receiver).ok()?),
+                };
+                let (wi, jacobian) = domain.map(u);
+                if jacobian <= 0.0 || jacobian.is_nan() {
+                    return None;
+                }
+                let hit = self.hit(x, wi, 0.0)?;
+                Some(LightSample {
+                    wi,
+                    distance: hit.distance,
+                    point: if hit.distance.is_finite() {
+                        x + wi * hit.distance
+                    } else {
+                        wi
+                    },
+                    pdf: 1.0 / jacobian,
+                    pdf_area: None,
+                    radiance: hit.radiance,
+                })
+            }
+        }
+    }
+
+    /// The density in solid angle with which [`Emitter::sample`] by `how`
+    /// produces the unit direction `w` (0 where it cannot).
+    fn pdf(&self, receiver: &Receiver, how: LightSampling, w: Vec3) -> f64 {
+        let x = receiver.point();
+        match how {
+            LightSampling::Cone => match self.cone(receiver) {
+                Ok(cone) if cone.contains_direction(w) => 1.0 / cone.measure(),
+                _ => 0.0,
+            },
+            LightSampling::Area => {
+                let Ok(surface) = self.surface(receiver) else {
+                    return 0.0;
+                };
+                if self.at_infinity() {
+                    return match surface.invert(&w) {
+                        Some(u) => 1.0 / surface.map(u).1,
+                        None => 0.0,
+                    };
+                }
+                let Some(hit) = self.hit(x, w, 0.0) else {
+                    return 0.0;
+                };
+                let y = x + w * hit.distance;
+                let cos_light = -self.normal_at(y).dot(&w);
+                let Some(u) = surface.invert(&y) else {
+                    return 0.0;
+                };
+                let jacobian = surface.map(u).1;
+                if cos_light > 0.0 && jacobian > 0.0 {
+                    hit.distance * hit.distance / (jacobian * cos_light)
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+}
+
+/// The radiance `value` toward a ray of direction `w` meeting a one-sided
+/// planar light of normal `n`: `L_e` when `n . w < 0` (the ray arrives on the
+/// emitting side), else zero.
+fn one_sided<V: Value>(radiance: V, n: Vec3, w: Vec3) -> V {
+    if n.dot(&w) < 0.0 { radiance } else { V::zero() }
+}
+
+/// A Lambertian parallelogram light `o + a e_1 + b e_2` emitting `L_e` on the
+/// side of `e_1 x e_2`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RectangleLight<V: Value> {
+    shape: Rectangle,
+    radiance: V,
+}
+
+impl<V: Value> RectangleLight<V> {
+    /// The light at `origin` spanned by `edge_u`, `edge_v` (finite, not
+    /// parallel) of radiance `radiance` (finite, `>= 0`).
+    pub fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3, radiance: V) -> Result<Self, QuadError> {
+        Ok(RectangleLight {
+            shape: Rectangle::new(origin, edge_u, edge_v)?,
+            radiance: check_radiance("radiance", radiance)?,
+        })
+    }
+
+    /// The parallelogram.
+    pub fn shape(&self) -> &Rectangle {
+        &self.shape
+    }
+}
+
+impl<V: Value> Emitter<V> for RectangleLight<V> {
+    fn radiance(&self) -> V {
+        self.radiance
+    }
+
+    fn hit(&self, x: Vec3, w: Vec3, t_min: f64) -> Option<EmitterHit<V>> {
+        let t = intersect_parallelogram(&self.shape, x, w, t_min, f64::INFINITY)?;
+        Some(EmitterHit {
+            distance: t,
+            radiance: one_sided(self.radiance, self.shape.normal(), w),
+        })
+    }
+
+    /// The parallelogram, `|J| = |e_1 x e_2|` (uniform in area).
+    fn surface(&self, _: &Receiver) -> Result<LightDomain, QuadError> {
+        Ok(LightDomain::Rectangle(self.shape))
+    }
+
+    fn normal_at(&self, _: Vec3) -> Vec3 {
+        self.shape.normal()
+    }
+
+    /// The cone of the circumscribed sphere (centre `o + (e_1 + e_2)/2`,
+    /// radius the half of the longer diagonal).
+    fn cone(&self, receiver: &Receiver) -> Result<Cap, QuadError> {
+        let (e1, e2) = (self.shape.edge_u(), self.shape.edge_v());
+        let centre = self.shape.origin() + (e1 + e2) * 0.5;
+        let radius = 0.5 * (e1 + e2).norm().max((e1 - e2).norm());
+        bounding_cone(receiver.point(), centre, radius)
+    }
+
+    fn occluder(&self) -> Option<Occluder> {
+        Some(Occluder::Rectangle(self.shape))
+    }
+}
+
+/// A Lambertian disk light emitting `L_e` on the side of its normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DiskLight<V: Value> {
+    shape: Disk,
+    /// The disk grown by `RIM_TOL` for [`Emitter::hit`].
+    rim: Disk,
+    radiance: V,
+}
+
+impl<V: Value> DiskLight<V> {
+    /// The disk about `centre` with normal `normal` (the emitting side) and
+    /// radius `radius`, of radiance `radiance` (finite, `>= 0`).
+    pub fn new(centre: Vec3, normal: Vec3, radius: f64, radiance: V) -> Result<Self, QuadError> {
+        let shape = Disk::new(centre, normal, radius)?;
+        Ok(DiskLight {
+            shape,
+            rim: Disk::new(centre, normal, radius * (1.0 + RIM_TOL))?,
+            radiance: check_radiance("radiance", radiance)?,
+        })
+    }
+
+    /// The disk.
+    pub fn shape(&self) -> &Disk {
+        &self.shape
+    }
+}
+
+impl<V: Value> Emitter<V> for DiskLight<V> {
+    fn radiance(&self) -> V {
+        self.radiance
+    }
+
+    /// The plane hit within `(1 + RIM_TOL) R` of the centre.
+    fn hit(&self, x: Vec3, w: Vec3, t_min: f64) -> Option<EmitterHit<V>> {
+        let t = intersect_disk(&self.rim, x, w, t_min, f64::INFINITY)?;
+        Some(EmitterHit {
+            distance: t,
+            radiance: one_sided(self.radiance, self.shape.frame().n, w),
+        })
+    }
+
+    /// The polar map `r = R u_1`, `|J| = 2 pi R^2 u_1` ([`Disk`]).
+    fn surface(&self, _: &Receiver) -> Result<LightDomain, QuadError> {
+        Ok(LightDomain::Disk(self.shape))
+    }
+
+    fn normal_at(&self, _: Vec3) -> Vec3 {
+        self.shape.frame().n
+    }
+
+    /// Seen from a point on its axis at height `h` (lateral offset at most
+    /// `1e-14 (|h| + R)`), the disk is exactly the circular cone `tan alpha =
+    /// R / |h|`, `1 - cos alpha = R^2 / (l (l + |h|))`, `l = sqrt(h^2 + R^2)`;
+    /// elsewhere the cone of the sphere about its centre of radius `R`.
+    fn cone(&self, receiver: &Receiver) -> Result<Cap, QuadError> {
+        let (c, radius) = (self.shape.centre(), self.shape.radius());
+        let local = self.shape.frame().to_local(receiver.point() - c);
+        let (h, lateral) = (local.z.abs(), local.x.hypot(local.y));
+        if h > 0.0 && lateral <= 1e-14 * (h + radius) {
+            let l = h.hypot(radius);
+            let axis = self.shape.frame().n * (-local.z.signum());
+            return Cap::directions(axis, radius * radius / (l * (l + h)));
+        }
+        bounding_cone(receiver.point(), c, radius)
+    }
+
+    fn occluder(&self) -> Option<Occluder> {
+        Some(Occluder::Disk(self.shape))
+    }
+}
+
+/// A Lambertian triangle light `abc` emitting `L_e` on the side of `(b - a)
+/// x (c - b)` (counter-clockwise seen from the lit side).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriangleLight<V: Value> {
+    shape: Triangle,
+    radiance: V,
+}
+
+impl<V: Value> TriangleLight<V> {
+    /// The triangle `abc` (finite, non-degenerate) of radiance `radiance`.
+    pub fn new(a: Vec3, b: Vec3, c: Vec3, radiance: V) -> Result<Self, QuadError> {
+        Ok(TriangleLight {
+            shape: Triangle::new(a, b, c)?,
+            radiance: check_radiance("radiance", radiance)?,
+        })
+    }
+
+    /// The triangle.
+    pub fn shape(&self) -> &Triangle {
+        &self.shape
+    }
+}
+
+impl<V: Value> Emitter<V> for TriangleLight<V> {
+    fn radiance(&self) -> V {
+        self.radiance
+    }
+
+    fn hit(&self, x: Vec3, w: Vec3, t_min: f64) -> Option<EmitterHit<V>> {
+        let t = intersect_triangle(&self.shape, x, w, t_min, f64::INFINITY)?;
+        Some(EmitterHit {
+            distance: t,
+            radiance: one_sided(self.radiance, self.shape.normal(), w),
+        })
+    }
+
+    /// The Duffy map `p = a + u_1 (b - a) + u_1 u_2 (c - b)`, `|J| = 2 A u_1`.
+    fn surface(&self, _: &Receiver) -> Result<LightDomain, QuadError> {
+        Ok(LightDomain::Triangle(self.shape))
+    }
+
+    fn normal_at(&self, _: Vec3) -> Vec3 {
+        self.shape.normal()
+    }
+
+    /// The cone of the sphere about the centroid through the farthest vertex.
+    fn cone(&self, receiver: &Receiver) -> Result<Cap, QuadError> {
+        let v = self.shape.vertices();
+        let centroid = (v[0] + v[1] + v[2]) / 3.0;
+        let radius = v.iter().fold(0.0_f64, |m, p| m.max((p - centroid).norm()));
+        bounding_cone(receiver.point(), centroid, radius)
+    }
+
+    fn occluder(&self) -> Option<Occluder> {
+        Some(Occluder::Triangle(self.shape))
+    }
+}
+
+/// A Lambertian sphere light: every point of the sphere emits `L_e`
+/// outward.
+///
+/// Seen from `x` at distance `d > R` from the centre, the sphere's visible
+/// part is the cap about the axis toward `x` with `cos theta_max = R / d`
+/// (the points whose tangent plane separates them from `x`), and it covers
+/// the cone of directions `sin alpha = R / d`. A fully visible sphere
+/// (above the receiver's horizon, `cos omega >= sin alpha`) gives the
+/// irradiance `E = pi L (R/d)^2 cos omega`
+/// ([`crate::exact::rendering::spherical_cap_irradiance`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SphereLight<V: Value> {
+    shape: Sphere,
+    radiance: V,
+}
+
+impl<V: Value> SphereLight<V> {
+    /// The sphere about `centre` (finite) of radius `radius` (finite, `> 0`)
+    /// of radiance `radiance`.
+    pub fn new(centre: Vec3, radius: f64, radiance: V) -> Result<Self, QuadError> {
+        Ok(SphereLight {
+            shape: Sphere::new(centre, radius)?,
+            radiance: check_radiance("radiance", radiance)?,
+        })
+    }
+
+    /// The sphere.
+    pub fn shape(&self) -> &Sphere {
+        &self.shape
+    }
+
+    /// The distance `d` from `x` to the centre and the unit axis from the
+    /// centre toward `x`; an error naming `point` for `x` inside or on the
+    /// sphere (the sphere emits outward only).
+    fn outside(&self, x: Vec3) -> Result<(f64, Vec3), QuadError> {
+        let from_centre = x - self.shape.centre;
+        let d = from_centre.norm();
+        if d <= self.shape.radius || d.is_nan() {
+            return Err(QuadError::invalid(
+                "point",
+                format!("{:?}", x.as_slice()),
+                format!(
+                    "a receiver outside the sphere light (centre {:?}, radius {})",
+                    self.shape.centre.as_slice(),
+                    self.shape.radius
+                ),
+            ));
+        }
+        Ok((d, from_centre / d))
+    }
+}
+
+impl<V: Value> Emitter<V> for SphereLight<V> {
+    fn radiance(&self) -> V {
+        self.radiance
+    }
+
+    /// The nearer root of the robust ray–sphere roots beyond `t_min`: `L_e`
+    /// when it is the entering root (`x` outside), zero from inside. A ray
+    /// that misses by at most `RIM_TOL R + 16 eps d` (`d = |c - x|`: the
+    /// rounding of a unit direction, `~eps` rad, moves the ray by `eps d` at
+    /// the sphere) touches the sphere at the foot of the perpendicular from
+    /// the centre, `t = (c - x) . w`.
+    fn hit(&self, x: Vec3, w: Vec3, t_min: f64) -> Option<EmitterHit<V>> {
+        let Some((t0, t1)) = self.shape.line_roots(x, w) else {
+            let to_centre = self.shape.centre - x;
+            let t = to_centre.dot(&w);
+            let h = (to_centre - w * t).norm();
+            let slack = self.shape.radius * RIM_TOL + 16.0 * f64::EPSILON * to_centre.norm();
+            return (h <= self.shape.radius + slack && t > t_min).then_some(EmitterHit {
+                distance: t,
+                radiance: self.radiance,
+            });
+        };
+        if t0 > t_min {
+            Some(EmitterHit {
+                distance: t0,
+                radiance: self.radiance,
+            })
+        } else if t1 > t_min {
+            Some(EmitterHit {
+                distance: t1,
+                radiance: V::zero(),
+            })
+        } else {
+            None
+        }
+    }
+
+    /// The cap visible from `x`: axis `(x - c)/d`, `1 - cos theta_max = (d -
+    /// R)/d`, uniform in area, `|J| = 2 pi R^2 (d - R)/d`.
+    fn surface(&self, receiver: &Receiver) -> Result<LightDomain, QuadError> {
+        let (d, axis) = self.outside(receiver.point())?;
+        let k = (d - self.shape.radius) / d;
+        Ok(LightDomain::Cap(Cap::new(
+            self.shape.centre,
+            axis,
+            self.shape.radius,
+            k,
+        )?))
+    }
+
+    fn normal_at(&self, y: Vec3) -> Vec3 {
+        (y - self.shape.centre) / self.shape.radius
+    }
+
+    /// `sin alpha = R / d`, `1 - cos alpha = s^2 / (1 + sqrt((1 - s)(1 +
+    /// s)))`, about the axis toward the centre.
+    fn cone(&self, receiver: &Receiver) -> Result<Cap, QuadError> {
+        let (d, axis) = self.outside(receiver.point())?;
+        Cap::directions(-axis, one_minus_cos_from_sin(self.shape.radius / d)?)
+    }
+
+    fn occluder(&self) -> Option<Occluder> {
+        Some(Occluder::Sphere(self.shape))
+    }
+}
+
+/// A uniform environment: radiance `L_e` arrives from every direction that
+/// no surface of the scene blocks. Over an unblocked hemisphere `E = pi L_e`.
+///
+/// Its domain for R-A and its cone are the receiver's hemisphere of
+/// directions (uniform map; the lower hemisphere adds nothing to R-H).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvironmentLight<V: Value> {
+    radiance: V,
+}
+
+impl<V: Value> EnvironmentLight<V> {
+    /// The environment of radiance `radiance` (finite, `>= 0`).
+    pub fn new(radiance: V) -> Result<Self, QuadError> {
+        Ok(EnvironmentLight {
+            radiance: check_radiance("radiance", radiance)?,
+        })
+    }
+}
+
+impl<V: Value> Emitter<V> for EnvironmentLight<V> {
+    fn radiance(&self) -> V {
+        self.radiance
+    }
+
+    fn at_infinity(&self) -> bool {
+        true
+    }
+
+    fn hit(&self, _: Vec3, _: Vec3, _: f64) -> Option<EmitterHit<V>> {
+        Some(EmitterHit {
+            distance: f64::INFINITY,
+            radiance: self.radiance,
+        })
+    }
+
+    /// The hemisphere about the receiver's normal, `|J| = 2 pi`.
+    fn surface(&self, receiver: &Receiver) -> Result<LightDomain, QuadError> {
+        Ok(LightDomain::Cap(self.cone(receiver)?))
+    }
+
+    fn normal_at(&self, y: Vec3) -> Vec3 {
+        -y
+    }
+
+    fn cone(&self, receiver: &Receiver) -> Result<Cap, QuadError> {
+        Cap::directions(receiver.normal(), 1.0)
+    }
+
+    fn occluder(&self) -> Option<Occluder> {
+        None
+    }
+}
+
+/// A spherical-cap light: uniform radiance `L_e` from the directions
+/// within `alpha` of `axis`, at infinity (a distant sphere light of angular
+/// radius `alpha`). `E / L_e = int_cap max(0, cos theta) d omega`, `pi sin^2
+/// alpha cos omega` when the cap is above the horizon, Snyder's formula when
+/// it crosses it ([`crate::exact::rendering::spherical_cap_irradiance`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CapLight<V: Value> {
+    cone: Cap,
+    radiance: V,
+}
+
+impl<V: Value> CapLight<V> {
+    /// The light of half-angle `half_angle` in `(0, pi]` about `axis`
+    /// (finite, non-zero), `1 - cos alpha = 2 sin^2(alpha / 2)` without
+    /// cancellation.
+    pub fn new(axis: Vec3, half_angle: f64, radiance: V) -> Result<Self, QuadError> {
+        if !(half_angle.is_finite() && half_angle > 0.0 && half_angle <= std::f64::consts::PI) {
+            return Err(QuadError::invalid(
+                "half_angle",
+                half_angle,
+                "an angle in (0, pi]",
+            ));
+        }
+        let s = (half_angle / 2.0).sin();
+        let axis = normalize("axis", axis)?;
+        Ok(CapLight {
+            cone: Cap::directions(axis, 2.0 * s * s)?,
+            radiance: check_radiance("radiance", radiance)?,
+        })
+    }
+
+    /// The light a sphere of radius `radius` at distance `distance` (`>
+    /// radius`) along `axis` subtends: `sin alpha = radius / distance`.
+    pub fn subtended(
+        axis: Vec3,
+        radius: f64,
+        distance: f64,
+        radiance: V,
+    ) -> Result<Self, QuadError> {
+        crate::error::require_positive("radius", radius)?;
+        crate::error::require_positive("distance", distance)?;
+        if distance <= radius {
+            return Err(QuadError::invalid(
+                "distance",
+                distance,
+                format!("a distance > radius = {radius}"),
+            ));
+        }
+        let axis = normalize("axis", axis)?;
+        Ok(CapLight {
+            cone: Cap::directions(axis, one_minus_cos_from_sin(radius / distance)?)?,
+            radiance: check_radiance("radiance", radiance)?,
+        })
+    }
+
+    /// The cone of directions.
+    pub fn cap(&self) -> &Cap {
+        &self.cone
+    }
+}
+
+impl<V: Value> Emitter<V> for CapLight<V> {
+    fn radiance(&self) -> V {
+        self.radiance
+    }
+
+    fn at_infinity(&self) -> bool {
+        true
+    }
+
+    /// `w` within the cone, `1 - w . axis <= (1 + RIM_TOL) k`.
+    fn hit(&self, _: Vec3, w: Vec3, _: f64) -> Option<EmitterHit<V>> {
+        let k = self.cone.one_minus_cos() * (1.0 + RIM_TOL);
+        (one_minus_cos_between(w, self.cone.axis()) <= k).then_some(EmitterHit {
+            distance: f64::INFINITY,
+            radiance: self.radiance,
+        })
+    }
+
+    /// The cone of directions, uniform in solid angle.
+    fn surface(&self, _: &Receiver) -> Result<LightDomain, QuadError> {
+        Ok(LightDomain::Cap(self.cone))
+    }
+
+    fn normal_at(&self, y: Vec3) -> Vec3 {
+        -y
+    }
+
+    fn cone(&self, _: &Receiver) -> Result<Cap, QuadError> {
+        Ok(self.cone)
+    }
+
+    fn occluder(&self) -> Option<Occluder> {
+        None
+    }
+}
+
+/// Any emitter of the family, for a scene's list.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyEmitter<V: Value> {
+    /// [`RectangleLight`].
+    Rectangle(RectangleLight<V>),
+    /// [`DiskLight`].
+    Disk(DiskLight<V>),
+    /// [`TriangleLight`].
+    Triangle(TriangleLight<V>),
+    /// [`SphereLight`].
+    Sphere(SphereLight<V>),
+    /// [`EnvironmentLight`].
+    Environment(EnvironmentLight<V>),
+    /// [`CapLight`].
+    Cap(CapLight<V>),
+}
+
+/// Forwards a method of [`Emitter`] to the variant's type.
+macro_rules! forward {
+    ($self:ident, $e:ident => $call:expr) => {
+        match $self {
+            AnyEmitter::Rectangle($e) => $call,
+            AnyEmitter::Disk($e) => $call,
+            AnyEmitter::Triangle($e) => $call,
+            AnyEmitter::Sphere($e) => $call,
+            AnyEmitter::Environment($e) => $call,
+            AnyEmitter::Cap($e) => $call,
+        }
+    };
+}
+
+impl<V: Value> Emitter<V> for AnyEmitter<V> {
+    fn radiance(&self) -> V {
+        forward!(self, e => e.radiance())
+    }
+
+    fn at_infinity(&self) -> bool {
+        forward!(self, e => e.at_infinity())
+    }
+
+    fn hit(&self, x: Vec3, w: Vec3, t_min: f64) -> Option<EmitterHit<V>> {
+        forward!(self, e => e.hit(x, w, t_min))
+    }
+
+    fn surface(&self, receiver: &Receiver) -> Result<LightDomain, QuadError> {
+        forward!(self, e => e.surface(receiver))
+    }
+
+    fn normal_at(&self, y: Vec3) -> Vec3 {
+        forward!(self, e => e.normal_at(y))
+    }
+
+    fn cone(&self, receiver: &Receiver) -> Result<Cap, QuadError> {
+        forward!(self, e => e.cone(receiver))
+    }
+
+    fn occluder(&self) -> Option<Occluder> {
+        forward!(self, e => e.occluder())
+    }
+}
+
+macro_rules! from_light {
+    ($($ty:ident => $variant:ident),+) => {
+        $(impl<V: Value> From<$ty<V>> for AnyEmitter<V> {
+            fn from(e: $ty<V>) -> Self {
+                AnyEmitter::$variant(e)
+            }
+        })+
+    };
+}
+
+from_light!(
+    RectangleLight => Rectangle,
+    DiskLight => Disk,
+    TriangleLight => Triangle,
+    SphereLight => Sphere,
+    EnvironmentLight => Environment,
+    CapLight => Cap
+);
