@@ -308,7 +308,7 @@ pub enum Flag {
 impl std::fmt::Display for Flag {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Flag::Underflow => write!(f, "underflows: log space"),
+            Flag::Underflow => write!(f, "underflows: 0 in f64, ln_tau holds it in log space"),
             Flag::Cancellation { parts } => {
                 write!(f, "cancellation: |sum| < 1e-6 of its parts ({parts:.1e})")
             }

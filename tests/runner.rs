@@ -1573,3 +1573,66 @@ fn true_errors_near_the_top_of_the_range_do_not_overflow() {
     assert!(row.contains(&want), "{want} in {row}");
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// What the independent check of the reports found (issue 9): on the stiff
+/// sphere (optical depth 1e5) `I_B = e^-100000` reads 0 against a
+/// reference of 0 and was shown unflagged, ranked by time and "at the error
+/// floor from its first budget: easy"; it is flagged as underflowing like
+/// tau, and an underflowed row reaches no target and is never called easy. A random rule on a constant integrand
+/// (stratified on tau through a constant sphere: error 0 from the first
+/// budget) gets the same note as a deterministic one; stratified sampling
+/// on two cells has an infinite estimate, flagged.
+#[test]
+fn underflow_constant_integrands_and_missing_estimates_are_labelled() {
+    let stiff = fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/v-tau-stiff-sphere.json"),
+    )
+    .expect("bundled");
+    let (_dir, out, o) = run_text("stiff", &stiff);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = fs::read_to_string(out.join("v-tau-stiff-sphere/report.md")).expect("report");
+    let section = report.split("## I_B").nth(1).expect("an I_B section");
+    let rows: Vec<&str> = section
+        .lines()
+        .filter(|l| l.starts_with("| gauss-legendre | ") || l.starts_with("| trapezoid | "))
+        .filter(|l| {
+            l.split('|')
+                .nth(2)
+                .is_some_and(|b| b.trim().parse::<usize>().is_ok())
+        })
+        .collect();
+    assert!(rows.len() >= 6, "{section}");
+    for row in rows {
+        assert!(row.contains("underflows"), "unflagged: {row}");
+    }
+    let index = fs::read_to_string(out.join("index.md")).expect("index");
+    let ib = index
+        .lines()
+        .find(|l| l.starts_with("- I_B:"))
+        .expect("I_B ranked");
+    assert!(
+        !ib.contains("easy for it") && ib.contains("not reached"),
+        "{ib}"
+    );
+
+    let constant = VALID
+        .replace(
+            r#""quantities": ["tau", "I_E"]"#,
+            r#""quantities": ["tau"]"#,
+        )
+        .replace(r#""budgets": [4, 16, 64]"#, r#""budgets": [2, 16, 64]"#);
+    let (_dir, out, o) = run_text("constant", &constant);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let index = fs::read_to_string(out.join("index.md")).expect("index");
+    let line = index
+        .lines()
+        .find(|l| l.contains("stratified"))
+        .expect("stratified ranked");
+    assert!(line.contains("easy for it"), "{line}");
+    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+    let two = report
+        .lines()
+        .find(|l| l.starts_with("| stratified | 2 |"))
+        .expect("a row at n = 2");
+    assert!(two.contains("no error estimate"), "{two}");
+}

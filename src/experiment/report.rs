@@ -117,6 +117,9 @@ pub enum RowFlag {
     ErrorGrew,
     /// The error is at or below the reference's own relative accuracy.
     AtReferenceAccuracy(f64),
+    /// The method's error estimate is infinite: it had no information to
+    /// estimate the error (stratified sampling on two cells).
+    NoEstimate,
 }
 
 impl std::fmt::Display for RowFlag {
@@ -129,6 +132,10 @@ impl std::fmt::Display for RowFlag {
             RowFlag::EstimateOff => write!(f, "estimate off by more than 10x"),
             RowFlag::ErrorGrew => write!(f, "error grew with the budget"),
             RowFlag::AtReferenceAccuracy(a) => write!(f, "at the reference's accuracy ({a:.1e})"),
+            RowFlag::NoEstimate => write!(
+                f,
+                "no error estimate (infinite: too little to estimate from)"
+            ),
         }
     }
 }
@@ -144,8 +151,9 @@ per axis), whose differences do not shrink the way its order says, or whose sum 
 carries; or a random one whose \
 samples were all alike, a constant integrand included, since nothing was seen to vary, or whose \
 sample variance is carried by a few samples); `error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
-parts); `underflows: log space` (the value is below the smallest f64; its logarithm is exact: ask for `ln_tau`); \
-`at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
+parts); `underflows` (the value is below the smallest f64 and reads 0; its logarithm is exact: ask for `ln_tau`, \
+and `ln I_B = ln B + ln tau`); `no error estimate` (the method had too little to estimate from: \
+stratified sampling on two cells); `at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
 scored alike` (a tracking estimate with zero sample variance: its error is a Wilson half-width \
 / 1.96, not a sample standard error).";
 
@@ -259,6 +267,12 @@ fn row(
         .any(|m| m.value.iter().any(|v| !v.is_finite()))
     {
         flags.push(RowFlag::NonFinite);
+    }
+    if measured
+        .iter()
+        .any(|m| m.error.iter().any(|e| !e.is_finite()))
+    {
+        flags.push(RowFlag::NoEstimate);
     }
     // The families' flags, once per kind.
     for f in measured.iter().flat_map(|m| &m.flags) {
@@ -431,10 +445,18 @@ pub fn order_and_scatter(rows: &[&Row], against: Against, floor: f64) -> Option<
 }
 
 /// The least median time among rows whose error meets `target`.
+///
+/// A failed row reaches nothing, nor does one whose value underflowed: 0
+/// against a reference that also reads 0 in f64 is an error of 0 on paper
+/// and of 100% against the true value (`e^-100000` on the stiff sphere).
 pub fn time_to(rows: &[&Row], target: f64) -> Option<f64> {
     rows.iter()
         .filter(|r| {
-            r.rel_error <= target && !r.flags.iter().any(|f| matches!(f, RowFlag::Failed(_)))
+            r.rel_error <= target
+                && !r
+                    .flags
+                    .iter()
+                    .any(|f| matches!(f, RowFlag::Failed(_) | RowFlag::Job(Flag::Underflow)))
         })
         .map(|r| r.seconds)
         .min_by(f64::total_cmp)
@@ -841,8 +863,13 @@ fn orders_and_plots(
         ranking.push(Ranked {
             label: label.clone(),
             seconds: reach(middle),
-            exact_from_start: !page.rules.get(i).is_some_and(|r| r.is_random)
-                && first.is_some_and(|r| r.rel_error <= floor.max(1e-14)),
+            // At the floor from the first budget, deterministic or random
+            // (a random rule whose every sample agrees sees a constant
+            // integrand), unless the value underflowed: 0 against 0 is not
+            // an easy integrand but one f64 cannot hold.
+            exact_from_start: first.is_some_and(|r| {
+                r.rel_error <= floor.max(1e-14) && !r.flags.contains(&RowFlag::Job(Flag::Underflow))
+            }),
         });
         // NaN (failed) rows are dropped; the plot puts unresolved errors on
         // its floor line.

@@ -787,7 +787,16 @@ fn collect(res: &VolumeResult, quantities: &[VolumeQuantity]) -> Outcome<VolumeQ
                     ..res.optical_depth
                 }),
                 VolumeQuantity::Emission => term(res.emission),
-                VolumeQuantity::Background => term(res.background),
+                // I_B = B tau underflows with tau: flagged as tau is
+                // (`ln I_B = ln B + ln tau`).
+                VolumeQuantity::Background => {
+                    let b = term(res.background);
+                    if res.underflow && b.value.iter().all(|v| v.abs() < f64::MIN_POSITIVE) {
+                        b.flagged(Flag::Underflow)
+                    } else {
+                        b
+                    }
+                }
                 VolumeQuantity::Light => term(res.light),
                 VolumeQuantity::Total => total(res),
             };
