@@ -12,6 +12,7 @@
 //! | [`forms`] | R-H and R-A integrands for any rule, over the hemisphere, a BRDF-sampled map, emitter cones and emitter surfaces |
 //! | [`mis`] | multiple importance sampling of light and BRDF samples (balance, power heuristics) |
 //! | [`cap`] | spherical caps and cones of directions given by `1 - cos theta_max` |
+//! | [`furnace`] | the full equation in a closed scene (an integrating sphere, the white furnace): Neumann series bounce by bounce and path tracing with Russian roulette |
 //!
 //! Closed forms live in [`crate::exact::rendering`].
 
@@ -19,6 +20,7 @@ pub mod brdf;
 pub mod cap;
 pub mod emitter;
 pub mod forms;
+pub mod furnace;
 pub mod mis;
 pub mod occluder;
 pub mod receiver;
