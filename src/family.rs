@@ -174,10 +174,14 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
             )));
         };
         let Some(tag) = tag.as_str() else {
-            return Err(D::Error::custom(format!(
-                "`rule` is {tag}, not a name: {}",
-                accepted()
-            )));
+            return Err(below(
+                "rule",
+                &format!(
+                    "{}: expected a name in quotes, one of {}",
+                    crate::experiment::tagged::kind(tag),
+                    names.join(", ")
+                ),
+            ));
         };
         // A fault inside a rule is reported at its field; serde's tagged enums
         // do not track paths below the tag, so a rule's parameters are read

@@ -107,8 +107,8 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
     );
     rejected(
         &VALID.replace("\"quantities\": [\"tau\", \"I_E\"],", ""),
-        ".",
-        "missing field `quantities`",
+        "quantities",
+        "the required field `quantities` is missing",
     );
     rejected(
         &VALID.replace("[4, 16, 64]", "[4, -16, 64]"),
@@ -1139,8 +1139,8 @@ fn a_fault_inside_a_tagged_object_names_its_own_path() {
     );
     rejected(
         &medium("{ \"radius\": 1 }"),
-        "scene.medium",
-        "missing field `type`: expected one of `constant-sphere`",
+        "scene.medium.type",
+        "the required field `type` is missing: expected one of `constant-sphere`",
     );
     rejected(
         &VALID.replace(
@@ -1156,7 +1156,7 @@ fn a_fault_inside_a_tagged_object_names_its_own_path() {
             "{ \"type\": \"field\", \"field\": { \"type\": \"constant-sphere\", \"centre\": [0, 0, 0], \"radius\": 1, \"kappa\": [1] } }",
         ),
         "scene.emission.field.kappa",
-        "invalid type: sequence, expected a number",
+        "invalid type: a list, expected a number",
     );
     rejected(
         &VALID.replace(
@@ -1572,4 +1572,168 @@ fn true_errors_near_the_top_of_the_range_do_not_overflow() {
         .expect("row");
     assert!(row.contains(&want), "{want} in {row}");
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// A value of the wrong JSON kind where a name or an object is needed lists
+/// what is accepted (the hostile review of issue 10, M5): enum fields said
+/// only "expected string or map", and `"scene": [1, 2]` was reported at
+/// `scene[0]`.
+#[test]
+fn a_value_of_the_wrong_kind_lists_what_is_accepted() {
+    rejected(
+        &VALID.replace("\"scene\": {", "\"scene\": [1, 2], \"x\": {"),
+        "scene",
+        "a list [1,2]: expected an object",
+    );
+    rejected(
+        &VALID.replace("\"scene\": {", "\"scene\": 3, \"x\": {"),
+        "scene",
+        "a number 3: expected an object",
+    );
+    rejected(
+        &VALID.replace("\"scene\": {", "\"scene\": { \"depth_scheme\": 3,"),
+        "scene.depth_scheme",
+        "a number 3: expected a name in quotes, `cumulative` or `nested`",
+    );
+    rejected(
+        &VALID.replace("\"scene\": {", "\"scene\": { \"shadow\": {\"a\": 1},"),
+        "scene.shadow",
+        "expected a name in quotes, `closed-form` or `quadrature`",
+    );
+    rejected(
+        &VALID.replace("[\"tau\", \"I_E\"]", "[\"tau\", 3]"),
+        "quantities[1]",
+        "a number 3: expected a name in quotes, one of `tau`, `ln_tau`, `I_E`, `I_B`, `I_L`, `I`",
+    );
+    rejected(
+        &VALID.replace("[\"tau\", \"I_E\"]", "\"tau\""),
+        "quantities",
+        "a string \"tau\": expected a list of names, each one of `tau`",
+    );
+    rejected(
+        &VALID.replace("{ \"rule\": \"stratified\" }", "{ \"rule\": 3 }"),
+        "rules[1].rule",
+        "a number 3: expected a name in quotes, one of trapezoid, simpson",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"product\", \"outer\": \"trapezoid\", \"inner\": { \"rule\": \"trapezoid\" } }",
+        ),
+        "rules[1].outer",
+        "\"trapezoid\" is not a rule: expected {\"rule\": <name>, <parameters>}, the name one of trapezoid, simpson",
+    );
+    rejected(
+        &VALID.replace("{ \"type\": \"closed-form\" }", "{ \"type\": 3 }"),
+        "reference.type",
+        "a number 3: expected a name in quotes, one of `closed-form`, `value`, `mitsuba`, `converged`",
+    );
+    rejected(
+        &VALID.replace(
+            "\"emission\": { \"type\": \"constant\", \"c\": 1.0 }",
+            "\"emission\": \"constant\"",
+        ),
+        "scene.emission",
+        "\"constant\" is not an object: expected {\"type\": <name>, ...} with the name one of `constant`",
+    );
+    rejected(
+        &VALID.replace(
+            "\"budgets\": [4, 16, 64]",
+            "\"budgets\": {\"from\": 4}, \"x\": 1",
+        ),
+        "budgets.to",
+        "the required field `to` is missing",
+    );
+}
+
+/// Every number error states the range the field accepts (the hostile
+/// review of issue 10, M6): `"replicates": -1` said `>= 0` (it accepts
+/// 2..=1000000), `budgets: [18446744073709551615]` named no range, and a
+/// number past the f64 range said only "number out of range".
+#[test]
+fn every_number_error_states_the_range_the_field_accepts() {
+    rejected(
+        &VALID.replace("[4, 16, 64]", "[18446744073709551615]"),
+        "budgets[0]",
+        "invalid value: integer `18446744073709551615`, expected a whole number in 1..=100000000",
+    );
+    rejected(
+        &VALID.replace("[4, 16, 64]", "{\"from\": 4, \"to\": 1e30, \"factor\": 2}"),
+        "budgets.to",
+        "expected a whole number in 1..=100000000",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"sobol\", \"replicates\": -1 }",
+        ),
+        "rules[1].replicates",
+        "invalid value: integer `-1`, expected a whole number in 2..=1000000",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"product\", \"outer\": { \"rule\": \"sobol\", \"replicates\": 2.5 }, \"inner\": { \"rule\": \"trapezoid\" } }",
+        ),
+        "rules[1].outer.replicates",
+        "invalid type: floating point `2.5`, expected a whole number in 2..=1000000",
+    );
+    rejected(
+        &VALID.replace("\"repeats\": 2", "\"repeats\": -1"),
+        "repeats",
+        "expected a whole number in 1..=1000",
+    );
+    rejected(
+        &VALID.replace("\"seed\": 7", "\"seed\": -7"),
+        "seed",
+        "expected a whole number in 0..=18446744073709551615",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"converged\", \"n\": -1 }",
+        ),
+        "reference.n",
+        "expected a whole number in 2..=100000",
+    );
+    rejected(
+        &VALID.replace("\"radius\": 1.0", "\"radius\": 1e400"),
+        "scene.medium.radius",
+        "a number beyond the f64 range (its magnitude is above 1.8e308)",
+    );
+}
+
+/// A missing field is named at its own path, not at the object that lacks
+/// it (the hostile review of issue 10, M7): `scene.ray.origin`, not
+/// `scene.ray`. Every required field of a valid file, dropped in turn.
+#[test]
+fn a_missing_field_is_named_at_its_own_path() {
+    let required = [
+        ("\"origin\": [-3.0, 0.3, 0.0], ", "scene.ray.origin"),
+        (", \"direction\": [1.0, 0.0, 0.0]", "scene.ray.direction"),
+        ("\"type\": \"constant-sphere\", ", "scene.medium.type"),
+        (", \"radius\": 1.0", "scene.medium.radius"),
+        (", \"kappa\": 2.0", "scene.medium.kappa"),
+        (", \"c\": 1.0", "scene.emission.c"),
+        ("\"rule\": \"stratified\"", "rules[1].rule"),
+        ("\"quantities\": [\"tau\", \"I_E\"],", "quantities"),
+        ("\"type\": \"closed-form\"", "reference.type"),
+    ];
+    for (cut, path) in required {
+        assert!(VALID.contains(cut), "{cut}");
+        let field = path.rsplit('.').next().expect("field");
+        rejected(
+            &VALID.replace(cut, ""),
+            path,
+            &format!("the required field `{field}` is missing"),
+        );
+    }
+    rejected(
+        &VALID.replace(
+            "\"ray\": { \"origin\": [-3.0, 0.3, 0.0], \"direction\": [1.0, 0.0, 0.0] },",
+            "",
+        ),
+        "scene.ray",
+        "the required field `ray` is missing",
+    );
 }
