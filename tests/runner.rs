@@ -1549,29 +1549,41 @@ fn resume_reads_past_a_bad_line_and_says_what_it_does_not_reuse() {
 /// their difference overflowed, and the report showed a true error of `inf`
 /// where it is |I_E - r| / |r| = 1.38 (the hostile review of issue 10, M4).
 /// I_E = c (1 - e^{-sigma L}) / sigma with c = 1.7e308, sigma = 2, L = 2
-/// sqrt(1 - 0.3^2), against the literal reference -1.7e308.
+/// sqrt(1 - 0.3^2), against the reference -1.7e308. A radiance is never
+/// negative, so `check` now refuses that literal reference (see
+/// `a_reference_value_outside_what_the_quantity_can_take_is_refused`); the
+/// report's rows are checked on the jobs' real results through the library.
 #[test]
 fn true_errors_near_the_top_of_the_range_do_not_overflow() {
     let text = VALID
         .replace("\"c\": 1.0", "\"c\": 1.7e308")
         .replace("[\"tau\", \"I_E\"]", "[\"I_E\"]")
         .replace("[4, 16, 64]", "[16]")
-        .replace(
-            "{ \"type\": \"closed-form\" }",
-            "{ \"type\": \"value\", \"values\": { \"I_E\": -1.7e308 } }",
-        );
-    let (dir, out, o) = run_text("toperr", &text);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+        .replace("\"repeats\": 2", "\"repeats\": 1")
+        .replace(", { \"rule\": \"stratified\" }", "");
+    let registry = lightquad::families::builtin();
+    let json = lightquad::experiment::validate::parse_json(&text).expect("json");
+    let exp = registry.load(json, "h").expect("valid");
+    let results: Vec<_> = exp.jobs(None).into_iter().map(|j| exp.run_job(j)).collect();
+    let rule = lightquad::experiment::report::RuleInfo {
+        label: "gauss-legendre".into(),
+        is_random: false,
+        min_budget: 1,
+        resolution: Default::default(),
+    };
+    let reference = [-1.7e308];
+    let rows = lightquad::experiment::report::rows(&[rule], &results, "I_E", &reference);
     let chord = 2.0 * (1.0f64 - 0.09).sqrt();
     let exact = 1.7e308 / 2.0 * (1.0 - (-2.0 * chord).exp());
-    let want = format!("| {:.2e} |", exact / 1.7e308 + 1.0);
-    let row = report
-        .lines()
-        .find(|l| l.starts_with("| gauss-legendre | 16 |"))
-        .expect("row");
-    assert!(row.contains(&want), "{want} in {row}");
-    let _ = fs::remove_dir_all(&dir);
+    let want = exact / 1.7e308 + 1.0;
+    assert_eq!(rows.len(), 1);
+    assert!(
+        (rows[0].rel_error / want - 1.0).abs() < 1e-12,
+        "{} vs {want}",
+        rows[0].rel_error
+    );
+    let d = lightquad::experiment::reference::relative_distance(&[exact], &reference);
+    assert!((d / want - 1.0).abs() < 1e-15, "{d} vs {want}");
 }
 
 /// A value of the wrong JSON kind where a name or an object is needed lists
@@ -1736,4 +1748,42 @@ fn a_missing_field_is_named_at_its_own_path() {
         "scene.ray",
         "the required field `ray` is missing",
     );
+}
+
+/// A radiance, intensity or transmittance given as a literal reference is
+/// refused outside what the quantity can take (the hostile review of issue
+/// 10, M4): `I_E: -1` was accepted and every error measured against it.
+/// `ln_tau` may be negative (it is at most 0).
+#[test]
+fn a_reference_value_outside_what_the_quantity_can_take_is_refused() {
+    let with = |values: &str| {
+        VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            &format!("{{ \"type\": \"value\", \"values\": {{ {values} }} }}"),
+        )
+    };
+    rejected(
+        &with("\"tau\": 0.5, \"I_E\": -1"),
+        "reference.values.I_E",
+        "-1 is not a value I_E can take: expected a number >= 0",
+    );
+    rejected(
+        &with("\"tau\": 1.5, \"I_E\": 1"),
+        "reference.values.tau",
+        "1.5 is not a value tau can take: expected a number in [0, 1]",
+    );
+    let ln =
+        with("\"ln_tau\": 0.5, \"I_E\": 1").replace("[\"tau\", \"I_E\"]", "[\"ln_tau\", \"I_E\"]");
+    rejected(
+        &ln,
+        "reference.values.ln_tau",
+        "0.5 is not a value ln_tau can take: expected a number <= 0",
+    );
+    // In range: accepted, ln tau negative.
+    let dir = scratch("refok");
+    let file = dir.join("e.json");
+    fs::write(&file, ln.replace("\"ln_tau\": 0.5", "\"ln_tau\": -3.3")).expect("write");
+    let check = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(check.status.success(), "{}", stderr(&check));
+    let _ = fs::remove_dir_all(&dir);
 }

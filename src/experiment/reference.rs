@@ -237,6 +237,17 @@ fn values_from_json<Q: Quantity>(
                 ),
             ));
         };
+        let (lo, hi) = q.bounds();
+        if !(lo..=hi).contains(&v) {
+            return Err(SpecError::at(
+                at,
+                format!(
+                    "{path} gives {} = {v}, which is not a value it can take: expected {}",
+                    q.name(),
+                    crate::family::bounds_in_words((lo, hi))
+                ),
+            ));
+        }
         values.insert(*q, vec![v]);
         worst = worst.max(se);
     }

@@ -354,6 +354,16 @@ impl family::Quantity for VolumeQuantity {
         use VolumeQuantity::*;
         &[Tau, LnTau, Emission, Background, Light, Total]
     }
+
+    /// A transmittance is in [0, 1] and its logarithm at most 0; the
+    /// radiances are at least 0 (emission, background and light are).
+    fn bounds(&self) -> (f64, f64) {
+        match self {
+            VolumeQuantity::Tau => (0.0, 1.0),
+            VolumeQuantity::LnTau => (f64::NEG_INFINITY, 0.0),
+            _ => (0.0, f64::INFINITY),
+        }
+    }
 }
 
 impl family::Estimator for Tracker {
