@@ -1336,14 +1336,19 @@ fn long_names_and_files_that_are_not_regular_are_refused() {
         "{ \"type\": \"closed-form\" }",
         "{ \"type\": \"mitsuba\", \"file\": \"/dev/zero\" }",
     );
-    rejected(&zero, "reference.file", "/dev/zero (not a regular file");
+    rejected(
+        &zero,
+        "reference.file",
+        "/dev/zero (is a device: expected a regular JSON file",
+    );
     let dir = scratch("fifo");
     let fifo = dir.join("f.json");
     let made = Command::new("mkfifo").arg(&fifo).status();
     if made.is_ok_and(|s| s.success()) {
         let o = run_with_timeout(&["check", &fifo.display().to_string()], 20);
         assert!(
-            !o.status.success() && stderr(&o).contains("not a regular file"),
+            !o.status.success()
+                && stderr(&o).contains("is a FIFO (named pipe): expected a regular JSON file"),
             "{}",
             stderr(&o)
         );
@@ -1785,5 +1790,74 @@ fn a_reference_value_outside_what_the_quantity_can_take_is_refused() {
     fs::write(&file, ln.replace("\"ln_tau\": 0.5", "\"ln_tau\": -3.3")).expect("write");
     let check = bin().arg("check").arg(&file).output().expect("runs");
     assert!(check.status.success(), "{}", stderr(&check));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// File system faults name the path and the reason in words (the hostile
+/// review of issue 10, low): not found, a directory, a FIFO, a device, an
+/// --out that is a file; a Mitsuba reference that is some other JSON file
+/// says it is not a values file and what it lacks (it was called "stale").
+#[test]
+fn file_system_faults_name_the_path_and_the_reason() {
+    let dir = scratch("fs");
+    let check = |path: &Path| {
+        let o = bin().arg("check").arg(path).output().expect("runs");
+        assert!(!o.status.success());
+        stderr(&o)
+    };
+    let missing = dir.join("missing.json");
+    let msg = check(&missing);
+    assert!(
+        msg.contains(&format!("{}: not found (os error 2)", missing.display())),
+        "{msg}"
+    );
+    let msg = check(&dir);
+    assert!(
+        msg.contains(&format!(
+            "{}: is a directory: expected a regular JSON file",
+            dir.display()
+        )),
+        "{msg}"
+    );
+    let msg = check(Path::new("/dev/null"));
+    assert!(msg.contains("/dev/null: is a device"), "{msg}");
+    // --out naming a file.
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let out = dir.join("a-file");
+    fs::write(&out, "").expect("write");
+    let o = bin()
+        .arg("run")
+        .arg("--out")
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains(&format!(
+            "{}: is a file, not a directory: the output folder (--out)",
+            out.display()
+        )),
+        "{}",
+        stderr(&o)
+    );
+    // A Mitsuba reference naming some other JSON file.
+    fs::write(dir.join("other.json"), "{\"a\": 1}").expect("write");
+    fs::write(
+        &file,
+        VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"mitsuba\", \"file\": \"other.json\" }",
+        ),
+    )
+    .expect("write");
+    let msg = check(&file);
+    assert!(
+        msg.contains("at `reference.file`")
+            && msg.contains("other.json (not a Mitsuba values file: it has no `experiment_hash` and `quantities`")
+            && !msg.contains("stale"),
+        "{msg}"
+    );
     let _ = fs::remove_dir_all(&dir);
 }
