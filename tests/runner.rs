@@ -1861,3 +1861,37 @@ fn file_system_faults_name_the_path_and_the_reason() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A sphere of subnormal radius is refused at check with the accepted range
+/// (the hostile review of issue 10, M1: radius 1e-310 gave a closed-form
+/// ln tau of -inf); tiny normal radii seen from far away are measured right
+/// (M2: radius 1e-200 from a distance of 3, ln tau = -kappa 2r = -4e-200).
+#[test]
+fn sphere_radii_are_normal_numbers_and_tiny_ones_are_measured_right() {
+    let with = |r: &str| {
+        VALID
+            .replace("\"radius\": 1.0", &format!("\"radius\": {r}"))
+            .replace("[-3.0, 0.3, 0.0]", "[-3.0, 0.0, 0.0]")
+            .replace("[\"tau\", \"I_E\"]", "[\"ln_tau\", \"tau\"]")
+            .replace(", { \"rule\": \"stratified\" }", "")
+            .replace("[4, 16, 64]", "[4]")
+    };
+    rejected(
+        &with("1e-310"),
+        "scene.medium.radius",
+        "invalid radius = 1e-310: expected a finite number in [2.2250738585072014e-308, 1.7976931348623157e308]",
+    );
+    for (r, want) in [
+        ("1e-150", "-4.000000000000000e-150"),
+        ("1e-200", "-4.000000000000000e-200"),
+    ] {
+        let (dir, out, o) = run_text("tiny", &with(r));
+        assert!(o.status.success(), "{}", stderr(&o));
+        let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+        assert!(
+            report.contains(&format!("## ln_tau (reference {want})")),
+            "{report}"
+        );
+        let _ = fs::remove_dir_all(&dir);
+    }
+}
