@@ -85,6 +85,11 @@ impl family::Quantity for Integral {
             Integral::Cos3Hemisphere,
         ]
     }
+
+    /// Every calibration integral is of a positive integrand.
+    fn bounds(&self) -> (f64, f64) {
+        (0.0, f64::INFINITY)
+    }
 }
 
 /// `q` with `rule` at budget `n`; evaluations are integrand evaluations.

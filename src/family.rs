@@ -43,6 +43,25 @@ pub trait Quantity:
     fn name(&self) -> &'static str;
     /// Every quantity of the family.
     fn all() -> &'static [Self];
+    /// The values the quantity can take, `(lo, hi)` inclusive: a radiance is
+    /// never negative, a transmittance is in [0, 1], `ln tau` is never
+    /// positive. A literal reference value outside them is refused at
+    /// `check` (`-1` for a radiance was accepted, and every error measured
+    /// against it). Default: any number.
+    fn bounds(&self) -> (f64, f64) {
+        (f64::NEG_INFINITY, f64::INFINITY)
+    }
+}
+
+/// `(lo, hi)` of [`Quantity::bounds`] in words: `a number >= 0`, `a number in
+/// [0, 1]`.
+pub fn bounds_in_words((lo, hi): (f64, f64)) -> String {
+    match (lo.is_finite(), hi.is_finite()) {
+        (true, true) => format!("a number in [{lo}, {hi}]"),
+        (true, false) => format!("a number >= {lo}"),
+        (false, true) => format!("a number <= {hi}"),
+        (false, false) => "a finite number".into(),
+    }
 }
 
 /// A family's estimator that is not a quadrature rule (tracking, path
@@ -174,10 +193,14 @@ impl<'de, E: Estimator> Deserialize<'de> for Method<E> {
             )));
         };
         let Some(tag) = tag.as_str() else {
-            return Err(D::Error::custom(format!(
-                "`rule` is {tag}, not a name: {}",
-                accepted()
-            )));
+            return Err(below(
+                "rule",
+                &format!(
+                    "{}: expected a name in quotes, one of {}",
+                    crate::experiment::tagged::kind(tag),
+                    names.join(", ")
+                ),
+            ));
         };
         // A fault inside a rule is reported at its field; serde's tagged enums
         // do not track paths below the tag, so a rule's parameters are read

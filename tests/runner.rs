@@ -107,8 +107,8 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
     );
     rejected(
         &VALID.replace("\"quantities\": [\"tau\", \"I_E\"],", ""),
-        ".",
-        "missing field `quantities`",
+        "quantities",
+        "the required field `quantities` is missing",
     );
     rejected(
         &VALID.replace("[4, 16, 64]", "[4, -16, 64]"),
@@ -1139,8 +1139,8 @@ fn a_fault_inside_a_tagged_object_names_its_own_path() {
     );
     rejected(
         &medium("{ \"radius\": 1 }"),
-        "scene.medium",
-        "missing field `type`: expected one of `constant-sphere`",
+        "scene.medium.type",
+        "the required field `type` is missing: expected one of `constant-sphere`",
     );
     rejected(
         &VALID.replace(
@@ -1156,7 +1156,7 @@ fn a_fault_inside_a_tagged_object_names_its_own_path() {
             "{ \"type\": \"field\", \"field\": { \"type\": \"constant-sphere\", \"centre\": [0, 0, 0], \"radius\": 1, \"kappa\": [1] } }",
         ),
         "scene.emission.field.kappa",
-        "invalid type: sequence, expected a number",
+        "invalid type: a list, expected a number",
     );
     rejected(
         &VALID.replace(
@@ -1336,14 +1336,19 @@ fn long_names_and_files_that_are_not_regular_are_refused() {
         "{ \"type\": \"closed-form\" }",
         "{ \"type\": \"mitsuba\", \"file\": \"/dev/zero\" }",
     );
-    rejected(&zero, "reference.file", "/dev/zero (not a regular file");
+    rejected(
+        &zero,
+        "reference.file",
+        "/dev/zero (is a device: expected a regular JSON file",
+    );
     let dir = scratch("fifo");
     let fifo = dir.join("f.json");
     let made = Command::new("mkfifo").arg(&fifo).status();
     if made.is_ok_and(|s| s.success()) {
         let o = run_with_timeout(&["check", &fifo.display().to_string()], 20);
         assert!(
-            !o.status.success() && stderr(&o).contains("not a regular file"),
+            !o.status.success()
+                && stderr(&o).contains("is a FIFO (named pipe): expected a regular JSON file"),
             "{}",
             stderr(&o)
         );
@@ -1549,28 +1554,242 @@ fn resume_reads_past_a_bad_line_and_says_what_it_does_not_reuse() {
 /// their difference overflowed, and the report showed a true error of `inf`
 /// where it is |I_E - r| / |r| = 1.38 (the hostile review of issue 10, M4).
 /// I_E = c (1 - e^{-sigma L}) / sigma with c = 1.7e308, sigma = 2, L = 2
-/// sqrt(1 - 0.3^2), against the literal reference -1.7e308.
+/// sqrt(1 - 0.3^2), against the reference -1.7e308. A radiance is never
+/// negative, so `check` now refuses that literal reference (see
+/// `a_reference_value_outside_what_the_quantity_can_take_is_refused`); the
+/// report's rows are checked on the jobs' real results through the library.
 #[test]
 fn true_errors_near_the_top_of_the_range_do_not_overflow() {
     let text = VALID
         .replace("\"c\": 1.0", "\"c\": 1.7e308")
         .replace("[\"tau\", \"I_E\"]", "[\"I_E\"]")
         .replace("[4, 16, 64]", "[16]")
-        .replace(
-            "{ \"type\": \"closed-form\" }",
-            "{ \"type\": \"value\", \"values\": { \"I_E\": -1.7e308 } }",
-        );
-    let (dir, out, o) = run_text("toperr", &text);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+        .replace("\"repeats\": 2", "\"repeats\": 1")
+        .replace(", { \"rule\": \"stratified\" }", "");
+    let registry = lightquad::families::builtin();
+    let json = lightquad::experiment::validate::parse_json(&text).expect("json");
+    let exp = registry.load(json, "h").expect("valid");
+    let results: Vec<_> = exp.jobs(None).into_iter().map(|j| exp.run_job(j)).collect();
+    let rule = lightquad::experiment::report::RuleInfo {
+        label: "gauss-legendre".into(),
+        is_random: false,
+        min_budget: 1,
+        resolution: Default::default(),
+    };
+    let reference = [-1.7e308];
+    let rows = lightquad::experiment::report::rows(&[rule], &results, "I_E", &reference);
     let chord = 2.0 * (1.0f64 - 0.09).sqrt();
     let exact = 1.7e308 / 2.0 * (1.0 - (-2.0 * chord).exp());
-    let want = format!("| {:.2e} |", exact / 1.7e308 + 1.0);
-    let row = report
-        .lines()
-        .find(|l| l.starts_with("| gauss-legendre | 16 |"))
-        .expect("row");
-    assert!(row.contains(&want), "{want} in {row}");
+    let want = exact / 1.7e308 + 1.0;
+    assert_eq!(rows.len(), 1);
+    assert!(
+        (rows[0].rel_error / want - 1.0).abs() < 1e-12,
+        "{} vs {want}",
+        rows[0].rel_error
+    );
+    let d = lightquad::experiment::reference::relative_distance(&[exact], &reference);
+    assert!((d / want - 1.0).abs() < 1e-15, "{d} vs {want}");
+}
+
+/// A value of the wrong JSON kind where a name or an object is needed lists
+/// what is accepted (the hostile review of issue 10, M5): enum fields said
+/// only "expected string or map", and `"scene": [1, 2]` was reported at
+/// `scene[0]`.
+#[test]
+fn a_value_of_the_wrong_kind_lists_what_is_accepted() {
+    rejected(
+        &VALID.replace("\"scene\": {", "\"scene\": [1, 2], \"x\": {"),
+        "scene",
+        "a list [1,2]: expected an object",
+    );
+    rejected(
+        &VALID.replace("\"scene\": {", "\"scene\": 3, \"x\": {"),
+        "scene",
+        "a number 3: expected an object",
+    );
+    rejected(
+        &VALID.replace("\"scene\": {", "\"scene\": { \"depth_scheme\": 3,"),
+        "scene.depth_scheme",
+        "a number 3: expected a name in quotes, `cumulative` or `nested`",
+    );
+    rejected(
+        &VALID.replace("\"scene\": {", "\"scene\": { \"shadow\": {\"a\": 1},"),
+        "scene.shadow",
+        "expected a name in quotes, `closed-form` or `quadrature`",
+    );
+    rejected(
+        &VALID.replace("[\"tau\", \"I_E\"]", "[\"tau\", 3]"),
+        "quantities[1]",
+        "a number 3: expected a name in quotes, one of `tau`, `ln_tau`, `I_E`, `I_B`, `I_L`, `I`",
+    );
+    rejected(
+        &VALID.replace("[\"tau\", \"I_E\"]", "\"tau\""),
+        "quantities",
+        "a string \"tau\": expected a list of names, each one of `tau`",
+    );
+    rejected(
+        &VALID.replace("{ \"rule\": \"stratified\" }", "{ \"rule\": 3 }"),
+        "rules[1].rule",
+        "a number 3: expected a name in quotes, one of trapezoid, simpson",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"product\", \"outer\": \"trapezoid\", \"inner\": { \"rule\": \"trapezoid\" } }",
+        ),
+        "rules[1].outer",
+        "\"trapezoid\" is not a rule: expected {\"rule\": <name>, <parameters>}, the name one of trapezoid, simpson",
+    );
+    rejected(
+        &VALID.replace("{ \"type\": \"closed-form\" }", "{ \"type\": 3 }"),
+        "reference.type",
+        "a number 3: expected a name in quotes, one of `closed-form`, `value`, `mitsuba`, `converged`",
+    );
+    rejected(
+        &VALID.replace(
+            "\"emission\": { \"type\": \"constant\", \"c\": 1.0 }",
+            "\"emission\": \"constant\"",
+        ),
+        "scene.emission",
+        "\"constant\" is not an object: expected {\"type\": <name>, ...} with the name one of `constant`",
+    );
+    rejected(
+        &VALID.replace(
+            "\"budgets\": [4, 16, 64]",
+            "\"budgets\": {\"from\": 4}, \"x\": 1",
+        ),
+        "budgets.to",
+        "the required field `to` is missing",
+    );
+}
+
+/// Every number error states the range the field accepts (the hostile
+/// review of issue 10, M6): `"replicates": -1` said `>= 0` (it accepts
+/// 2..=1000000), `budgets: [18446744073709551615]` named no range, and a
+/// number past the f64 range said only "number out of range".
+#[test]
+fn every_number_error_states_the_range_the_field_accepts() {
+    rejected(
+        &VALID.replace("[4, 16, 64]", "[18446744073709551615]"),
+        "budgets[0]",
+        "invalid value: integer `18446744073709551615`, expected a whole number in 1..=100000000",
+    );
+    rejected(
+        &VALID.replace("[4, 16, 64]", "{\"from\": 4, \"to\": 1e30, \"factor\": 2}"),
+        "budgets.to",
+        "expected a whole number in 1..=100000000",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"sobol\", \"replicates\": -1 }",
+        ),
+        "rules[1].replicates",
+        "invalid value: integer `-1`, expected a whole number in 2..=1000000",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"rule\": \"stratified\" }",
+            "{ \"rule\": \"product\", \"outer\": { \"rule\": \"sobol\", \"replicates\": 2.5 }, \"inner\": { \"rule\": \"trapezoid\" } }",
+        ),
+        "rules[1].outer.replicates",
+        "invalid type: floating point `2.5`, expected a whole number in 2..=1000000",
+    );
+    rejected(
+        &VALID.replace("\"repeats\": 2", "\"repeats\": -1"),
+        "repeats",
+        "expected a whole number in 1..=1000",
+    );
+    rejected(
+        &VALID.replace("\"seed\": 7", "\"seed\": -7"),
+        "seed",
+        "expected a whole number in 0..=18446744073709551615",
+    );
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"converged\", \"n\": -1 }",
+        ),
+        "reference.n",
+        "expected a whole number in 2..=100000",
+    );
+    rejected(
+        &VALID.replace("\"radius\": 1.0", "\"radius\": 1e400"),
+        "scene.medium.radius",
+        "a number beyond the f64 range (its magnitude is above 1.8e308)",
+    );
+}
+
+/// A missing field is named at its own path, not at the object that lacks
+/// it (the hostile review of issue 10, M7): `scene.ray.origin`, not
+/// `scene.ray`. Every required field of a valid file, dropped in turn.
+#[test]
+fn a_missing_field_is_named_at_its_own_path() {
+    let required = [
+        ("\"origin\": [-3.0, 0.3, 0.0], ", "scene.ray.origin"),
+        (", \"direction\": [1.0, 0.0, 0.0]", "scene.ray.direction"),
+        ("\"type\": \"constant-sphere\", ", "scene.medium.type"),
+        (", \"radius\": 1.0", "scene.medium.radius"),
+        (", \"kappa\": 2.0", "scene.medium.kappa"),
+        (", \"c\": 1.0", "scene.emission.c"),
+        ("\"rule\": \"stratified\"", "rules[1].rule"),
+        ("\"quantities\": [\"tau\", \"I_E\"],", "quantities"),
+        ("\"type\": \"closed-form\"", "reference.type"),
+    ];
+    for (cut, path) in required {
+        assert!(VALID.contains(cut), "{cut}");
+        let field = path.rsplit('.').next().expect("field");
+        rejected(
+            &VALID.replace(cut, ""),
+            path,
+            &format!("the required field `{field}` is missing"),
+        );
+    }
+    rejected(
+        &VALID.replace(
+            "\"ray\": { \"origin\": [-3.0, 0.3, 0.0], \"direction\": [1.0, 0.0, 0.0] },",
+            "",
+        ),
+        "scene.ray",
+        "the required field `ray` is missing",
+    );
+}
+
+/// A radiance, intensity or transmittance given as a literal reference is
+/// refused outside what the quantity can take (the hostile review of issue
+/// 10, M4): `I_E: -1` was accepted and every error measured against it.
+/// `ln_tau` may be negative (it is at most 0).
+#[test]
+fn a_reference_value_outside_what_the_quantity_can_take_is_refused() {
+    let with = |values: &str| {
+        VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            &format!("{{ \"type\": \"value\", \"values\": {{ {values} }} }}"),
+        )
+    };
+    rejected(
+        &with("\"tau\": 0.5, \"I_E\": -1"),
+        "reference.values.I_E",
+        "-1 is not a value I_E can take: expected a number >= 0",
+    );
+    rejected(
+        &with("\"tau\": 1.5, \"I_E\": 1"),
+        "reference.values.tau",
+        "1.5 is not a value tau can take: expected a number in [0, 1]",
+    );
+    let ln =
+        with("\"ln_tau\": 0.5, \"I_E\": 1").replace("[\"tau\", \"I_E\"]", "[\"ln_tau\", \"I_E\"]");
+    rejected(
+        &ln,
+        "reference.values.ln_tau",
+        "0.5 is not a value ln_tau can take: expected a number <= 0",
+    );
+    // In range: accepted, ln tau negative.
+    let dir = scratch("refok");
+    let file = dir.join("e.json");
+    fs::write(&file, ln.replace("\"ln_tau\": 0.5", "\"ln_tau\": -3.3")).expect("write");
+    let check = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(check.status.success(), "{}", stderr(&check));
     let _ = fs::remove_dir_all(&dir);
 }
 
@@ -1635,4 +1854,106 @@ fn underflow_constant_integrands_and_missing_estimates_are_labelled() {
         .find(|l| l.starts_with("| stratified | 2 |"))
         .expect("a row at n = 2");
     assert!(two.contains("no error estimate"), "{two}");
+
+/// File system faults name the path and the reason in words (the hostile
+/// review of issue 10, low): not found, a directory, a FIFO, a device, an
+/// --out that is a file; a Mitsuba reference that is some other JSON file
+/// says it is not a values file and what it lacks (it was called "stale").
+#[test]
+fn file_system_faults_name_the_path_and_the_reason() {
+    let dir = scratch("fs");
+    let check = |path: &Path| {
+        let o = bin().arg("check").arg(path).output().expect("runs");
+        assert!(!o.status.success());
+        stderr(&o)
+    };
+    let missing = dir.join("missing.json");
+    let msg = check(&missing);
+    assert!(
+        msg.contains(&format!("{}: not found (os error 2)", missing.display())),
+        "{msg}"
+    );
+    let msg = check(&dir);
+    assert!(
+        msg.contains(&format!(
+            "{}: is a directory: expected a regular JSON file",
+            dir.display()
+        )),
+        "{msg}"
+    );
+    let msg = check(Path::new("/dev/null"));
+    assert!(msg.contains("/dev/null: is a device"), "{msg}");
+    // --out naming a file.
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let out = dir.join("a-file");
+    fs::write(&out, "").expect("write");
+    let o = bin()
+        .arg("run")
+        .arg("--out")
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains(&format!(
+            "{}: is a file, not a directory: the output folder (--out)",
+            out.display()
+        )),
+        "{}",
+        stderr(&o)
+    );
+    // A Mitsuba reference naming some other JSON file.
+    fs::write(dir.join("other.json"), "{\"a\": 1}").expect("write");
+    fs::write(
+        &file,
+        VALID.replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"mitsuba\", \"file\": \"other.json\" }",
+        ),
+    )
+    .expect("write");
+    let msg = check(&file);
+    assert!(
+        msg.contains("at `reference.file`")
+            && msg.contains("other.json (not a Mitsuba values file: it has no `experiment_hash` and `quantities`")
+            && !msg.contains("stale"),
+        "{msg}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A sphere of subnormal radius is refused at check with the accepted range
+/// (the hostile review of issue 10, M1: radius 1e-310 gave a closed-form
+/// ln tau of -inf); tiny normal radii seen from far away are measured right
+/// (M2: radius 1e-200 from a distance of 3, ln tau = -kappa 2r = -4e-200).
+#[test]
+fn sphere_radii_are_normal_numbers_and_tiny_ones_are_measured_right() {
+    let with = |r: &str| {
+        VALID
+            .replace("\"radius\": 1.0", &format!("\"radius\": {r}"))
+            .replace("[-3.0, 0.3, 0.0]", "[-3.0, 0.0, 0.0]")
+            .replace("[\"tau\", \"I_E\"]", "[\"ln_tau\", \"tau\"]")
+            .replace(", { \"rule\": \"stratified\" }", "")
+            .replace("[4, 16, 64]", "[4]")
+    };
+    rejected(
+        &with("1e-310"),
+        "scene.medium.radius",
+        "invalid radius = 1e-310: expected a finite number in [2.2250738585072014e-308, 1.7976931348623157e308]",
+    );
+    for (r, want) in [
+        ("1e-150", "-4.000000000000000e-150"),
+        ("1e-200", "-4.000000000000000e-200"),
+    ] {
+        let (dir, out, o) = run_text("tiny", &with(r));
+        assert!(o.status.success(), "{}", stderr(&o));
+        let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+        assert!(
+            report.contains(&format!("## ln_tau (reference {want})")),
+            "{report}"
+        );
+        let _ = fs::remove_dir_all(&dir);
+    }
 }

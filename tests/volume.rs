@@ -940,3 +940,70 @@ fn printed_formulas_evaluate_to_their_closed_forms_in_every_arithmetic() {
     let err = Volume::build(&no_light).expect_err("refused").to_string();
     assert!(err.contains("scene.printed[0]"), "{err}");
 }
+
+/// Ray–sphere chords against the exact `2 sqrt(r^2 - d^2)` (computed in
+/// units of `r`, so exactly rounded) for spheres of radius 1e-306 to 1e300
+/// and the smallest normal radius, rays through the centre and offset by
+/// `d = 0.6 r` and `0.999 r`, along an axis and obliquely, from `3r`
+/// before the sphere and from inside it, around a centre away from the
+/// origin (the hostile review of issue 10, M2). The tolerances are the
+/// rounding of the origin's coordinates (eps |3r|) times the chord's
+/// sensitivity to the offset (d^2 / (r^2 - d^2): 500 at 0.999). A subnormal radius is
+/// refused (M1: its chord came out as (-inf, inf) and the closed-form ln tau
+/// as -inf); one built field by field still gets finite roots.
+#[test]
+fn sphere_chords_are_exact_at_every_scale() {
+    use lightquad::geometry::{MIN_RADIUS, Sphere};
+    let dirs = [
+        Vec3::x(),
+        Vec3::new(0.48, -0.6, 0.64),
+        Vec3::new(-0.2, 0.3, 0.9).normalize(),
+    ];
+    for s in [
+        1e-306, 1e-300, 1e-200, 1e-150, 1e-100, 1e-10, 1.0, 1e10, 1e100, 1e150, 1e200, 1e300,
+    ] {
+        let centre = Vec3::new(1.0, -2.0, 0.5) * s;
+        let sphere = Sphere::new(centre, s).expect("normal radius");
+        for u in dirs {
+            // A unit vector perpendicular to u.
+            let w = u.cross(&Vec3::new(0.3, 0.7, -0.1)).normalize();
+            for (offset, tol) in [(0.0, 1e-15), (0.6, 5e-15), (0.999, 1e-12)] {
+                let exact = 2.0 * (1.0f64 - offset * offset).sqrt() * s;
+                for back in [3.0, 0.2] {
+                    let origin = centre + w * (offset * s) - u * (back * s);
+                    let ray = Ray::new(origin, u).expect("ray");
+                    let (t0, t1) = sphere
+                        .clip(&ray, f64::NEG_INFINITY, f64::INFINITY)
+                        .unwrap_or_else(|| panic!("missed: s {s:e} d {offset} back {back}"));
+                    let err = ((t1 - t0) / exact - 1.0).abs();
+                    assert!(
+                        err < tol,
+                        "s {s:e} u {u:?} d {offset} back {back}: chord {:e} vs {exact:e}",
+                        t1 - t0
+                    );
+                    // The midpoint is the closest approach, at t = back * s.
+                    let mid = 0.5 * (t0 + t1);
+                    assert!(((mid - back * s) / s).abs() < 1e-14, "mid {mid:e}");
+                }
+            }
+        }
+    }
+    // The smallest radius: its chord's parameters are near the subnormals.
+    let smallest = Sphere::new(Vec3::zeros(), MIN_RADIUS).expect("smallest");
+    let ray = Ray::new(Vec3::new(-3.0 * MIN_RADIUS, 0.0, 0.0), Vec3::x()).expect("ray");
+    let (t0, t1) = smallest.clip(&ray, 0.0, f64::INFINITY).expect("hits");
+    assert!(((t1 - t0) / (2.0 * MIN_RADIUS) - 1.0).abs() < 1e-12);
+    let e = Sphere::new(Vec3::zeros(), 1e-310).expect_err("subnormal radius");
+    assert!(e.to_string().contains("invalid radius = 1e-310"), "{e}");
+    assert!(e.to_string().contains("2.2250738585072014e-308"), "{e}");
+    // Built field by field, a subnormal sphere still gets finite roots
+    // (the scale 2^-1030 was computed as 1 / 2^1030 = 0).
+    let tiny = Sphere {
+        centre: Vec3::zeros(),
+        radius: 1e-310,
+    };
+    let (t0, t1) = tiny
+        .line_roots(Vec3::new(-3e-310, 0.0, 0.0), Vec3::x())
+        .expect("hits");
+    assert!(((t1 - t0) / 2e-310 - 1.0).abs() < 1e-12, "{t0:e} {t1:e}");
+}

@@ -94,10 +94,16 @@ pub enum RunError {
     },
 }
 
-fn io(path: &Path, e: impl std::fmt::Display) -> RunError {
+fn io<E: std::fmt::Display + 'static>(path: &Path, e: E) -> RunError {
+    // A file system error says what happened in words (`not found`,
+    // `permission denied`, `is a directory`) beside the system's own.
+    let message = match (&e as &dyn std::any::Any).downcast_ref::<std::io::Error>() {
+        Some(e) => source::describe(e),
+        None => e.to_string(),
+    };
     RunError::Io {
         path: path.display().to_string(),
-        message: e.to_string(),
+        message,
     }
 }
 
@@ -218,9 +224,27 @@ fn lock_output(out: &Path, shard: Option<(usize, usize)>) -> Result<Vec<fs::File
 
 /// Checks that `dir` exists (or can be made) and is writable.
 fn writable(dir: &Path) -> Result<(), RunError> {
-    fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    if let Ok(meta) = fs::metadata(dir)
+        && !meta.is_dir()
+    {
+        return Err(io(
+            dir,
+            "is a file, not a directory: the output folder (--out) must be a directory or \
+             not exist yet",
+        ));
+    }
+    fs::create_dir_all(dir).map_err(|e| {
+        io(
+            dir,
+            format!(
+                "cannot create the output folder (--out): {}",
+                source::describe(&e)
+            ),
+        )
+    })?;
     let probe = dir.join(format!(".lightquad-write-probe-{}", std::process::id()));
-    write_atomic(&probe, b"").map_err(|e| io(dir, format!("not writable: {e}")))?;
+    write_atomic(&probe, b"")
+        .map_err(|e| io(dir, format!("not writable: {}", source::describe(&e))))?;
     let _ = fs::remove_file(&probe);
     Ok(())
 }

@@ -199,8 +199,8 @@ pub fn mitsuba_values<Q: Quantity>(
             format!("{path}: {e} (run scripts/reference.sh to generate it)"),
         )
     })?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| SpecError::at(at, format!("{path}: {e}")))?;
+    let json =
+        super::source::values_json(&text).map_err(|e| SpecError::at(at, format!("{path}: {e}")))?;
     let made_from = json["experiment_hash"].as_str().unwrap_or("");
     if made_from != hash {
         return Err(stale_values(path, made_from, hash));
@@ -238,6 +238,17 @@ fn values_from_json<Q: Quantity>(
                 ),
             ));
         };
+        let (lo, hi) = q.bounds();
+        if !(lo..=hi).contains(&v) {
+            return Err(SpecError::at(
+                at,
+                format!(
+                    "{path} gives {} = {v}, which is not a value it can take: expected {}",
+                    q.name(),
+                    crate::family::bounds_in_words((lo, hi))
+                ),
+            ));
+        }
         values.insert(*q, vec![v]);
         worst = worst.max(se);
     }

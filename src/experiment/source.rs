@@ -160,40 +160,42 @@ pub enum Values {
 /// bundled values. The first made from these bytes wins; otherwise the first
 /// found is stale.
 pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>) -> Values {
-    let mut places: Vec<(String, Option<String>)> = Vec::new();
+    // Each place with its values, or why it has none (said when none is found).
+    let mut places: Vec<(String, Result<serde_json::Value, String>)> = Vec::new();
     if let Origin::Folder(dir) = origin {
         if let Some(file) = named {
-            // The file the experiment names: why it cannot be read is said.
             let path = resolve(dir, file);
-            places.push(match read_text(&path) {
-                Ok(text) => (path.display().to_string(), Some(text)),
-                Err(why) => (format!("{} ({why})", path.display()), None),
-            });
+            places.push((
+                path.display().to_string(),
+                read_text(&path).and_then(|t| values_json(&t)),
+            ));
         }
         let path = dir
             .join("..")
             .join("reference")
             .join("values")
             .join(format!("{name}.json"));
-        places.push((path.display().to_string(), read_text(&path).ok()));
+        places.push((
+            path.display().to_string(),
+            read_text(&path).and_then(|t| values_json(&t)),
+        ));
     }
     places.push((
         format!("<bundled>/values/{name}.json"),
-        bundled_values(name).map(str::to_string),
+        bundled_values(name)
+            .ok_or_else(|| "not bundled".to_string())
+            .and_then(values_json),
     ));
     let mut stale = None;
-    for (location, text) in &places {
-        let Some(json) = text
-            .as_deref()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(t).ok())
-        else {
+    for (location, json) in &places {
+        let Ok(json) = json else {
             continue;
         };
         let made_from = json["experiment_hash"].as_str().unwrap_or("").to_string();
         if made_from == hash {
             return Values::Found {
                 location: location.clone(),
-                json,
+                json: json.clone(),
             };
         }
         stale.get_or_insert(Values::Stale {
@@ -205,10 +207,87 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
         s
     } else if named.is_some() || bundled_values(name).is_some() {
         Values::Missing {
-            looked: places.into_iter().map(|(l, _)| l).collect(),
+            looked: places
+                .into_iter()
+                .map(|(l, json)| match json {
+                    Err(why) => format!("{l} ({why})"),
+                    Ok(_) => l,
+                })
+                .collect(),
         }
     } else {
         Values::NotExpected
+    }
+}
+
+/// The JSON of a Mitsuba values file, or why `text` is not one: another
+/// JSON file was reported "stale" (made from the hash "").
+pub fn values_json(text: &str) -> Result<serde_json::Value, String> {
+    let json: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
+    let missing: Vec<&str> = [
+        ("experiment_hash", json["experiment_hash"].is_string()),
+        ("quantities", json["quantities"].is_object()),
+    ]
+    .into_iter()
+    .filter(|(_, present)| !present)
+    .map(|(field, _)| field)
+    .collect();
+    if missing.is_empty() {
+        Ok(json)
+    } else {
+        Err(format!(
+            "not a Mitsuba values file: it has no {} (scripts/reference.sh writes \
+             `experiment_hash`, a string, and `quantities`, an object of values)",
+            missing
+                .iter()
+                .map(|f| format!("`{f}`"))
+                .collect::<Vec<_>>()
+                .join(" and ")
+        ))
+    }
+}
+
+/// Why a file operation failed, in words with the operating system's own
+/// (`not found`, `permission denied`, `is a directory`).
+pub fn describe(e: &std::io::Error) -> String {
+    use std::io::ErrorKind::*;
+    let words = match e.kind() {
+        NotFound => "not found",
+        PermissionDenied => "permission denied",
+        IsADirectory => "is a directory",
+        NotADirectory => "a part of the path is a file, not a directory",
+        AlreadyExists => "already exists",
+        ReadOnlyFilesystem => "the file system is read-only",
+        StorageFull => "no space left on the device",
+        _ => return e.to_string(),
+    };
+    match e.raw_os_error() {
+        Some(code) => format!("{words} (os error {code})"),
+        None => words.to_string(),
+    }
+}
+
+/// What kind of thing a path that is not a regular file is.
+fn not_regular(meta: &fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            return "is a FIFO (named pipe)";
+        }
+        if t.is_char_device() || t.is_block_device() {
+            return "is a device";
+        }
+        if t.is_socket() {
+            return "is a socket";
+        }
+    }
+    if meta.is_dir() {
+        "is a directory"
+    } else {
+        "is not a regular file"
     }
 }
 
@@ -230,11 +309,12 @@ pub const MAX_FILE_BYTES: u64 = 16 << 20;
 /// `/dev/zero` or a directory is refused at once instead of read forever.
 pub fn read_regular(path: &Path) -> Result<Vec<u8>, String> {
     use std::io::Read;
-    let meta = fs::metadata(path).map_err(|e| e.to_string())?;
+    let meta = fs::metadata(path).map_err(|e| describe(&e))?;
     if !meta.is_file() {
-        return Err(
-            "not a regular file (a FIFO, a device or a folder): expected a JSON file".into(),
-        );
+        return Err(format!(
+            "{}: expected a regular JSON file",
+            not_regular(&meta)
+        ));
     }
     if meta.len() > MAX_FILE_BYTES {
         return Err(format!(
@@ -245,7 +325,7 @@ pub fn read_regular(path: &Path) -> Result<Vec<u8>, String> {
     let mut bytes = Vec::new();
     fs::File::open(path)
         .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| describe(&e))?;
     if bytes.len() as u64 > MAX_FILE_BYTES {
         return Err(format!("grew past {MAX_FILE_BYTES} bytes while read"));
     }

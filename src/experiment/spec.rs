@@ -52,8 +52,10 @@ pub struct ExperimentSpec<F: Family> {
     #[serde(default)]
     pub equations: Vec<String>,
     /// The scene, in the family's format: only the parts it has.
+    #[serde(deserialize_with = "super::tagged::object")]
     pub scene: F::SceneSpec,
     /// Quantities to compute.
+    #[serde(deserialize_with = "super::tagged::names")]
     pub quantities: Vec<F::Quantity>,
     /// Rules and estimators to compare, with their parameters.
     pub rules: Vec<Method<F::Estimator>>,
@@ -61,11 +63,11 @@ pub struct ExperimentSpec<F: Family> {
     pub budgets: Budgets,
     /// Repeats per (rule, budget): run time is their lower median; randomised
     /// rules get one independent stream each.
-    #[serde(default = "default_repeats")]
+    #[serde(default = "default_repeats", deserialize_with = "repeats")]
     #[schemars(range(min = 1, max = 1000))]
     pub repeats: usize,
     /// Seed of every random stream (each job derives its own from it).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "seed")]
     pub seed: u64,
     /// The reference the errors are measured against.
     pub reference: ReferenceSpec<F::Quantity>,
@@ -76,6 +78,29 @@ pub struct ExperimentSpec<F: Family> {
 
 fn default_repeats() -> usize {
     3
+}
+
+fn repeats<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
+    super::tagged::whole(d, 1, 1000, "")
+}
+
+fn seed<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+    super::tagged::whole(d, 0, u64::MAX.into(), "")
+}
+
+/// A budget read by [`whole`](super::tagged::whole): its range named where
+/// the number does not fit (`18446744073709551615`).
+fn budget<'de, D: serde::Deserializer<'de>>(d: D) -> Result<i64, D::Error> {
+    super::tagged::whole(d, 1, super::validate::MAX_BUDGET.into(), "")
+}
+
+/// One budget of a list (see [`budget`]).
+struct ListedBudget(i64);
+
+impl<'de> Deserialize<'de> for ListedBudget {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        budget(d).map(ListedBudget)
+    }
 }
 
 fn default_targets() -> Vec<f64> {
@@ -99,9 +124,11 @@ pub enum Budgets {
 #[serde(deny_unknown_fields)]
 pub struct BudgetRange {
     /// First budget.
+    #[serde(deserialize_with = "budget")]
     #[schemars(range(min = 1, max = 100_000_000))]
     pub from: i64,
     /// Last budget (inclusive bound).
+    #[serde(deserialize_with = "budget")]
     #[schemars(range(min = 1, max = 100_000_000))]
     pub to: i64,
     /// Ratio between consecutive budgets (> 1).
@@ -198,7 +225,7 @@ pub struct MitsubaReference {
 #[serde(deny_unknown_fields)]
 pub struct ConvergedReference {
     /// Nodes per smooth piece (default 400).
-    #[serde(default = "four_hundred")]
+    #[serde(default = "four_hundred", deserialize_with = "converged_n")]
     #[schemars(range(min = 2, max = 100_000))]
     pub n: usize,
 }
@@ -207,12 +234,16 @@ fn four_hundred() -> usize {
     400
 }
 
+fn converged_n<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
+    super::tagged::whole(d, 2, 100_000, "")
+}
+
 /// Deserialises the two untagged enums of experiment files by the JSON
 /// kind they meet (number, list, map) instead of serde's untagged buffering,
 /// which loses the path and the reason of an error inside ("data did not
 /// match any variant").
 mod untagged {
-    use super::{BudgetRange, Budgets, Literal};
+    use super::{BudgetRange, Budgets, ListedBudget, Literal};
     use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
     use serde::de::{Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
     use std::fmt;
@@ -229,7 +260,8 @@ mod untagged {
                     )
                 }
                 fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Budgets, A::Error> {
-                    Vec::<i64>::deserialize(SeqAccessDeserializer::new(seq)).map(Budgets::List)
+                    Vec::<ListedBudget>::deserialize(SeqAccessDeserializer::new(seq))
+                        .map(|list| Budgets::List(list.into_iter().map(|b| b.0).collect()))
                 }
                 fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Budgets, A::Error> {
                     BudgetRange::deserialize(MapAccessDeserializer::new(map)).map(Budgets::Range)

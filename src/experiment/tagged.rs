@@ -51,9 +51,20 @@ pub fn split_tag<E: Error>(value: Value, tag: &str, names: &[&str]) -> Result<(S
         Some(Value::String(name)) if names.contains(&name.as_str()) => {
             Ok((name, Value::Object(map)))
         }
+        Some(other @ Value::String(_)) => Err(below(
+            tag,
+            &format!(
+                "unknown variant {}: {}",
+                crate::error::shortened(other.to_string()),
+                accepted()
+            ),
+        )),
         Some(other) => Err(below(
             tag,
-            &format!("unknown variant {other}: {}", accepted()),
+            &format!(
+                "{}: expected a name in quotes, one of {quoted}",
+                kind(&other)
+            ),
         )),
     }
 }
@@ -89,6 +100,21 @@ pub fn located(path: &str, message: &str) -> (String, String) {
             format!("{path}.{inner}")
         };
         message = rest.to_string();
+    }
+    // A missing field is named at its own path (`scene.ray.origin`), not at
+    // the object that lacks it; the message no longer starts "missing field",
+    // so an outer level does not move it again.
+    if let Some((field, rest)) = message
+        .strip_prefix("missing field `")
+        .and_then(|m| m.split_once('`'))
+    {
+        let field = field.to_string();
+        message = format!("the required field `{field}` is missing{rest}");
+        path = if path.is_empty() {
+            field
+        } else {
+            format!("{path}.{field}")
+        };
     }
     (path, message)
 }
@@ -156,6 +182,17 @@ pub fn plain_words(message: &str) -> String {
         let head = m[..i].replace("invalid length", "a list of length");
         m = format!("{head}expected an object ({{\"field\": value, ...}})");
     }
+    // serde's names of JSON kinds, and of a number past the f64 range.
+    m = m
+        .replace("invalid type: map,", "invalid type: an object,")
+        .replace("invalid type: sequence,", "invalid type: a list,")
+        .replace("expected a sequence", "expected a list");
+    if let Some(rest) = m.strip_prefix("number out of range") {
+        m = format!(
+            "a number beyond the f64 range (its magnitude is above 1.8e308){rest}: expected a \
+             finite number"
+        );
+    }
     for (rust, words) in [
         ("expected f64", "expected a number"),
         ("expected f32", "expected a number"),
@@ -211,4 +248,191 @@ where
             Ok((key, value))
         })
         .collect()
+}
+
+/// Reads a whole number into `T`, naming the range the field accepts,
+/// `lo..=hi`, where a value `T` cannot hold is refused: serde said `expected
+/// a whole number >= 0` of `"replicates": -1` (which accepts 2..=1000000) and
+/// nothing of the range for 18446744073709551615 in `budgets`. A value `T`
+/// holds is returned as it is, for the caller's own check of the range
+/// (whose message names the field's meaning).
+pub fn whole<'de, D, T>(d: D, lo: i128, hi: i128, note: &str) -> Result<T, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: TryFrom<i128>,
+{
+    struct Whole<'n, T> {
+        lo: i128,
+        hi: i128,
+        note: &'n str,
+        out: std::marker::PhantomData<T>,
+    }
+    impl<T: TryFrom<i128>> Whole<'_, T> {
+        fn take<E: Error>(&self, x: i128, got: serde::de::Unexpected) -> Result<T, E> {
+            T::try_from(x).map_err(|_| E::invalid_value(got, self))
+        }
+    }
+    impl<'de, T: TryFrom<i128>> serde::de::Visitor<'de> for Whole<'_, T> {
+        type Value = T;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(
+                f,
+                "a whole number in {}..={}{}",
+                self.lo, self.hi, self.note
+            )
+        }
+        fn visit_i64<E: Error>(self, x: i64) -> Result<T, E> {
+            self.take(x.into(), serde::de::Unexpected::Signed(x))
+        }
+        fn visit_u64<E: Error>(self, x: u64) -> Result<T, E> {
+            self.take(x.into(), serde::de::Unexpected::Unsigned(x))
+        }
+    }
+    d.deserialize_any(Whole {
+        lo,
+        hi,
+        note,
+        out: std::marker::PhantomData,
+    })
+}
+
+/// A count of at least 1 (voxels along an axis), read by [`whole`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Count(pub usize);
+
+impl<'de> Deserialize<'de> for Count {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        whole(d, 1, usize::MAX as i128, "").map(Count)
+    }
+}
+
+/// Reads `[n_x, n_y, n_z]` counts of at least 1 (see [`array()`], [`Count`]).
+pub fn counts<'de, D, const N: usize>(d: D) -> Result<[usize; N], D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let counts: [Count; N] = array(d)?;
+    Ok(counts.map(|c| c.0))
+}
+
+/// Reads an object into `T` with a fault inside named at its own path (as
+/// [`variant`]); anything else is refused as what it is: serde's derived
+/// reader takes a list for a struct too, and `"scene": [1, 2]` was reported
+/// at `scene[0]` as "expected string or map".
+pub fn object<'de, D, T>(d: D) -> Result<T, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: DeserializeOwned,
+{
+    let value = Value::deserialize(d)?;
+    if !value.is_object() {
+        return Err(D::Error::custom(format!(
+            "{}: expected an object ({{\"field\": value, ...}})",
+            kind(&value)
+        )));
+    }
+    variant(value)
+}
+
+/// [`object`] for an optional field (`null` is `None`).
+pub fn optional_object<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: DeserializeOwned,
+{
+    match Value::deserialize(d)? {
+        Value::Null => Ok(None),
+        value => object(value).map(Some).map_err(D::Error::custom),
+    }
+}
+
+/// What a JSON value is, with the value (shortened): `a list [1, 2]`.
+pub fn kind(value: &Value) -> String {
+    let what = match value {
+        Value::Null => return "null".into(),
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "a list",
+        Value::Object(_) => "an object",
+    };
+    format!("{what} {}", crate::error::shortened(value.to_string()))
+}
+
+/// The names a unit enum accepts, as serde lists them (`` `cumulative` or
+/// `nested` ``, `` one of `tau`, `ln_tau`, ... ``), found by offering it a
+/// name that no enum has.
+fn accepted_names<T: DeserializeOwned>() -> String {
+    let probe = Value::String("\u{0}".into());
+    match serde_json::from_value::<T>(probe) {
+        Err(e) => {
+            let e = e.to_string();
+            match e.split_once("expected ") {
+                Some((_, names)) => names.to_string(),
+                None => e,
+            }
+        }
+        Ok(_) => "a name".into(),
+    }
+}
+
+/// Reads one name of a unit enum (`"depth_scheme": "nested"`); a value that
+/// is not a name is refused with the names listed (serde said only
+/// "expected string or map").
+pub fn named<'de, D, T>(d: D) -> Result<T, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: DeserializeOwned,
+{
+    let value = Value::deserialize(d)?;
+    name_of(value).map_err(D::Error::custom)
+}
+
+fn name_of<T: DeserializeOwned>(value: Value) -> Result<T, String> {
+    if !value.is_string() {
+        return Err(format!(
+            "{}: expected a name in quotes, {}",
+            kind(&value),
+            accepted_names::<T>()
+        ));
+    }
+    serde_json::from_value(value).map_err(|e| e.to_string())
+}
+
+/// Reads a list of names of a unit enum (`"quantities": ["tau"]`), a fault
+/// named at its index with the names listed (see [`named`]).
+pub fn names<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: DeserializeOwned,
+{
+    let value = Value::deserialize(d)?;
+    let Value::Array(items) = value else {
+        return Err(D::Error::custom(format!(
+            "{}: expected a list of names, each {}",
+            kind(&value),
+            accepted_names::<T>()
+        )));
+    };
+    items
+        .into_iter()
+        .enumerate()
+        .map(|(i, item)| name_of(item).map_err(|m| below(&format!("[{i}]"), &m)))
+        .collect()
+}
+
+/// [`names`] for an optional list that, when given, names at least one item
+/// (see [`non_empty`]).
+pub fn non_empty_names<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: DeserializeOwned,
+{
+    let items: Vec<T> = names(d)?;
+    if items.is_empty() {
+        return Err(D::Error::custom(
+            "an empty list: name at least one item, or leave the field out",
+        ));
+    }
+    Ok(items)
 }

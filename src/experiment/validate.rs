@@ -562,6 +562,26 @@ pub fn literal_values<Q: Quantity>(
                 ),
             ));
         }
+        let (lo, hi) = q.bounds();
+        if let Some((i, x)) = got
+            .iter()
+            .enumerate()
+            .find(|(_, x)| !(lo..=hi).contains(*x))
+        {
+            let at = if let super::spec::Literal::Channels(_) = v {
+                format!("{at}[{i}]")
+            } else {
+                at
+            };
+            return Err(SpecError::at(
+                at,
+                format!(
+                    "{x} is not a value {} can take: expected {}",
+                    q.name(),
+                    crate::family::bounds_in_words((lo, hi))
+                ),
+            ));
+        }
         out.insert(*q, got);
     }
     Ok(out)

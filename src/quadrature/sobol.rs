@@ -63,14 +63,22 @@ use crate::value::Value;
 pub struct Sobol {
     /// Number of independent scrambles (>= 2) used for the standard error
     /// (default 8).
-    #[serde(default = "Sobol::default_replicates")]
-    #[schemars(range(min = 2))]
+    #[serde(
+        default = "Sobol::default_replicates",
+        deserialize_with = "Sobol::read_replicates"
+    )]
+    #[schemars(range(min = 2, max = 1_000_000))]
     pub replicates: usize,
 }
 
 impl Sobol {
     fn default_replicates() -> usize {
         8
+    }
+
+    /// The range named where a value does not fit (`-1` said `>= 0`).
+    fn read_replicates<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
+        crate::experiment::tagged::whole(d, 2, MAX_REPLICATES as i128, "")
     }
 }
 

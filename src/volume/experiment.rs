@@ -58,12 +58,13 @@ pub struct Volume;
 #[serde(deny_unknown_fields)]
 pub struct SceneSpec {
     /// How `tau(t_n, t)` inside V-E and V-L is computed.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "tagged::named")]
     pub depth_scheme: DepthSchemeSpec,
     /// How the shadow ray's optical depth in V-Lp is computed.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "tagged::named")]
     pub shadow: ShadowSpec,
     /// The eye ray.
+    #[serde(deserialize_with = "tagged::object")]
     pub ray: RaySpec,
     /// Start of the looked-at part of the ray (default 0).
     #[serde(default)]
@@ -84,12 +85,12 @@ pub struct SceneSpec {
     #[serde(default)]
     pub background: Option<f64>,
     /// The directional light, if any.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "tagged::optional_object")]
     pub light: Option<LightSpec>,
     /// Audit points of docs/EQUATIONS.md whose printed forms the report
     /// evaluates in this scene beside the corrected ones (constant sphere
     /// only; `s` and `exponent` need a light, `background` a background).
-    #[serde(default, deserialize_with = "tagged::non_empty")]
+    #[serde(default, deserialize_with = "tagged::non_empty_names")]
     pub printed: Vec<Printed>,
 }
 
@@ -187,7 +188,7 @@ pub struct VoxelGridSpec {
     #[serde(deserialize_with = "tagged::array")]
     pub max: [f64; 3],
     /// Voxels per axis.
-    #[serde(deserialize_with = "tagged::array")]
+    #[serde(deserialize_with = "tagged::counts")]
     pub resolution: [usize; 3],
     /// Densities, x fastest.
     pub data: Vec<f64>,
@@ -352,6 +353,16 @@ impl family::Quantity for VolumeQuantity {
     fn all() -> &'static [Self] {
         use VolumeQuantity::*;
         &[Tau, LnTau, Emission, Background, Light, Total]
+    }
+
+    /// A transmittance is in [0, 1] and its logarithm at most 0; the
+    /// radiances are at least 0 (emission, background and light are).
+    fn bounds(&self) -> (f64, f64) {
+        match self {
+            VolumeQuantity::Tau => (0.0, 1.0),
+            VolumeQuantity::LnTau => (f64::NEG_INFINITY, 0.0),
+            _ => (0.0, f64::INFINITY),
+        }
     }
 }
 
