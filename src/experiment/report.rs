@@ -873,7 +873,16 @@ fn orders_and_plots(
         });
         // NaN (failed) rows are dropped; the plot puts unresolved errors on
         // its floor line.
-        let err = |r: &&Row| r.rel_error;
+        // An underflowed row (0 against a reference that also reads 0) is
+        // not an error at the floor: it is dropped like a failed one, and
+        // the rows and the log-space quantity (`ln_tau`) say why.
+        let err = |r: &&Row| {
+            if r.flags.contains(&RowFlag::Job(Flag::Underflow)) {
+                f64::NAN
+            } else {
+                r.rel_error
+            }
+        };
         by_time.push((
             label.clone(),
             mine.iter().map(|r| (r.seconds.max(1e-9), err(r))).collect(),
