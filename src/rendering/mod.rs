@@ -12,12 +12,14 @@
 //! | [`forms`] | R-H and R-A integrands for any rule, over the hemisphere, a BRDF-sampled map, emitter cones and emitter surfaces |
 //! | [`mis`] | multiple importance sampling of light and BRDF samples (balance, power heuristics) |
 //! | [`cap`] | spherical caps and cones of directions given by `1 - cos theta_max` |
+//! | [`experiment`] | the family of the experiment layer (`"family": "rendering"`): scene format, quantities by form, MIS estimators, closed forms, converged reference |
 //!
 //! Closed forms live in [`crate::exact::rendering`].
 
 pub mod brdf;
 pub mod cap;
 pub mod emitter;
+pub mod experiment;
 pub mod forms;
 pub mod mis;
 pub mod occluder;
