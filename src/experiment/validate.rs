@@ -161,7 +161,7 @@ pub fn validate_from<F: Family>(
             let at = format!("quantities[{k}]");
             return Err(SpecError::at(
                 at,
-                format!("{} in this scene: {why}", q.name()),
+                format!("{} cannot be computed in this scene: {why}", q.name()),
             ));
         }
     }

@@ -1340,7 +1340,20 @@ fn emitter(spec: &EmitterSpec) -> Result<AnyEmitter<f64>, QuadError> {
         }
         EmitterSpec::Sphere(s) => SphereLight::new(vec3(s.centre), s.radius, s.radiance)?.into(),
         EmitterSpec::Environment(e) => EnvironmentLight::new(e.radiance)?.into(),
-        EmitterSpec::Cap(c) => CapLight::new(vec3(c.axis), c.half_angle, c.radiance)?.into(),
+        EmitterSpec::Cap(c) => CapLight::new(vec3(c.axis), c.half_angle, c.radiance)
+            .map_err(|e| match e {
+                // 1 - cos of an angle below ~1e-162 rad underflows to 0.
+                QuadError::InvalidParameter { name, .. } if name == "one_minus_cos" => {
+                    QuadError::invalid(
+                        "half_angle",
+                        c.half_angle,
+                        "an angle in (0, pi] whose 1 - cos is a positive f64 (at least about \
+                         1e-161 rad)",
+                    )
+                }
+                other => other,
+            })?
+            .into(),
     })
 }
 
@@ -1433,14 +1446,30 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
             bounded(&at, &o)?;
         }
         // Every form's domain must exist from the receiver: a receiver
-        // inside a sphere light has none.
+        // inside a sphere light has none, nor does a light too small to
+        // subtend a solid angle in f64.
+        if let AnyEmitter::Sphere(s) = &e {
+            let (c, radius) = (s.shape().centre, s.shape().radius);
+            if (receiver.point() - c).norm() <= radius {
+                return Err(SpecError::at(
+                    at,
+                    format!(
+                        "the receiver at {:?} is inside or on this sphere light (centre {:?}, \
+                         radius {radius}), which emits outward: expected a receiver outside \
+                         every sphere light",
+                        r.point,
+                        c.as_slice()
+                    ),
+                ));
+            }
+        }
         if let Err(err) = e.surface(&receiver).and_then(|_| e.cone(&receiver)) {
             return Err(SpecError::at(
                 at,
                 format!(
-                    "the receiver at {:?} cannot see this emitter's outside ({err}): expected a \
-                     receiver outside every sphere light",
-                    r.point
+                    "its domains seen from the receiver cannot be built ({err}): expected an \
+                     emitter whose cone of directions from the receiver is representable in f64 \
+                     (an angular radius above about 1e-154 rad)"
                 ),
             ));
         }
