@@ -14,12 +14,14 @@
 //!
 //! | quantity | form | domain, per evaluation | integrand in `u` |
 //! |---|---|---|---|
-//! | `E_hemisphere` | R-H | the hemisphere, uniform map `cos theta = u_1`, `|J| = 2 pi` | `L_i(x, w) cos theta 2 pi`: a ray cast per node |
-//! | `E_cosine` | R-H | the hemisphere, Malley's map in projected solid angle, `|J| = pi` | `L_i(x, w) pi` |
-//! | `E_cone` | R-H per emitter | the cone of directions that holds the emitter (exact for a sphere, a cap light, the environment's hemisphere and a disk seen from its axis; a bounding cone otherwise) | `L_i^k(x, w) cos theta |J|` |
-//! | `E_area` | R-A (R-S, R-3P's `g`) per emitter | the emitter's surface through its map with the Jacobian (rectangle, polar disk, Duffy triangle, the visible cap of a sphere; the cap of directions of a light at infinity) | `L_e cos theta cos theta' / r^2 V(x, y) |J|` |
+//! | `E_hemisphere` | R-H | the hemisphere, uniform map `cos theta = u_1`, `J = 2 pi` | `L_i(x, w) cos theta 2 pi`: a ray cast per node |
+//! | `E_cosine` | R-H | the hemisphere, Malley's map in projected solid angle, `J = pi` | `L_i(x, w) pi` |
+//! | `E_cone` | R-H per emitter | the cone of directions that holds the emitter (exact for a sphere, a cap light, the environment's hemisphere and a disk seen from its axis; a bounding cone otherwise) | `L_i^k(x, w) cos theta J` |
+//! | `E_area` | R-A (R-S, R-3P's `g`) per emitter | the emitter's surface through its map with the Jacobian (rectangle, polar disk, Duffy triangle, the visible cap of a sphere; the cap of directions of a light at infinity) | `L_e cos theta cos theta' / r^2 V(x, y) J` |
 //! | `L_hemisphere`, `L_cosine`, `L_cone`, `L_area` | as the `E_` forms | as above | the same with `f_r(w, wo)` |
-//! | `L_brdf` | R-H | the BRDF-sampled map of `scene.receiver.brdf` for `wo`, `|J| = 1 / pdf` | `f_r L_i cos theta / pdf` |
+//! | `L_brdf` | R-H | the BRDF-sampled map of `scene.receiver.brdf` for `wo`, `J = 1 / pdf` | `f_r L_i cos theta / pdf` |
+//!
+//! (`J` is the Jacobian of the domain's map.)
 //!
 //! The per-emitter forms (`_cone`, `_area`) spend the budget on each emitter
 //! and add the parts. Every quantity is a 2-D integral: every 2-D rule
@@ -1602,20 +1604,24 @@ fn terms_section(built: &Built) -> String {
             Form::Cone => (
                 "R-H per emitter",
                 "the emitter's cone of directions",
-                format!("{k}L_i^k cos theta |J|"),
+                format!("{k}L_i^k cos theta J"),
                 "L_i^k: one ray against every surface",
             ),
             Form::Area => (
                 "R-A (R-S, g of R-3P) per emitter",
                 "the emitter's surface, its map's Jacobian",
-                format!("L_e {k}cos theta cos theta' / r^2 V |J|"),
+                format!("L_e {k}cos theta cos theta' / r^2 V J"),
                 "V: a shadow ray where tested (below)",
             ),
         };
         let name = family::Quantity::name(&q);
         let _ = writeln!(s, "| {name} | {form} | {domain} | {integrand} | {terms} |");
     }
-    let _ = writeln!(s, "\nVisibility of the area forms: {}.", shadow.join("; "));
+    let _ = writeln!(
+        s,
+        "\nJ is the Jacobian of the domain's map. Visibility of the area forms: {}.",
+        shadow.join("; ")
+    );
     s
 }
 
