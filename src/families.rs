@@ -4,7 +4,7 @@
 //! ```
 //! let registry = lightquad::families::builtin();
 //! let names: Vec<&str> = registry.entries().iter().map(|f| f.name).collect();
-//! assert_eq!(names, ["calibration", "volume"]);
+//! assert_eq!(names, ["calibration", "volume", "rendering"]);
 //! assert!(registry.get("volume").expect("registered").quantities().contains(&"tau"));
 //! ```
 
@@ -16,6 +16,7 @@ pub fn builtin() -> Registry {
     Registry::new()
         .with::<crate::calibration::Calibration>()
         .with::<crate::volume::experiment::Volume>()
+        .with::<crate::rendering::experiment::Rendering>()
 }
 
 #[cfg(test)]
@@ -41,6 +42,7 @@ mod tests {
     fn every_builtin_familys_names_agree_with_its_serde_forms() -> Result<(), serde_json::Error> {
         names_agree::<crate::calibration::Calibration>()?;
         names_agree::<crate::volume::experiment::Volume>()?;
+        names_agree::<crate::rendering::experiment::Rendering>()?;
         // Every family listed above is the registry's.
         assert_eq!(
             super::builtin()
@@ -48,7 +50,7 @@ mod tests {
                 .iter()
                 .map(|e| e.name)
                 .collect::<Vec<_>>(),
-            ["calibration", "volume"]
+            ["calibration", "volume", "rendering"]
         );
         Ok(())
     }

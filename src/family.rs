@@ -447,6 +447,14 @@ pub trait Family: Sized + Send + Sync + 'static {
     /// it must have that many.
     fn channels(scene: &Self::Scene, quantity: Self::Quantity) -> usize;
 
+    /// Why `quantity` cannot be computed in this `scene` by any method (a
+    /// term it needs is missing: reflected radiance without a BRDF); checked
+    /// when an experiment is validated, the error at the quantity. None: it
+    /// can.
+    fn lacks(_scene: &Self::Scene, _quantity: Self::Quantity) -> Option<String> {
+        None
+    }
+
     /// The quantities `estimator` estimates.
     fn estimates(estimator: &Self::Estimator) -> &'static [Self::Quantity];
 

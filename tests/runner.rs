@@ -507,7 +507,7 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
                 .expect("const family")
         })
         .collect();
-    assert_eq!(families, ["calibration", "volume"]);
+    assert_eq!(families, ["calibration", "volume", "rendering"]);
     let volume = &schema["oneOf"][1];
     assert!(
         volume["properties"]["scene"]["$ref"].is_string(),

@@ -156,6 +156,15 @@ pub fn validate_from<F: Family>(
 ) -> Result<Experiment<F>, SpecError> {
     check_header::<F>(&spec)?;
     let scene = F::build(&spec.scene)?;
+    for (k, q) in spec.quantities.iter().enumerate() {
+        if let Some(why) = F::lacks(&scene, *q) {
+            let at = format!("quantities[{k}]");
+            return Err(SpecError::at(
+                at,
+                format!("{} cannot be computed in this scene: {why}", q.name()),
+            ));
+        }
+    }
     check_methods::<F>(&spec, &scene)?;
     let budgets = budgets(&spec.budgets)?;
     // Budgets below a rule's minimum are skipped for that rule; a rule left

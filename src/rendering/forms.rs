@@ -285,13 +285,54 @@ pub fn cone_integrand<'a, V: Value, K: Kernel>(
 /// (y - x)/r`, `cos theta = n . wi`, `cos theta' = -n_y . wi`, each clamped
 /// at 0 (R-A, the geometry term `g` of R-3P); for a light at infinity, whose
 /// domain is its cap of directions, `w -> L_e K(w) cos theta V(x, w)`.
-/// Zero without a shadow ray where the cosines or the kernel vanish. An
-/// index `k` past the scene's emitters is an error naming `k`.
+/// Zero without a shadow ray where the cosines or the kernel vanish, and
+/// without one anywhere when nothing can block the emitter
+/// ([`Scene::has_blockers`]). An index `k` past the scene's emitters is an
+/// error naming `k`.
 pub fn area_integrand<'a, V: Value, K: Kernel>(
     scene: &'a Scene<V>,
     receiver: &'a Receiver,
     kernel: &'a K,
     k: usize,
+) -> Result<impl Fn(Vec3) -> V + 'a, QuadError> {
+    let visible = area_visibility(scene, receiver.point(), k);
+    area_integrand_with(scene, receiver, kernel, k, visible)
+}
+
+/// R-A's visibility term for emitter `k` seen from `x`, as
+/// [`area_integrand`] evaluates it: `V(x, y)` for a point `y` on a finite
+/// emitter ([`Scene::visible`], the emitter itself not tested), `V(x, w)`
+/// toward the lights at infinity for a direction `w`
+/// ([`Scene::visible_to_infinity`]); the constant 1, with no ray cast, when
+/// nothing can block the emitter ([`Scene::has_blockers`]).
+pub fn area_visibility<V: Value>(
+    scene: &Scene<V>,
+    x: Vec3,
+    k: usize,
+) -> impl Fn(Vec3) -> bool + '_ {
+    let infinite = scene.emitters().get(k).is_some_and(|e| e.at_infinity());
+    let skip = if infinite { None } else { Some(k) };
+    let tested = scene.has_blockers(skip);
+    move |y: Vec3| {
+        !tested
+            || if infinite {
+                scene.visible_to_infinity(x, y)
+            } else {
+                scene.visible(x, y, Some(k))
+            }
+    }
+}
+
+/// [`area_integrand`] with the visibility term `visible` (called only where
+/// the rest of the integrand is non-zero): a caller that counts shadow rays
+/// wraps [`area_visibility`] (counting by wrapping, as the rules' evaluations
+/// are counted).
+pub fn area_integrand_with<'a, V: Value, K: Kernel, W: Fn(Vec3) -> bool + 'a>(
+    scene: &'a Scene<V>,
+    receiver: &'a Receiver,
+    kernel: &'a K,
+    k: usize,
+    visible: W,
 ) -> Result<impl Fn(Vec3) -> V + 'a, QuadError> {
     let x = receiver.point();
     let count = scene.emitters().len();
@@ -308,7 +349,7 @@ pub fn area_integrand<'a, V: Value, K: Kernel>(
         if infinite {
             let cos = receiver.cos_theta(y);
             let weight = if cos > 0.0 { kernel.weight(y) } else { 0.0 };
-            if weight == 0.0 || !scene.visible_to_infinity(x, y) {
+            if weight == 0.0 || !visible(y) {
                 return V::zero();
             }
             return radiance.map(|l| l * weight * cos);
@@ -326,7 +367,7 @@ pub fn area_integrand<'a, V: Value, K: Kernel>(
             return V::zero();
         }
         let weight = kernel.weight(wi);
-        if weight == 0.0 || !scene.visible(x, y, Some(k)) {
+        if weight == 0.0 || !visible(y) {
             return V::zero();
         }
         let g = weight * cos * cos_light / r2;

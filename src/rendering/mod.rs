@@ -13,12 +13,14 @@
 //! | [`mis`] | multiple importance sampling of light and BRDF samples (balance, power heuristics) |
 //! | [`cap`] | spherical caps and cones of directions given by `1 - cos theta_max` |
 //! | [`furnace`] | the full equation in a closed scene (an integrating sphere, the white furnace): Neumann series bounce by bounce and path tracing with Russian roulette |
+//! | [`experiment`] | the family of the experiment layer (`"family": "rendering"`): scene format, quantities by form, MIS estimators, closed forms, converged reference |
 //!
 //! Closed forms live in [`crate::exact::rendering`].
 
 pub mod brdf;
 pub mod cap;
 pub mod emitter;
+pub mod experiment;
 pub mod forms;
 pub mod furnace;
 pub mod mis;

@@ -104,6 +104,34 @@ impl<V: Value> Scene<V> {
         SHADOW_OFFSET * (self.scale + x.amax().max(y.amax()))
     }
 
+    /// True when some surface can stand between a receiver and emitter
+    /// `skip` (`None`: the lights at infinity): an occluder, or a finite
+    /// emitter other than `skip`. Without one, R-A's visibility `V` is 1
+    /// everywhere for that emitter and needs no shadow ray.
+    ///
+    /// ```
+    /// use lightquad::domain::Vec3;
+    /// use lightquad::rendering::emitter::{AnyEmitter, DiskLight, EnvironmentLight};
+    /// use lightquad::rendering::scene::Scene;
+    ///
+    /// let disk = DiskLight::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::z(), 1.0, 1.0)?;
+    /// let sky = EnvironmentLight::new(1.0)?;
+    /// let alone = Scene::new(vec![AnyEmitter::from(disk)], vec![]);
+    /// assert!(!alone.has_blockers(Some(0)));
+    /// // The disk shadows the sky, and nothing shadows the disk.
+    /// let both = Scene::new(vec![AnyEmitter::from(disk), AnyEmitter::from(sky)], vec![]);
+    /// assert!(both.has_blockers(Some(1)) && !both.has_blockers(Some(0)));
+    /// # Ok::<(), lightquad::QuadError>(())
+    /// ```
+    pub fn has_blockers(&self, skip: Option<usize>) -> bool {
+        !self.occluders.is_empty()
+            || self
+                .emitters
+                .iter()
+                .enumerate()
+                .any(|(i, e)| Some(i) != skip && e.occluder().is_some())
+    }
+
     /// True when some blocker (every occluder, every finite emitter but
     /// `skip`) meets `x + t w` for `t` in `(t_min, t_max)`.
     fn blocked(&self, x: Vec3, w: Vec3, t_min: f64, t_max: f64, skip: Option<usize>) -> bool {
