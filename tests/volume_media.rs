@@ -733,3 +733,19 @@ fn end_nodes_read_the_pieces_own_field_so_the_trapezoid_is_exact_on_linear_media
     assert!(worst_gradient < 1e-13, "gradient {worst_gradient:e}");
     assert!(worst_grid < 1e-13, "grid {worst_grid:e}");
 }
+
+/// A subnormal density is refused, naming `kappa` and the range: 1e-320
+/// keeps a few bits, and the closed form of I_E built from it was off by
+/// 1.2e-4 against `c L`, which every rule got exactly (the hostile probe of
+/// issue 10). Zero and the smallest normal density are accepted.
+#[test]
+fn a_subnormal_density_is_refused() {
+    use lightquad::volume::constant_sphere::ConstantSphere;
+    let e = ConstantSphere::new(Vec3::zeros(), 1.0, 1e-320).expect_err("subnormal");
+    assert!(
+        e.to_string().contains("kappa") && e.to_string().contains("normal f64"),
+        "{e}"
+    );
+    assert!(ConstantSphere::new(Vec3::zeros(), 1.0, 0.0).is_ok());
+    assert!(ConstantSphere::new(Vec3::zeros(), 1.0, f64::MIN_POSITIVE).is_ok());
+}

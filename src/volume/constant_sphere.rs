@@ -39,10 +39,20 @@ pub struct ConstantSphere {
 }
 
 impl ConstantSphere {
-    /// A constant-density sphere; `kappa` finite and >= 0.
+    /// A constant-density sphere; `kappa` finite and >= 0, and 0 or a normal
+    /// f64: a subnormal density (1e-320) keeps a few bits, and the closed
+    /// form `c (1 - e^(-kappa L)) / kappa` built from it was off by 1.2e-4
+    /// while every rule had `c L` exactly (the hostile probe of issue 10).
     pub fn new(centre: Vec3, radius: f64, kappa: f64) -> Result<Self, QuadError> {
-        if !(kappa.is_finite() && kappa >= 0.0) {
-            return Err(QuadError::invalid("kappa", kappa, "a finite density >= 0"));
+        if !(kappa.is_finite() && (kappa == 0.0 || kappa >= f64::MIN_POSITIVE)) {
+            return Err(QuadError::invalid(
+                "kappa",
+                kappa,
+                format!(
+                    "a finite density >= 0: 0 or at least {:e} (a normal f64; a subnormal one keeps too few digits)",
+                    f64::MIN_POSITIVE
+                ),
+            ));
         }
         Ok(ConstantSphere {
             sphere: Sphere::new(centre, radius)?,
