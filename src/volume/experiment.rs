@@ -48,6 +48,7 @@ use crate::experiment::tagged;
 use crate::family::{self, Family, Flag, Measured, Method, Outcome};
 use crate::geometry::Ray;
 use crate::quadrature::GaussKronrod;
+use crate::volume::gaussian_blobs::{MAX_WIDTH, MIN_WIDTH};
 
 /// The volume family.
 #[derive(Debug, Clone, Copy)]
@@ -622,8 +623,9 @@ impl Family for Volume {
             rel_tol: 1e-13,
         };
         let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
+        // Only the terms asked for: I_B alone computed I_L too.
         let res = evaluate(
-            &built.scene,
+            &needed(&built.scene, quantities),
             &rule,
             15 + 30 * n,
             DepthScheme::Cumulative,
@@ -1078,6 +1080,25 @@ fn printed_forms(spec: &SceneSpec) -> Result<Option<(printed::Sphere, Vec<Printe
                 ),
             ));
         }
+    }
+    // The printed light formulas square the radius unscaled, as the
+    // document writes them: outside [1e-150, 1e150] R^2 leaves the normal
+    // numbers (radius 1e308 made their evaluation NaN; 1e-200 made the
+    // printed root real where it is not), as for a blob's width.
+    let light_forms = spec
+        .printed
+        .iter()
+        .any(|p| matches!(p, Printed::S | Printed::Exponent));
+    if light_forms && !(MIN_WIDTH..=MAX_WIDTH).contains(&radius) {
+        return Err(SpecError::at(
+            "scene.medium.radius",
+            format!(
+                "{}: expected a radius in [{MIN_WIDTH:e}, {MAX_WIDTH:e}] where the printed light \
+                 formulas (scene.printed \"s\" or \"exponent\") are evaluated: they square it, \
+                 and its square must be a normal number",
+                crate::error::shortened(radius.to_string())
+            ),
+        ));
     }
     Ok(Some((
         printed::Sphere {
