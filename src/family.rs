@@ -472,15 +472,20 @@ pub trait Family: Sized + Send + Sync + 'static {
     /// About how many integrand evaluations one job of `quantity` with
     /// `method` at `budget` costs, to refuse before running what would take
     /// hours ([`crate::experiment::validate::MAX_JOB_EVALUATIONS`]). The
-    /// budget itself by default; a family whose evaluations nest (an inner
-    /// integral per outer node) says so here.
+    /// evaluations the rule makes at that budget by default
+    /// ([`Rule::evaluations`], in the quantity's dimension; the budget for an
+    /// estimator); a family whose evaluations nest (an inner integral per
+    /// outer node) says so here.
     fn cost(
-        _scene: &Self::Scene,
-        _method: &Method<Self::Estimator>,
+        scene: &Self::Scene,
+        method: &Method<Self::Estimator>,
         budget: usize,
-        _quantity: Self::Quantity,
+        quantity: Self::Quantity,
     ) -> f64 {
-        budget as f64
+        match method {
+            Method::Rule(rule) => rule.evaluations(budget, Self::dimension(scene, quantity)),
+            Method::Estimator(_) => budget as f64,
+        }
     }
 
     /// About how many bytes one job of `quantity` with `method` at `budget`

@@ -104,6 +104,13 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
         Dimensions { min: 2, max: 2 }
     }
 
+    /// The outer factor's evaluations at `floor(sqrt(n))` nodes, each one an
+    /// inner integral of the inner factor's.
+    fn evaluations(&self, n: usize, _dim: usize) -> f64 {
+        let m = integer_root(n, 2);
+        self.outer.evaluations(m, 1) * self.inner.evaluations(m, 1)
+    }
+
     /// Both factors' memory at their `floor(sqrt(n))` nodes each.
     fn memory(&self, n: usize, _dim: usize) -> f64 {
         let m = integer_root(n, 2);

@@ -48,6 +48,7 @@ use crate::experiment::tagged;
 use crate::family::{self, Family, Flag, Measured, Method, Outcome};
 use crate::geometry::Ray;
 use crate::quadrature::GaussKronrod;
+use crate::volume::gaussian_blobs::{MAX_WIDTH, MIN_WIDTH};
 
 /// The volume family.
 #[derive(Debug, Clone, Copy)]
@@ -496,11 +497,21 @@ impl Family for Volume {
         1
     }
 
-    /// Per smooth piece (graded at optical depths 1, 2, 4, ...: about
-    /// `1 + log2 D` pieces for a depth bound `D`), `n` nodes, times `n` more
-    /// where an integral nests in each node: the nested depth scheme (V-E,
-    /// V-L), shadow rays by quadrature (V-L). A tracker's walks cost about
-    /// `1 + D` density lookups each.
+    /// Per smooth piece of the ray (its support pieces split at their break
+    /// points: a voxel grid's cells), `n` nodes; V-E and V-L pieces are
+    /// further graded at optical depths 1, 2, 4, ... up to where the
+    /// transmittance underflows (about `log2 min(D, 746)` more pieces for a
+    /// depth bound `D`), and a transfer table's knots cut them too. Per
+    /// outer node of V-E and V-L: in the cumulative scheme the optical depth
+    /// walks from the nearest visited node with 6-point panels, about
+    /// 12 density lookups (two panels) for rules that visit their nodes in
+    /// order (trapezoid, Simpson, Gauss–Legendre, stratified), `6 (2 + log2
+    /// n)` for those that do not (Gauss–Kronrod, Monte Carlo, Sobol': they
+    /// walk the gaps again at every level); it was counted as 1, and the
+    /// bundled scenes cost 12 to 80 times the estimate (Gauss–Legendre's
+    /// error estimate's rules, 2.5 n more, were not counted either); `n` more where an integral
+    /// nests in each node (the nested scheme, shadow rays by quadrature). A
+    /// tracker's walks cost about `1 + D` density lookups each.
     fn cost(
         built: &Built,
         method: &Method<Tracker>,
@@ -508,26 +519,74 @@ impl Family for Volume {
         quantity: VolumeQuantity,
     ) -> f64 {
         use VolumeQuantity::*;
-        let (_, depth) = built.scene.anchored().0.depth_bound();
+        let (scene, _) = built.scene.anchored();
+        let (_, depth) = scene.depth_bound();
         let n = budget as f64;
-        if let Method::Estimator(_) = method {
-            return n * (1.0 + depth);
-        }
-        let pieces = 1.0 + depth.max(1.0).log2();
-        let nested = built.scheme == DepthScheme::Nested;
-        let shadow = built.shadow == ShadowMethod::Quadrature;
-        let per_node = match quantity {
-            Tau | LnTau | Background => 1.0,
-            Emission => {
-                if nested {
-                    n
-                } else {
-                    1.0
-                }
-            }
-            Light | Total => (if nested { n } else { 1.0 }) + if shadow { n } else { 1.0 },
+        let rule = match method {
+            Method::Estimator(_) => return n * (1.0 + depth),
+            Method::Rule(rule) => rule,
         };
-        pieces * n * per_node
+        // A rule's evaluations at the budget, its error estimate's included
+        // (Gauss–Legendre's are 3.5 n).
+        let e = crate::quadrature::Rule::evaluations(rule, budget, 1);
+        let support = scene
+            .medium
+            .as_ref()
+            .map(|m| m.support(&scene.ray, scene.t_min, scene.t_max))
+            .unwrap_or_default();
+        let smooth = (support.iter().map(|p| p.pieces().count()).sum::<usize>() as f64).max(1.0);
+        let knots = match &scene.emission {
+            Some(super::EmissionMap::Table(t)) => 2.0 * t.knots().count() as f64,
+            Some(super::EmissionMap::Field(f)) => f
+                .support(&scene.ray, scene.t_min, scene.t_max)
+                .iter()
+                .map(|p| p.pieces().count() as f64)
+                .sum(),
+            _ => 0.0,
+        };
+        // Where the transmittance from t_n has underflowed the pieces are
+        // skipped (exp(-745.2) is 0).
+        let graded = smooth + support.len() as f64 * depth.clamp(1.0, 746.0).log2();
+        let nested = built.scheme == DepthScheme::Nested;
+        // Shadow rays by quadrature: asked for, or the medium has no closed
+        // form for them.
+        let shadow = built.shadow == ShadowMethod::Quadrature
+            || scene.medium.as_ref().is_some_and(|m| {
+                m.density_integral(&scene.ray, scene.t_min, scene.t_max)
+                    .is_none()
+            });
+        // Rules that visit their nodes out of order walk the gaps again at
+        // every level of their refinement; the others about twice.
+        let in_order = !matches!(
+            crate::quadrature::Rule::name(rule),
+            "gauss-kronrod" | "monte-carlo" | "sobol"
+        );
+        let inner = if nested {
+            e * smooth
+        } else if in_order {
+            12.0
+        } else {
+            6.0 * (2.0 + n.max(1.0).log2())
+        };
+        let shadow = if shadow { e * smooth } else { 1.0 };
+        // V-tau is always evaluated; a term the scene lacks costs nothing.
+        let tau = smooth * e;
+        let emission = if scene.emission.is_some() {
+            (graded + knots) * e * (1.0 + inner)
+        } else {
+            0.0
+        };
+        let light = if scene.light.is_some() && scene.medium.is_some() {
+            graded * e * (1.0 + inner + shadow)
+        } else {
+            0.0
+        };
+        match quantity {
+            Tau | LnTau | Background => tau,
+            Emission => tau + emission,
+            Light => tau + light,
+            Total => tau + emission + light,
+        }
     }
 
     /// The rule's node table, and a second one of the same size under the
@@ -622,8 +681,9 @@ impl Family for Volume {
             rel_tol: 1e-13,
         };
         let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
+        // Only the terms asked for: I_B alone computed I_L too.
         let res = evaluate(
-            &built.scene,
+            &needed(&built.scene, quantities),
             &rule,
             15 + 30 * n,
             DepthScheme::Cumulative,
@@ -1087,6 +1147,25 @@ fn printed_forms(spec: &SceneSpec) -> Result<Option<(printed::Sphere, Vec<Printe
                 ),
             ));
         }
+    }
+    // The printed light formulas square the radius unscaled, as the
+    // document writes them: outside [1e-150, 1e150] R^2 leaves the normal
+    // numbers (radius 1e308 made their evaluation NaN; 1e-200 made the
+    // printed root real where it is not), as for a blob's width.
+    let light_forms = spec
+        .printed
+        .iter()
+        .any(|p| matches!(p, Printed::S | Printed::Exponent));
+    if light_forms && !(MIN_WIDTH..=MAX_WIDTH).contains(&radius) {
+        return Err(SpecError::at(
+            "scene.medium.radius",
+            format!(
+                "{}: expected a radius in [{MIN_WIDTH:e}, {MAX_WIDTH:e}] where the printed light \
+                 formulas (scene.printed \"s\" or \"exponent\") are evaluated: they square it, \
+                 and its square must be a normal number",
+                crate::error::shortened(radius.to_string())
+            ),
+        ));
     }
     Ok(Some((
         printed::Sphere {

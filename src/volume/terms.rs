@@ -607,8 +607,16 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         let mut total = Estimate::zero();
         // Optical depth from t_n to the start of the current sub-piece.
         let mut before = Compensated::<f64>::new();
-        for piece in pieces {
+        'pieces: for piece in pieces {
             for sub in graded(medium, scene.lambda, &ray, piece) {
+                // Past an optical depth of ~745 from t_n the transmittance is
+                // 0 in f64, and with it every node's product on every later
+                // piece: they add exactly 0. A sphere of radius 1e308 has
+                // 1024 graded pieces, all but 11 of them there, each given
+                // the whole budget of an adaptive rule.
+                if (-before.total()).exp() == 0.0 {
+                    break 'pieces;
+                }
                 along.start_piece(&sub, piece);
                 // The outer rule's own rng stream is derived so the inner calls
                 // can use the caller's.
@@ -619,8 +627,15 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
                 // (a sub-piece of optical depth 1 at sigma = 1e100 is 1e-100
                 // long, and its midpoint's point rounds onto the entry).
                 let est = sub.try_integrate_pieces(rule, n, &mut outer_rng, |t, mid| {
+                    // The term first: where it is 0 (a shadowed light, a
+                    // piece that does not emit) the depth to t is not
+                    // needed, and walking to it cost most of the time.
+                    let term = h(t, piece.smooth_mid(mid), rng)?;
+                    if term == 0.0 {
+                        return Ok(0.0);
+                    }
                     let d = along.depth_to(&sub, t, rng)?;
-                    Ok((-(before.total() + d)).exp() * h(t, piece.smooth_mid(mid), rng)?)
+                    Ok((-(before.total() + d)).exp() * term)
                 })?;
                 total = total.combine(est);
                 before.add(along.depth_to(&sub, sub.end(), rng)?);

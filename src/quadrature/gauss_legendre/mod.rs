@@ -425,6 +425,22 @@ impl Rule for GaussLegendre {
         56.0 * integer_root(n, dim) as f64
     }
 
+    /// `m^D` nodes, and for the estimate `(m-1)^D + (m-2)^D` more, and
+    /// `ceil(m/2)^D` from 16 nodes per axis.
+    fn evaluations(&self, n: usize, dim: usize) -> f64 {
+        let m = integer_root(n, dim).max(1) as f64;
+        let d = dim.max(1) as i32;
+        if !self.error_estimate || m < 2.0 {
+            return m.powi(d);
+        }
+        let half = if m >= HYBRID_FROM as f64 {
+            (m / 2.0).ceil().powi(d)
+        } else {
+            0.0
+        };
+        m.powi(d) + (m - 1.0).powi(d) + (m - 2.0).max(0.0).powi(d) + half
+    }
+
     fn integrate_unguarded<
         const D: usize,
         V: Value,
