@@ -17,8 +17,9 @@
 use std::f64::consts::PI;
 use std::fs;
 use std::path::PathBuf;
-use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
+
+mod common;
+use common::{bin, scratch, stderr};
 
 use lightquad::domain::Vec3;
 use lightquad::experiment::validate::{Experiment, deserialize, validate};
@@ -35,27 +36,6 @@ fn rel(a: f64, b: f64) -> f64 {
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_lightquad"))
-}
-
-/// A fresh scratch folder.
-fn scratch(tag: &str) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let dir = std::env::temp_dir().join(format!(
-        "lightquad-rendering-{}-{tag}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::SeqCst)
-    ));
-    let _ = fs::remove_dir_all(&dir);
-    fs::create_dir_all(&dir).expect("scratch folder");
-    dir
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 /// The bundled experiments of the family, `(path, parsed)`.

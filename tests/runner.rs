@@ -6,25 +6,10 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
+
+mod common;
+use common::{bin, scratch, stderr};
 use std::time::{Duration, Instant};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_lightquad"))
-}
-
-/// A fresh scratch folder.
-fn scratch(tag: &str) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let dir = std::env::temp_dir().join(format!(
-        "lightquad-test-{}-{tag}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::SeqCst)
-    ));
-    let _ = fs::remove_dir_all(&dir);
-    fs::create_dir_all(&dir).expect("scratch folder");
-    dir
-}
 
 /// Writes `text` to a scratch folder and runs it into `<folder>/out`.
 fn run_text(tag: &str, text: &str) -> (PathBuf, PathBuf, Output) {
@@ -39,10 +24,6 @@ fn run_text(tag: &str, text: &str) -> (PathBuf, PathBuf, Output) {
         .output()
         .expect("runs");
     (dir, out, o)
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 const VALID: &str = r#"{

@@ -333,12 +333,7 @@ impl Rule for GaussKronrod {
     }
 
     fn check(&self) -> Result<(), QuadError> {
-        for (name, tol) in [("abs_tol", self.abs_tol), ("rel_tol", self.rel_tol)] {
-            if !(tol.is_finite() && tol >= 0.0) {
-                return Err(QuadError::invalid(name, tol, "a finite number >= 0"));
-            }
-        }
-        Ok(())
+        super::check_tolerances(self.abs_tol, self.rel_tol)
     }
 
     fn integrate_unguarded<

@@ -251,6 +251,17 @@ pub trait Rule {
     }
 }
 
+/// Checks an adaptive rule's stopping tolerances (Gauss–Kronrod,
+/// Genz–Malik): each finite and `>= 0`; the error names the parameter.
+pub(crate) fn check_tolerances(abs_tol: f64, rel_tol: f64) -> Result<(), QuadError> {
+    for (name, tol) in [("abs_tol", abs_tol), ("rel_tol", rel_tol)] {
+        if !(tol.is_finite() && tol >= 0.0) {
+            return Err(QuadError::invalid(name, tol, "a finite number >= 0"));
+        }
+    }
+    Ok(())
+}
+
 /// The largest budget any rule accepts, `2^40` (about 1.1e12) evaluations:
 /// hours of work at a nanosecond per evaluation. A larger `n` (`usize::MAX`
 /// from an unchecked computation) is refused at once instead of looping for

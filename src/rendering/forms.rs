@@ -232,6 +232,15 @@ impl<B: Brdf + Reach> Domain<2> for BrdfSampled<'_, B> {
     }
 }
 
+/// `(K(w), cos theta)` for a direction above the receiver's horizon whose
+/// kernel weight is not 0; `None` where the integrand is 0 without a ray
+/// cast.
+fn above_horizon<K: Kernel>(receiver: &Receiver, kernel: &K, w: Vec3) -> Option<(f64, f64)> {
+    let cos = receiver.cos_theta(w);
+    let weight = if cos > 0.0 { kernel.weight(w) } else { 0.0 };
+    (weight != 0.0).then_some((weight, cos))
+}
+
 /// R-H's integrand over the receiver's hemisphere with the map `map` (and
 /// over [`BrdfSampled`], with [`HemisphereMap::Uniform`]'s integrand):
 /// `w -> K(w) L_i(x, w) cos theta`, the cosine left out for
@@ -245,11 +254,9 @@ pub fn hemispherical_integrand<'a, V: Value, K: Kernel>(
 ) -> impl Fn(Vec3) -> V + 'a {
     let x = receiver.point();
     move |w: Vec3| {
-        let cos = receiver.cos_theta(w);
-        let weight = if cos > 0.0 { kernel.weight(w) } else { 0.0 };
-        if weight == 0.0 {
+        let Some((weight, cos)) = above_horizon(receiver, kernel, w) else {
             return V::zero();
-        }
+        };
         let factor = if map == HemisphereMap::Projected {
             weight
         } else {
@@ -270,11 +277,9 @@ pub fn cone_integrand<'a, V: Value, K: Kernel>(
 ) -> impl Fn(Vec3) -> V + 'a {
     let x = receiver.point();
     move |w: Vec3| {
-        let cos = receiver.cos_theta(w);
-        let weight = if cos > 0.0 { kernel.weight(w) } else { 0.0 };
-        if weight == 0.0 {
+        let Some((weight, cos)) = above_horizon(receiver, kernel, w) else {
             return V::zero();
-        }
+        };
         scene.incident_from(k, x, w).map(|l| l * weight * cos)
     }
 }
