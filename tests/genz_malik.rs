@@ -51,6 +51,7 @@ fn one_box_is_exact_to_degree_seven_and_its_estimate_to_degree_five() {
 
 /// `int int e^(x + y) = (e - 1)^2`: the error falls with the budget, the
 /// estimate stays above it, and the budget is spent to within one bisection.
+/// Every run past one box passes the check against its own history.
 #[test]
 fn a_smooth_integrand_converges_with_an_honest_estimate_and_the_budget_kept() {
     let exact = (E - 1.0) * (E - 1.0);
@@ -66,7 +67,8 @@ fn a_smooth_integrand_converges_with_an_honest_estimate_and_the_budget_kept() {
         );
         assert!(e.evaluations as usize <= n && e.evaluations as usize + 34 > n);
         assert!(truth <= last || truth < 1e-15);
-        assert!(e.error >= truth && e.reliable, "n = {n}");
+        // One box (17 evaluations) is doubted: nothing checks its estimate.
+        assert!(e.error >= truth && e.reliable == (n > 17), "n = {n}");
         last = truth;
     }
     assert!(last < 1e-14 * exact, "{last}");
@@ -176,6 +178,59 @@ fn estimates_across_a_circular_shadow_boundary_are_honest_or_doubted() {
         }
     }
     assert!(total > 200, "{total}");
+}
+
+/// A product of Lorentzian peaks `1/(((x - a)^2 + w^2)((y - b)^2 + w^2))`
+/// (integral the product of `(atan((1 - a)/w) + atan(a/w)) / w` and its `b`
+/// twin), a cross of two ridges of width `w` with `1/r^2` tails: at 6
+/// centres, `w` from 0.1 to 1e-3 and budgets from 1023 to 16383, every
+/// estimate is at least a tenth of the true error or doubted. The boxes
+/// find the ridges late; before the check against the run's history
+/// (`|Q - Q_half| <= E + E_half`) estimates fell to 0.024 of the error at
+/// `w = 1e-3` and 2047 evaluations. One box alone is always doubted. Below
+/// about 700 evaluations at `w = 1e-3` the peak stays unseen at every
+/// doubling (the value holds at 1% of the integral), and nothing in the
+/// samples shows it: those budgets are left out, as a missed feature.
+#[test]
+fn estimates_on_product_peaks_are_honest_or_doubted() {
+    let line = |c: f64, w: f64| (((1.0 - c) / w).atan() + (c / w).atan()) / w;
+    let mut total = 0;
+    for (a, b) in [
+        (0.3, 0.3),
+        (0.3, 0.7),
+        (0.123, 0.456),
+        (0.5, 0.5),
+        (0.25, 0.75),
+        (0.618_033_988_7, 0.1),
+    ] {
+        for w in [1e-1, 1e-2, 1e-3] {
+            let exact = line(a, w) * line(b, w);
+            for n in [1023usize, 2047, 3071, 4095, 6143, 8191, 16383] {
+                let e = GenzMalik::default()
+                    .integrate(n, &mut rng(0), |p: [f64; 2]| {
+                        1.0 / (((p[0] - a).powi(2) + w * w) * ((p[1] - b).powi(2) + w * w))
+                    })
+                    .expect("finite");
+                let truth = (e.value - exact).abs();
+                if truth > 1e-13 * exact {
+                    total += 1;
+                    assert!(
+                        e.error >= 0.1 * truth || !e.reliable,
+                        "peak ({a}, {b}) w = {w}, n = {n}: estimate {:e} against {truth:e}",
+                        e.error
+                    );
+                }
+            }
+        }
+        // One box: its |G7 - G5| is checked by nothing.
+        let one = GenzMalik::default()
+            .integrate(17, &mut rng(0), |p: [f64; 2]| {
+                1.0 / (((p[0] - a).powi(2) + 1e-6) * ((p[1] - b).powi(2) + 1e-6))
+            })
+            .expect("finite");
+        assert!(!one.reliable, "one box at ({a}, {b})");
+    }
+    assert!(total > 100, "{total}");
 }
 
 /// Wrong input is an error, not a panic: one dimension, a budget below one
