@@ -397,10 +397,20 @@ fn product_of_gauss_legendre_and_trapezoid_is_spectral_on_a_periodic_azimuth() {
     // Gauss–Legendre in u, the trapezoid rule in the periodic v.
     let f = |p: [f64; 2]| p[0].exp() * (1.0 + (2.0 * PI * p[1]).cos().powi(2));
     let exact = EXP1 * 1.5;
+    // With 33 points a side the trapezoid's coarser rules (17, 9, 5 points)
+    // nest and are exact too, so the estimate is at rounding; with 31 the
+    // 4h and 8h rules end in a finer tail, which a periodic integrand does
+    // not forgive, and the estimate stays honest but pessimistic (the finest
+    // two rules agreeing alone can be a coincidence of symmetry: the
+    // trapezoid at 47 points on 1/(1 + 0.99 sin 2 pi x) agrees with its 24-point
+    // rule to 1e-11 while both are off by 2e-2).
     let rule = AnyRule::by_name("product(gauss-legendre, trapezoid)").expect("known");
-    let est = rule.integrate(31 * 31, &mut rng(0), f).expect("finite");
+    let est = rule.integrate(33 * 33, &mut rng(0), f).expect("finite");
     assert!(rel(est.value, exact) < 1e-14, "{}", est.value);
     assert!(est.error < 1e-10, "error estimate {}", est.error);
+    let est = rule.integrate(31 * 31, &mut rng(0), f).expect("finite");
+    assert!(rel(est.value, exact) < 1e-14, "{}", est.value);
+    assert!(est.error >= (est.value - exact).abs(), "{}", est.error);
     // The same product of two Gauss–Legendre rules agrees with the built-in
     // tensor-product rule (a different code path) to rounding.
     let gl2 = AnyRule::by_name("product(gauss-legendre,gauss-legendre)").expect("known");
