@@ -63,6 +63,7 @@ pub mod rendering;
 pub mod sum;
 pub mod value;
 pub mod volume;
+pub mod whitted;
 
 pub use error::QuadError;
 pub use estimate::{ErrorKind, Estimate};
