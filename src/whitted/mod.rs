@@ -13,8 +13,10 @@
 //! | [`coverage`] | the exact fraction of a pixel inside a half-plane or convex polygon, by clipping |
 //! | [`image`] | PNG (W-Grey, 8 bits) and PFM output, error heat maps |
 //! | [`render`] | images and pixels of a scene by a scheme, with the rays they traced |
+//! | [`experiment`] | the family of the experiment layer (`"family": "whitted"`) |
 
 pub mod coverage;
+pub mod experiment;
 pub mod image;
 pub mod intersect;
 pub mod pixel;
