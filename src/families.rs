@@ -4,7 +4,7 @@
 //! ```
 //! let registry = lightquad::families::builtin();
 //! let names: Vec<&str> = registry.entries().iter().map(|f| f.name).collect();
-//! assert_eq!(names, ["calibration", "volume", "rendering"]);
+//! assert_eq!(names, ["calibration", "volume", "rendering", "whitted"]);
 //! assert!(registry.get("volume").expect("registered").quantities().contains(&"tau"));
 //! ```
 
@@ -17,6 +17,7 @@ pub fn builtin() -> Registry {
         .with::<crate::calibration::Calibration>()
         .with::<crate::volume::experiment::Volume>()
         .with::<crate::rendering::experiment::Rendering>()
+        .with::<crate::whitted::experiment::Whitted>()
 }
 
 #[cfg(test)]
@@ -43,6 +44,7 @@ mod tests {
         names_agree::<crate::calibration::Calibration>()?;
         names_agree::<crate::volume::experiment::Volume>()?;
         names_agree::<crate::rendering::experiment::Rendering>()?;
+        names_agree::<crate::whitted::experiment::Whitted>()?;
         // Every family listed above is the registry's.
         assert_eq!(
             super::builtin()
@@ -50,7 +52,7 @@ mod tests {
                 .iter()
                 .map(|e| e.name)
                 .collect::<Vec<_>>(),
-            ["calibration", "volume", "rendering"]
+            ["calibration", "volume", "rendering", "whitted"]
         );
         Ok(())
     }

@@ -455,6 +455,13 @@ pub trait Family: Sized + Send + Sync + 'static {
         None
     }
 
+    /// Doubts about a scene that is built and runs, but may not be what was
+    /// meant (a material that is not energy conserving), each at its JSON
+    /// path; `check` and `run` print them as warnings. None by default.
+    fn warnings(_scene: &Self::Scene) -> Vec<SpecError> {
+        Vec::new()
+    }
+
     /// The quantities `estimator` estimates.
     fn estimates(estimator: &Self::Estimator) -> &'static [Self::Quantity];
 

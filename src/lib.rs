@@ -4,9 +4,10 @@
 //! and what does it cost? lightquad answers with pluggable quadrature rules,
 //! domains that map the unit cube onto the geometry of rendering, and the
 //! equations of volume rendering with a directional light ([`volume`],
-//! docs/EQUATIONS.md V-*) with closed forms ([`exact`]) where they exist. The
-//! rendering equation and Whitted's model (R-*, W-* there) are stated in
-//! docs/EQUATIONS.md but are not yet a family.
+//! docs/EQUATIONS.md V-*) with closed forms ([`exact`]) where they exist, the
+//! rendering equation ([`rendering`], R-*) and Whitted ray tracing
+//! ([`whitted`], W-*: W-6.1 with Phong, recursive rays, the pixel as an
+//! integral over its square).
 //!
 //! Runnable programs in `examples/`: `cargo run --release --example
 //! quadrature_over_a_domain` (a rule over a disk and a hemisphere),
@@ -24,7 +25,8 @@
 //! - a **domain** ([`domain`]) maps `[0, 1]^D` onto a ray segment, a surface
 //!   patch, the hemisphere or a pixel, with the Jacobian of the map. Adding
 //!   one: its file.
-//! - a **family** of equations ([`family::Family`]: [`volume`], [`calibration`])
+//! - a **family** of equations ([`family::Family`]: [`volume`], [`rendering`],
+//!   [`whitted`], [`calibration`])
 //!   owns its scene format, quantities, estimators beside the rules, closed
 //!   forms and audit. Adding one: its module and one line in [`families`],
 //!   the only place that names them.
@@ -63,6 +65,7 @@ pub mod rendering;
 pub mod sum;
 pub mod value;
 pub mod volume;
+pub mod whitted;
 
 pub use error::QuadError;
 pub use estimate::{ErrorKind, Estimate};

@@ -88,6 +88,28 @@ enum Command {
     /// Print the families' audits of the source documents' printed formulas
     /// (Markdown; also at the end of every report's index).
     Audit,
+    /// Render the scene of a `whitted` experiment file (none: the bundled
+    /// w-grey-test-scene) to an 8-bit PNG by W-Grey, and a PFM of the same
+    /// floats; prints the rays traced by kind.
+    Render {
+        /// A `whitted` experiment file; none renders the bundled test scene.
+        file: Option<PathBuf>,
+        /// The PNG to write.
+        #[arg(long)]
+        png: PathBuf,
+        /// The PFM (32-bit float RGB) to write too.
+        #[arg(long)]
+        pfm: Option<PathBuf>,
+        /// Image width in pixels (default: the file's).
+        #[arg(long)]
+        width: Option<usize>,
+        /// Image height in pixels (default: the file's).
+        #[arg(long)]
+        height: Option<usize>,
+        /// Rays per pixel on W-SS's grid, rounded down to a square (9: 3 x 3).
+        #[arg(long, default_value_t = 9)]
+        samples: usize,
+    },
 }
 
 fn main() -> ExitCode {
@@ -166,6 +188,9 @@ fn run(command: Command) -> Result<(), Failure> {
             }
             for f in sources(files)? {
                 let exp = experiment::load_source(&registry, &f)?;
+                for w in exp.warnings() {
+                    eprintln!("warning: {}: {w}", f.display());
+                }
                 let (rules, budgets, repeats) = exp.shape();
                 writeln!(
                     out,
@@ -181,6 +206,40 @@ fn run(command: Command) -> Result<(), Failure> {
         Command::Merge { inputs, out: dir } => {
             let index = experiment::merge(&registry, &inputs, &dir)?;
             writeln!(out, "report: {}", index.display())?;
+        }
+        Command::Render {
+            file,
+            png,
+            pfm,
+            width,
+            height,
+            samples,
+        } => {
+            let source = match file {
+                Some(f) => Source::File(f),
+                None => Source::Bundled("w-grey-test-scene.json"),
+            };
+            let text = source.read()?;
+            let json = experiment::validate::parse_json(&String::from_utf8_lossy(&text))?;
+            let (image, rays) =
+                lightquad::whitted::experiment::render_spec(&json, width, height, samples)
+                    .map_err(|e| format!("{}: {e}", source.display()))?;
+            image.write_png(&png)?;
+            if let Some(p) = &pfm {
+                image.write_pfm(p)?;
+            }
+            writeln!(
+                out,
+                "{}: {} x {} pixels, {} rays ({} primary, {} shadow, {} reflection, {} refraction)",
+                png.display(),
+                image.width(),
+                image.height(),
+                rays.total(),
+                rays.primary,
+                rays.shadow,
+                rays.reflection,
+                rays.refraction
+            )?;
         }
         Command::Audit => {
             for audit in registry.entries().iter().filter_map(|f| f.audit()) {

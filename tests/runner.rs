@@ -488,7 +488,7 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
                 .expect("const family")
         })
         .collect();
-    assert_eq!(families, ["calibration", "volume", "rendering"]);
+    assert_eq!(families, ["calibration", "volume", "rendering", "whitted"]);
     let volume = &schema["oneOf"][1];
     assert!(
         volume["properties"]["scene"]["$ref"].is_string(),

@@ -277,6 +277,13 @@ pub fn run_sources(
         });
     }
     let loaded = load_all(registry, files)?;
+    if opts.progress {
+        for (exp, _, _) in &loaded {
+            for w in exp.warnings() {
+                eprintln!("warning: {}: {w}", exp.name());
+            }
+        }
+    }
     writable(&opts.out)?;
     let _lock = lock_output(&opts.out, opts.shard)?;
     let total: usize = loaded

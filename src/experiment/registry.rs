@@ -62,6 +62,9 @@ pub trait Loaded: Send + Sync {
     /// The `n` of a converged reference, which the report computes first
     /// (it can take longer than the jobs; the runner says so).
     fn converged_reference(&self) -> Option<usize>;
+    /// Doubts about its scene that do not stop it ([`Family::warnings`]),
+    /// each at its JSON path.
+    fn warnings(&self) -> Vec<SpecError>;
 }
 
 impl<F: Family> Loaded for Experiment<F> {
@@ -85,6 +88,9 @@ impl<F: Family> Loaded for Experiment<F> {
     }
     fn run_job(&self, key: JobKey) -> JobResult {
         run_job(self, key)
+    }
+    fn warnings(&self) -> Vec<SpecError> {
+        F::warnings(&self.scene)
     }
     fn converged_reference(&self) -> Option<usize> {
         match &self.spec.reference {

@@ -1,0 +1,204 @@
+//! Pixels and images of a scene by a supersampling scheme ([`Scheme`]),
+//! with the rays they traced by kind.
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::value::Rgb;
+//! use lightquad::whitted::intersect::Shape;
+//! use lightquad::whitted::render::{Scheme, render};
+//! use lightquad::whitted::scene::{Camera, Material, Object, Scene};
+//! use rand::SeedableRng;
+//!
+//! // An 8 x 6 image of an ambient-lit sphere: W-Corner traces 9 x 7 rays.
+//! let ball = Object { shape: Shape::sphere(Vec3::new(0.0, 0.0, -3.0), 1.0)?, material: Material::default() };
+//! let cam = Camera::new(Vec3::zeros(), -Vec3::z(), Vec3::y(), 60.0, 8, 6)?;
+//! let scene = Scene::new(vec![ball], vec![], Rgb::new(1.0, 1.0, 1.0), Rgb::zeros(), cam, 2)?;
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let out = render(&scene, &Scheme::Corner { m: 1 }, &mut rng)?;
+//! assert_eq!(out.rays.primary, 9 * 7);
+//! // No lights, no mirrors, nothing transparent: primary rays only.
+//! assert_eq!(out.rays.total(), out.rays.primary);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
+
+use crate::domain::Pixel;
+use crate::error::QuadError;
+use crate::quadrature::{AnyRule, Rule};
+use crate::value::{Rgb, Value};
+
+use super::pixel;
+use super::scene::Scene;
+use super::shade::{RayCount, film};
+
+/// How a pixel's integral is estimated ([`super::pixel`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Scheme {
+    /// One ray through the centre.
+    Centre,
+    /// W-SS: the `n x n` grid of cell centres.
+    Grid {
+        /// Cells per side.
+        n: usize,
+    },
+    /// A rule of the core with `n` evaluations per pixel.
+    Rule {
+        /// The rule.
+        rule: AnyRule,
+        /// Its budget per pixel.
+        n: usize,
+    },
+    /// W-Corner with `m x m` cells per pixel (`m = 1`: Whitted's corners).
+    Corner {
+        /// Subdivisions per pixel side.
+        m: usize,
+    },
+    /// Whitted's adaptive subdivision.
+    Adaptive {
+        /// The largest corner spread left unsplit.
+        threshold: f64,
+        /// The deepest split.
+        max_level: u32,
+    },
+}
+
+/// Estimates of a block of pixels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Estimated<V: Value> {
+    /// The values, rows from the top.
+    pub values: Vec<V>,
+    /// The rule's error estimate per pixel (infinite for the schemes
+    /// without one).
+    pub errors: Vec<V>,
+    /// False when a rule doubted its estimate for some pixel.
+    pub reliable: bool,
+}
+
+/// The `width x height` pixels from pixel `(i0, j0)` of the film function
+/// `f` by `scheme`.
+pub fn estimate<V: Value>(
+    corner: [usize; 2],
+    width: usize,
+    height: usize,
+    scheme: &Scheme,
+    rng: &mut rand_pcg::Pcg64,
+    mut f: impl FnMut([f64; 2]) -> V,
+) -> Result<Estimated<V>, QuadError> {
+    let origin = [corner[0] as f64, corner[1] as f64];
+    let unknown = V::from_fn(|_| f64::INFINITY);
+    let image_wide = |values: Vec<V>| Estimated {
+        errors: vec![unknown; values.len()],
+        values,
+        reliable: true,
+    };
+    match scheme {
+        Scheme::Corner { m } => Ok(image_wide(pixel::corner_image(
+            origin, width, height, *m, f,
+        ))),
+        Scheme::Adaptive {
+            threshold,
+            max_level,
+        } => Ok(image_wide(pixel::adaptive_image(
+            origin, width, height, *threshold, *max_level, f,
+        ))),
+        _ => {
+            let mut out = Estimated {
+                values: Vec::with_capacity(width * height),
+                errors: Vec::with_capacity(width * height),
+                reliable: true,
+            };
+            for j in 0..height {
+                for i in 0..width {
+                    let p = Pixel::new(origin[0] + i as f64, origin[1] + j as f64, 1.0, 1.0)?;
+                    let (v, e) = match scheme {
+                        Scheme::Centre => (pixel::centre(&p, &mut f), unknown),
+                        Scheme::Grid { n } => (pixel::grid(&p, *n, &mut f), unknown),
+                        Scheme::Rule { rule, n } => {
+                            let est = pixel::by_rule(rule, &p, *n, rng, &mut f)?;
+                            out.reliable &= est.reliable;
+                            (est.value, est.error)
+                        }
+                        Scheme::Corner { .. } | Scheme::Adaptive { .. } => {
+                            return Err(QuadError::invalid(
+                                "scheme",
+                                "an image-wide scheme",
+                                "a per-pixel scheme (handled above)",
+                            ));
+                        }
+                    };
+                    out.values.push(v);
+                    out.errors.push(e);
+                }
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// A rendered block and the rays it traced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rendered {
+    /// The pixel estimates.
+    pub image: Estimated<Rgb>,
+    /// The rays traced, by kind.
+    pub rays: RayCount,
+}
+
+/// The pixels of the block by `scheme`, each ray of W-6.1 counted.
+pub fn render_block(
+    scene: &Scene,
+    corner: [usize; 2],
+    width: usize,
+    height: usize,
+    scheme: &Scheme,
+    rng: &mut rand_pcg::Pcg64,
+) -> Result<Rendered, QuadError> {
+    let mut rays = RayCount::default();
+    let image = estimate(corner, width, height, scheme, rng, |p| {
+        film(scene, p, &mut rays)
+    })?;
+    Ok(Rendered { image, rays })
+}
+
+/// The whole image by `scheme`.
+pub fn render(
+    scene: &Scene,
+    scheme: &Scheme,
+    rng: &mut rand_pcg::Pcg64,
+) -> Result<Rendered, QuadError> {
+    let cam = &scene.camera;
+    render_block(scene, [0, 0], cam.width(), cam.height(), scheme, rng)
+}
+
+/// The fraction of the block's pixels covered by some object (1 where the
+/// primary ray hits, 0 where it escapes), by `scheme`; primary rays counted.
+pub fn coverage_block(
+    scene: &Scene,
+    corner: [usize; 2],
+    width: usize,
+    height: usize,
+    scheme: &Scheme,
+    rng: &mut rand_pcg::Pcg64,
+) -> Result<(Estimated<f64>, RayCount), QuadError> {
+    let mut rays = RayCount::default();
+    let est = estimate(corner, width, height, scheme, rng, |p| {
+        rays.primary += 1;
+        let ray = scene.camera.ray(p);
+        if scene.nearest(&ray).is_some() {
+            1.0
+        } else {
+            0.0
+        }
+    })?;
+    Ok((est, rays))
+}
+
+/// The rays `scheme` traces per pixel for a scheme with a fixed count (the
+/// budget a rule was given; `None` for the image-wide schemes).
+pub fn rays_per_pixel(scheme: &Scheme) -> Option<f64> {
+    match scheme {
+        Scheme::Centre => Some(1.0),
+        Scheme::Grid { n } => Some((n * n) as f64),
+        Scheme::Rule { rule, n } => Some(rule.evaluations(*n, 2)),
+        Scheme::Corner { .. } | Scheme::Adaptive { .. } => None,
+    }
+}

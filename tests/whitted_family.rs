@@ -1,0 +1,519 @@
+//! The Whitted family of the experiment layer (src/whitted/experiment.rs).
+//!
+//! Layers: (1) the bundled `w-*` experiments validate and run on the real
+//! binary, report every quantity, and cover every W-* equation ID; (2) the
+//! closed forms against computations written here (a triangle's projected
+//! coverage by the pinhole formula and a fine grid of the renderer's own
+//! primary rays; a plane's horizon); (3) the rays traced by kind through
+//! the family, W-Corner's `(s + 1)(z + 1)`; the jittered order through the
+//! renderer on a triangle's edge; (4) bad input refused by `check` with the
+//! JSON path, and the energy warning printed; extreme numbers never panic.
+
+use std::fs;
+use std::path::PathBuf;
+
+mod common;
+use common::{bin, fitted_order, scratch, stderr};
+
+use lightquad::experiment::validate::{Experiment, deserialize, validate};
+use lightquad::family::{Family, Method};
+use lightquad::whitted::experiment::{Scheme, Whitted, WhittedQuantity as Q, evaluate_counted};
+use rand::SeedableRng;
+use serde_json::{Value, json};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The bundled experiments of the family, `(path, parsed)`.
+fn bundled() -> Vec<(PathBuf, Value)> {
+    let mut out: Vec<(PathBuf, Value)> = fs::read_dir(root().join("experiments"))
+        .expect("experiments/")
+        .filter_map(Result::ok)
+        .map(|f| f.path())
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("w-") && n.ends_with(".json"))
+        })
+        .map(|p| {
+            let v = serde_json::from_str(&fs::read_to_string(&p).expect("read")).expect("json");
+            (p, v)
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
+fn load(json: Value) -> Experiment<Whitted> {
+    validate::<Whitted>(deserialize(json).expect("parses"), "hash").expect("valid")
+}
+
+/// A scene with one white ambient-lit triangle on black, seen by a 8 x 6
+/// camera looking down -z from the origin.
+fn triangle_scene(pixel: [usize; 2]) -> Value {
+    json!({
+        "camera": {"eye": [0.0, 0.0, 0.0], "look_at": [0.0, 0.0, -1.0], "up": [0.1, 1.0, 0.0],
+                   "fov_y": 50.0, "width": 8, "height": 6},
+        "ambient": [1.0, 1.0, 1.0],
+        "objects": [{"type": "triangle", "a": [-0.8, -0.6, -2.0], "b": [0.37, -0.5, -2.5],
+                     "c": [-0.2, 0.61, -2.2], "material": {"k_a": 0.8, "colour": [1.0, 0.5, 0.25]}}],
+        "pixel": pixel
+    })
+}
+
+fn experiment(scene: Value, quantities: &[&str]) -> Experiment<Whitted> {
+    load(json!({
+        "name": "t", "family": "whitted", "scene": scene, "quantities": quantities,
+        "rules": [{"rule": "grid"}], "budgets": [16], "repeats": 1,
+        "reference": {"type": "closed-form"}
+    }))
+}
+
+fn by(exp: &Experiment<Whitted>, method: Value, budget: usize, q: Q, seed: u64) -> (Vec<f64>, u64) {
+    let method: Method<Scheme> = serde_json::from_value(method).expect("a method");
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let (m, rays) = evaluate_counted(&exp.scene, &method, budget, &mut rng, q).expect("evaluates");
+    (m.value, rays.total())
+}
+
+// ---------------------------------------------------------------- (1) binary
+
+#[test]
+fn the_bundled_whitted_experiments_validate_run_and_cover_every_equation() {
+    let files = bundled();
+    assert!(files.len() >= 4, "{} bundled w-* experiments", files.len());
+    let check = bin()
+        .arg("check")
+        .args(files.iter().map(|f| &f.0))
+        .output()
+        .expect("runs");
+    assert!(check.status.success(), "{}", stderr(&check));
+    let dir = scratch("bundled-w");
+    let out = dir.join("out");
+    let run = bin()
+        .args(["run", "--out"])
+        .arg(&out)
+        .args(files.iter().map(|f| &f.0))
+        .output()
+        .expect("runs");
+    assert!(run.status.success(), "{}", stderr(&run));
+    let mut ids = std::collections::BTreeSet::new();
+    for (path, spec) in &files {
+        let name = spec["name"].as_str().expect("name");
+        assert_eq!(path.file_stem().and_then(|s| s.to_str()), Some(name));
+        let finished = stderr(&run)
+            .lines()
+            .find(|l| l.starts_with(&format!("finished {name}: ")))
+            .map(str::to_string)
+            .unwrap_or_else(|| panic!("{name} not run"));
+        assert!(finished.contains(" 0 failed"), "{finished}");
+        let report = fs::read_to_string(out.join(name).join("report.md")).expect("report");
+        for q in spec["quantities"].as_array().expect("quantities") {
+            let q = q.as_str().expect("name");
+            assert!(
+                report.contains(&format!("## {q} (reference")),
+                "{name} lacks {q}"
+            );
+        }
+        assert!(!report.contains("NaN"), "{name} reports a NaN");
+        assert!(report.contains("## Terms and rays of this scene"), "{name}");
+        let description = spec["description"].as_str().expect("description");
+        assert!(description.len() > 200, "{name}: say what the report shows");
+        for id in spec["equations"].as_array().expect("equations") {
+            ids.insert(id.as_str().expect("id").to_string());
+        }
+    }
+    for id in Whitted::EQUATIONS {
+        assert!(ids.contains(*id), "no bundled experiment for {id}");
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+// ------------------------------------------------------- (2) closed forms
+
+/// The triangle's coverage of every pixel: the closed form against the
+/// projection written here (`x = W/2 (1 + X / (Z tan(fov/2) W/H))` with the
+/// camera's frame built here from `up`) and a 512 x 512 grid of the
+/// renderer's own primary rays (error below 1/512 per pixel edge length).
+#[test]
+fn a_triangles_coverage_is_its_projection_clipped_to_the_pixel() {
+    let scene = triangle_scene([0, 0]);
+    let mut total_exact = 0.0;
+    let mut covered = 0;
+    for j in 0..6 {
+        for i in 0..8 {
+            let mut s = scene.clone();
+            s["pixel"] = json!([i, j]);
+            let exp = experiment(s, &["coverage", "pixel"]);
+            let exact = Whitted::closed_form(&exp.scene, Q::Coverage).expect("closed form")[0];
+            let (fine, _) = by(&exp, json!({"rule": "grid"}), 512 * 512, Q::Coverage, 0);
+            assert!(
+                (fine[0] - exact).abs() < 2.0 / 512.0,
+                "pixel {i} {j}: {} vs {exact}",
+                fine[0]
+            );
+            // The pixel value: background 0 + (0.8 (1, 0.5, 0.25)) coverage.
+            let px = Whitted::closed_form(&exp.scene, Q::Pixel).expect("closed form");
+            for (c, k) in px.iter().zip([0.8, 0.4, 0.2]) {
+                assert!((c - k * exact).abs() < 1e-15);
+            }
+            total_exact += exact;
+            covered += usize::from(exact > 0.0 && exact < 1.0);
+        }
+    }
+    // The triangle's projected area, by the shoelace formula here.
+    let (w, h, fov) = (8.0_f64, 6.0_f64, 50f64.to_radians());
+    let forward = [0.0, 0.0, -1.0_f64];
+    let upv = [0.1, 1.0, 0.0_f64];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let right = cross(forward, upv);
+    let rn = dot(right, right).sqrt();
+    let right = right.map(|x| x / rn);
+    let up = cross(right, forward);
+    let t = (fov / 2.0).tan();
+    let project = |p: [f64; 3]| {
+        let z = dot(p, forward);
+        [
+            w / 2.0 * (1.0 + dot(p, right) / z / (t * w / h)),
+            h / 2.0 * (1.0 - dot(p, up) / z / t),
+        ]
+    };
+    let v = [[-0.8, -0.6, -2.0], [0.37, -0.5, -2.5], [-0.2, 0.61, -2.2]].map(project);
+    // Inside the image, so the pixels' coverages add up to its area.
+    assert!(
+        v.iter()
+            .all(|p| p[0] > 0.0 && p[0] < w && p[1] > 0.0 && p[1] < h),
+        "{v:?}"
+    );
+    let area = 0.5
+        * ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1]))
+            .abs();
+    assert!(area < 48.0 && area > 1.0, "{area}");
+    println!(
+        "projected triangle area {area:.6}, sum of pixel coverages {total_exact:.6}, {covered} edge pixels"
+    );
+    assert!(
+        (total_exact - area).abs() < 1e-12,
+        "{total_exact} vs {area}"
+    );
+}
+
+/// A floor plane seen toward its horizon with the camera rolled by 20
+/// degrees: the covered film is a half-plane; its closed form matches a fine
+/// grid of primary rays at every pixel.
+#[test]
+fn a_planes_horizon_is_a_straight_edge_across_the_pixels() {
+    for j in 0..6 {
+        for i in 0..8 {
+            let exp = experiment(
+                json!({
+                    "camera": {"eye": [0.0, 1.0, 0.0], "look_at": [0.0, 1.0, -1.0],
+                               "up": [0.34202, 0.93969, 0.0], "fov_y": 4.0, "width": 8, "height": 6},
+                    "ambient": [1.0, 1.0, 1.0],
+                    "objects": [{"type": "plane", "point": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0],
+                                 "material": {"k_a": 1.0}}],
+                    "pixel": [i, j]
+                }),
+                &["coverage"],
+            );
+            let exact = Whitted::closed_form(&exp.scene, Q::Coverage).expect("closed form")[0];
+            let (fine, _) = by(&exp, json!({"rule": "grid"}), 256 * 256, Q::Coverage, 0);
+            assert!(
+                (fine[0] - exact).abs() < 2.0 / 256.0,
+                "{i} {j}: {} vs {exact}",
+                fine[0]
+            );
+        }
+    }
+}
+
+// ------------------------------------------------- (3) rays and orders
+
+/// Through the family: W-Corner on the 8 x 6 image traces 9 x 7 primary
+/// rays and nothing else (no lights, no mirrors, nothing transparent); the
+/// image's RMS error against the closed form falls as the corner lattice is
+/// refined, and the centre scheme traces one ray per pixel.
+#[test]
+fn the_family_counts_the_corner_schemes_rays_and_its_image_error_falls() {
+    let exp = experiment(triangle_scene([3, 2]), &["image"]);
+    let exact = Whitted::closed_form(&exp.scene, Q::Image).expect("closed form");
+    assert_eq!(exact.len(), 3 * 8 * 6);
+    let (_, rays) = by(&exp, json!({"rule": "corner"}), 1, Q::Image, 0);
+    assert_eq!(rays, 9 * 7);
+    let (_, rays) = by(&exp, json!({"rule": "centre"}), 1, Q::Image, 0);
+    assert_eq!(rays, 48);
+    let rms = |v: &[f64]| {
+        (v.iter()
+            .zip(&exact)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            / v.len() as f64)
+            .sqrt()
+    };
+    let mut points = Vec::new();
+    for budget in [1, 16, 256, 4096] {
+        let (v, rays) = by(&exp, json!({"rule": "corner"}), budget, Q::Image, 0);
+        let m = (budget as f64).sqrt() as u64;
+        assert_eq!(rays, (8 * m + 1) * (6 * m + 1));
+        points.push((rays as f64, rms(&v)));
+    }
+    let order = fitted_order(&points);
+    println!("corner scheme on the triangle image: {points:?}, order {order:.3} in rays");
+    assert!(points.windows(2).all(|w| w[1].1 < w[0].1), "{points:?}");
+    assert!(order < -0.4, "{order}");
+}
+
+/// Jittered sampling through the renderer on the triangle's edge pixel:
+/// RMS over 64 seeds against the closed form, fitted on a sweep: about
+/// `N^-3/4`.
+#[test]
+fn jittered_sampling_of_a_rendered_edge_pixel_goes_as_n_to_the_minus_three_quarters() {
+    // Pixels the triangle's edges cross.
+    let edge_pixels: Vec<[usize; 2]> = (0..48)
+        .map(|k| [k % 8, k / 8])
+        .filter(|&p| {
+            let exp = experiment(triangle_scene(p), &["coverage"]);
+            let f = Whitted::closed_form(&exp.scene, Q::Coverage).expect("closed")[0];
+            f > 0.05 && f < 0.95
+        })
+        .collect();
+    assert!(edge_pixels.len() >= 6, "{edge_pixels:?}");
+    let mut points = Vec::new();
+    for m in [4usize, 8, 16, 32, 64] {
+        let mut sum = 0.0;
+        let mut count = 0.0;
+        for (k, p) in edge_pixels.iter().enumerate() {
+            let exp = experiment(triangle_scene(*p), &["coverage"]);
+            let exact = Whitted::closed_form(&exp.scene, Q::Coverage).expect("closed")[0];
+            for seed in 0..16 {
+                let (v, _) = by(
+                    &exp,
+                    json!({"rule": "stratified"}),
+                    m * m,
+                    Q::Coverage,
+                    seed * 100 + k as u64,
+                );
+                sum += (v[0] - exact).powi(2);
+                count += 1.0;
+            }
+        }
+        points.push(((m * m) as f64, (sum / count).sqrt()));
+    }
+    let order = fitted_order(&points);
+    println!("rendered edge pixels, jittered: {points:?}, order {order:.3}");
+    assert!((order + 0.75).abs() < 0.1, "{order}");
+}
+
+// ------------------------------------------------------------ (4) bad input
+
+const GOOD: &str = r#"{
+  "name": "b", "family": "whitted",
+  "scene": {
+    "camera": {"eye": [0.0, 0.0, 5.0], "look_at": [0.0, 0.0, 0.0], "up": [0.0, 1.0, 0.0],
+               "fov_y": 40.0, "width": 4, "height": 3},
+    "ambient": [0.1, 0.1, 0.1],
+    "lights": [{"type": "point", "position": [3.0, 3.0, 3.0], "intensity": [1.0, 1.0, 1.0]}],
+    "objects": [{"type": "sphere", "centre": [0.0, 0.0, 0.0], "radius": 1.0,
+                 "material": {"k_a": 0.2, "k_d": 0.5, "k_s": 0.3, "phong": 10.0}}],
+    "max_depth": 3,
+    "pixel": [1, 1]
+  },
+  "quantities": ["pixel"],
+  "rules": [{"rule": "grid"}], "budgets": [16], "repeats": 1,
+  "reference": {"type": "converged"}
+}"#;
+
+/// `GOOD` with the JSON pointer `at` set to `value` (added to its parent
+/// object when absent).
+fn broken(at: &str, value: Value) -> String {
+    let mut v: Value = serde_json::from_str(GOOD).expect("json");
+    let (parent, key) = at.rsplit_once('/').expect("a pointer");
+    match v.pointer_mut(parent).expect("a pointer into GOOD") {
+        Value::Array(items) => items[key.parse::<usize>().expect("an index")] = value,
+        Value::Object(fields) => {
+            fields.insert(key.to_string(), value);
+        }
+        _ => panic!("{at} is not in GOOD"),
+    }
+    v.to_string()
+}
+
+fn checked(text: &str) -> std::process::Output {
+    let dir = scratch("bad-w");
+    let file = dir.join("e.json");
+    fs::write(&file, text).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    let _ = fs::remove_dir_all(&dir);
+    o
+}
+
+fn refused(text: &str, path: &str, what: &[&str]) {
+    let o = checked(text);
+    let msg = stderr(&o);
+    assert!(!o.status.success(), "accepted: {text}");
+    assert!(
+        msg.contains(&format!("at `{path}`")),
+        "no `{path}` in: {msg}"
+    );
+    for w in what {
+        assert!(msg.contains(w), "no {w:?} in: {msg}");
+    }
+    assert!(!msg.contains("panicked"), "{msg}");
+}
+
+#[test]
+fn the_good_file_is_accepted_and_an_energy_gain_is_a_warning_with_its_path() {
+    let o = checked(GOOD);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    let hot = broken("/scene/objects/0/material/k_t", json!(0.5));
+    let o = checked(&hot);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let msg = stderr(&o);
+    assert!(msg.contains("warning"), "{msg}");
+    assert!(msg.contains("at `scene.objects[0].material`"), "{msg}");
+    assert!(
+        msg.contains("1.3 > 1") && msg.contains("not energy conserving"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn bad_scenes_are_refused_with_the_path_and_what_is_accepted() {
+    refused(
+        &broken("/scene/camera/fov_y", json!(0.0)),
+        "scene.camera.fov_y",
+        &["(0, 180)"],
+    );
+    refused(
+        &broken("/scene/camera/fov_y", json!(180.0)),
+        "scene.camera.fov_y",
+        &["(0, 180)"],
+    );
+    refused(
+        &broken("/scene/camera/width", json!(0)),
+        "scene.camera.width",
+        &["1..=16384"],
+    );
+    refused(
+        &broken("/scene/camera/height", json!(0)),
+        "scene.camera.height",
+        &["1..=16384"],
+    );
+    refused(
+        &broken("/scene/camera/look_at", json!([0.0, 0.0, 5.0])),
+        "scene.camera.look_at",
+        &["the eye"],
+    );
+    refused(
+        &broken("/scene/camera/up", json!([0.0, 0.0, 1.0])),
+        "scene.camera.up",
+        &["not parallel"],
+    );
+    refused(
+        &broken("/scene/max_depth", json!(17)),
+        "scene.max_depth",
+        &["0..=16"],
+    );
+    refused(
+        &broken("/scene/objects/0/radius", json!(0.0)),
+        "scene.objects[0].radius",
+        &["> 0"],
+    );
+    refused(
+        &broken("/scene/objects/0/radius", json!(1e300)),
+        "scene.objects[0]",
+        &["1e100"],
+    );
+    refused(
+        &broken("/scene/objects/0/material/k_d", json!(1.5)),
+        "scene.objects[0].material.k_d",
+        &["[0, 1]"],
+    );
+    refused(
+        &broken("/scene/objects/0/material/ior", json!(0.0)),
+        "scene.objects[0].material.ior",
+        &["index of refraction"],
+    );
+    refused(
+        &broken("/scene/lights/0/intensity", json!([1.0, -1.0, 0.0])),
+        "scene.lights[0].intensity",
+        &[">= 0"],
+    );
+    refused(
+        &broken("/scene/ambient", json!([1e200, 0.0, 0.0])),
+        "scene.ambient",
+        &["1e100"],
+    );
+    refused(
+        &broken("/scene/pixel", json!([4, 0])),
+        "scene.pixel",
+        &["outside the 4 x 3 image"],
+    );
+    refused(
+        &broken("/scene/objects/0/type", json!("cube")),
+        "scene.objects[0].type",
+        &["sphere"],
+    );
+    refused(
+        &broken("/rules/0", json!({"rule": "adaptive", "threshold": -1.0})),
+        "rules[0]",
+        &["threshold"],
+    );
+    // The one-pixel quantities need scene.pixel.
+    let mut v: Value = serde_json::from_str(GOOD).expect("json");
+    v["scene"].as_object_mut().expect("scene").remove("pixel");
+    refused(&v.to_string(), "quantities[0]", &["scene.pixel"]);
+}
+
+/// Extreme numbers in every leaf of the bundled files and of GOOD never
+/// panic the validation, and a valid one evaluates without panicking.
+#[test]
+fn extreme_numbers_anywhere_are_errors_not_panics() {
+    let registry = lightquad::families::builtin();
+    let mut specs: Vec<Value> = bundled().into_iter().map(|(_, v)| v).collect();
+    specs.push(serde_json::from_str(GOOD).expect("json"));
+    for spec in specs {
+        let mut leaves = Vec::new();
+        fn walk(v: &Value, at: String, out: &mut Vec<String>) {
+            match v {
+                Value::Object(m) => m
+                    .iter()
+                    .for_each(|(k, c)| walk(c, format!("{at}/{k}"), out)),
+                Value::Array(a) => a
+                    .iter()
+                    .enumerate()
+                    .for_each(|(i, c)| walk(c, format!("{at}/{i}"), out)),
+                Value::Number(_) => out.push(at),
+                _ => {}
+            }
+        }
+        walk(&spec["scene"], "/scene".into(), &mut leaves);
+        for leaf in &leaves {
+            for x in [0.0, -1.0, 1e308, -1e308, 1e-308, 1e-300] {
+                let mut v = spec.clone();
+                *v.pointer_mut(leaf).expect("leaf") = json!(x);
+                match registry.load(v.clone(), "h") {
+                    Ok(_) => {
+                        // Render one centre ray per pixel of what was accepted.
+                        if let Ok(exp) = validate::<Whitted>(deserialize(v).expect("parses"), "h") {
+                            let method: Method<Scheme> = Method::Estimator(Scheme::Centre);
+                            let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+                            let q = exp.spec.quantities[0];
+                            let _ = Whitted::evaluate(&exp.scene, &method, 1, &mut rng, &[q]);
+                        }
+                    }
+                    Err(e) => assert!(!e.path.is_empty() && e.message.len() > 5, "{e}"),
+                }
+            }
+        }
+    }
+}
