@@ -141,12 +141,15 @@ fn stochastic_rules_cover_95_percent_on_every_volume_quantity() {
                 let counts = coverage(&b, &rule, n, &on_sphere, |q| sphere_exact(kappa, albedo, q));
                 for (q, c) in on_sphere.iter().zip(counts) {
                     let what = format!("{name} kappa {kappa} albedo {albedo:?} {q:?} n = {n}");
-                    if name == "stratified" && n == 16 {
+                    if name == "stratified" {
                         // At 16 cells the second differences also carry the
                         // integrand's curvature, (f'' h^2)^2 against
                         // sigma^2 = (f' h)^2 / 12 (68% more at kappa 2), and
-                        // the row's end triples count double: conservative
-                        // (99.75%), which only the lower bound checks.
+                        // the row's end triples count double; the end cells'
+                        // first differences (which see an endpoint
+                        // singularity) add (f' h)^2 at each row end, up to
+                        // sqrt(1 + 24/m) in the error: conservative (99.75%
+                        // at 64 cells), which only the lower bound checks.
                         assert_at_least_95(c, &what);
                     } else {
                         assert_95(c, &what);
@@ -460,6 +463,41 @@ fn infinite_variance_samples_are_flagged_or_covered() {
         }
         let (_, flagged, _) = rule_runs(&rule, 256, x06, 2.5);
         assert_at_least(0.8, flagged, &format!("{name} x^-0.6 n = 256 flagged"));
+    }
+}
+
+/// Stratified sampling at an endpoint singularity `x^-a` (integral `1/(1 -
+/// a)`): one sample of the end cell cannot show that its variance is large
+/// or infinite, and with second differences alone the estimate was unflagged
+/// at 56% (`a = 0.9`), 82% (0.6) and 90-92% (0.25) coverage, with 59 of 400
+/// runs at `a = 0.9` under a tenth of the error. A row's end cells now also
+/// count their first difference, which sees the value grow toward the
+/// boundary: coverage at 1.96 errors of 97.5% (`a = 0.6`) and 99.8%
+/// (0.45). At `a = 0.9` it stays near 68%, and about 3% of runs (11 of 400
+/// measured) remain under a tenth of the error, unflagged: said here, not
+/// fixed.
+#[test]
+fn stratified_covers_an_endpoint_singularity_of_finite_variance() {
+    let rule = random_rule("stratified");
+    let x06: Integrand = |x| x.powf(-0.6);
+    let x045: Integrand = |x| x.powf(-0.45);
+    for n in [32, 1024] {
+        for (f, exact, what) in [(x06, 2.5, "x^-0.6"), (x045, 1.0 / 0.55, "x^-0.45")] {
+            let (covered, flagged, _) = rule_runs(&rule, n, f, exact);
+            assert_eq!(flagged, 0, "{what} n = {n}");
+            assert_at_least_95(covered, &format!("stratified {what} n = {n} covered"));
+        }
+        let mut lies = 0;
+        for seed in 0..R {
+            let e = rule
+                .integrate::<1, f64, _, _>(n, &mut rng(80_000 + seed), |u: [f64; 1]| {
+                    u[0].powf(-0.9)
+                })
+                .expect("finite");
+            lies += u64::from(e.reliable && e.error < 0.1 * (e.value - 10.0).abs());
+        }
+        eprintln!("stratified x^-0.9 n = {n}: {lies} of {R} under a tenth of the error");
+        assert!(lies * 20 < R, "x^-0.9 n = {n}: {lies} of {R}");
     }
 }
 
