@@ -777,15 +777,25 @@ fn media_whose_optical_depth_overflows_are_refused_at_check() {
         "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
         "{ \"type\": \"gaussian-blobs\", \"blobs\": [{ \"centre\": [0.0, 0.0, 0.0], \"amplitude\": 1e308, \"width\": 1.0 }, { \"centre\": [0.1, 0.0, 0.0], \"amplitude\": 1e308, \"width\": 1.0 }] }",
     );
-    rejected(&blobs, "scene.medium", "overflows f64");
+    rejected(
+        &blobs,
+        "scene.medium.blobs[0].amplitude",
+        "1e308: the optical depth along the ray overflows f64",
+    );
+    rejected(
+        &blobs,
+        "scene.medium.blobs[0].amplitude",
+        "no value of this field alone brings it below 1.8e308: expected smaller values here \
+         and at scene.medium.blobs[1].amplitude",
+    );
     let gradient = VALID.replace(
         "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
         "{ \"type\": \"linear-gradient\", \"centre\": [0, 0, 0], \"radius\": 1e300, \"base\": 1.0, \"gradient\": [0.8, 0, 0] }",
     );
     rejected(
         &gradient,
-        "scene.medium",
-        "optical depth along the ray overflows",
+        "scene.medium.radius",
+        "1e300: the optical depth along the ray overflows",
     );
     // The same gradient at radius 1e20 is fine.
     let fine = gradient.replace("1e300", "1e20");
@@ -796,6 +806,56 @@ fn media_whose_optical_depth_overflows_are_refused_at_check() {
     let (dir, _, o) = run_text("fine-gradient", &fine);
     assert!(o.status.success(), "{}", stderr(&o));
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// A constant sphere whose optical depth overflows is refused at the field
+/// that does it, with the value and the largest it may take (the hostile
+/// review of issue 10: kappa = 1e308 and radius = 1e308 were refused at
+/// `scene.medium` only). VALID's ray, y = 0.3 from the centre, has the
+/// chord 2 sqrt(1 - 0.3^2) = 1.908 in the unit sphere, so kappa may reach
+/// f64::MAX / 1.908 = 9.42e307; a sphere of radius 1e308 holds the ray's
+/// origin, so its chord from t = 0 is r + 3 (about r), and with kappa = 2
+/// the radius may reach f64::MAX / 2 = 8.99e307.
+#[test]
+fn a_sphere_whose_depth_overflows_is_refused_at_kappa_or_radius_with_the_range() {
+    let chord = 2.0 * (1.0f64 - 0.09).sqrt();
+    let kappa_max = f64::MAX / chord;
+    assert!((9.4e307..9.5e307).contains(&kappa_max), "{kappa_max:e}");
+    let with_kappa = |k: &str| VALID.replace("\"kappa\": 2.0", &format!("\"kappa\": {k}"));
+    rejected(
+        &with_kappa("1e308"),
+        "scene.medium.kappa",
+        "1e308: the optical depth along the ray overflows f64",
+    );
+    rejected(
+        &with_kappa("1e308"),
+        "scene.medium.kappa",
+        "expected kappa at most 9.4e307 along this ray",
+    );
+    let check = |text: &str| {
+        let dir = scratch("kappa-edge");
+        let file = dir.join("e.json");
+        fs::write(&file, text).expect("write");
+        let o = bin().arg("check").arg(&file).output().expect("runs");
+        let _ = fs::remove_dir_all(&dir);
+        o
+    };
+    // Either side of the bound the message gives.
+    let o = check(&with_kappa("9.4e307"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!check(&with_kappa("9.5e307")).status.success());
+    let radius_max = f64::MAX / 2.0;
+    assert!((8.9e307..9.0e307).contains(&radius_max));
+    rejected(
+        &VALID.replace("\"radius\": 1.0", "\"radius\": 1e308"),
+        "scene.medium.radius",
+        "1e308: the optical depth along the ray overflows f64",
+    );
+    rejected(
+        &VALID.replace("\"radius\": 1.0", "\"radius\": 1e308"),
+        "scene.medium.radius",
+        "expected radius at most 8.9e307 along this ray",
+    );
 }
 
 /// The CSV has as many fields on every line as in its header, product labels

@@ -437,19 +437,19 @@ impl Family for Volume {
             let mut alone = scene.clone();
             alone.lambda = 1.0;
             let (s1, d1) = alone.anchored().0.depth_bound();
-            let path = if s1.is_finite() && d1.is_finite() {
-                "scene.lambda"
-            } else {
-                "scene.medium"
-            };
+            if !(s1.is_finite() && d1.is_finite())
+                && let Some(medium) = &spec.medium
+            {
+                return Err(depth_fault(spec, medium, sigma, depth));
+            }
             return Err(SpecError::at(
-                path,
+                "scene.lambda",
                 format!(
-                    "the optical depth along the ray overflows f64 (lambda = {:e}; the largest \
-                     extinction lambda v is {sigma:e}, and times the chord it bounds the depth \
-                     by {depth:e}): expected a medium and a lambda whose optical depth along the \
-                     ray stays below 1.8e308",
-                    scene.lambda
+                    "{}: the optical depth along the ray overflows f64 (the largest extinction \
+                     lambda v is {sigma:e}, and times the chord it bounds the depth by {depth:e}), \
+                     while with lambda = 1 it is finite: expected a lambda >= 0 whose optical \
+                     depth along the ray stays below 1.8e308",
+                    crate::error::shortened(scene.lambda.to_string())
                 ),
             ));
         }
@@ -1034,6 +1034,214 @@ fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
         VolumeQuantity::Light => light(),
         VolumeQuantity::Total => Some(emission()? + background + light()?),
     }
+}
+
+/// A field of a medium that scales its optical depth bound: its path below
+/// `scene.medium`, its value, and how to set it.
+type DepthField = (String, f64, Box<dyn Fn(&mut MediumSpec, f64)>);
+
+/// The fields whose size scales a medium's optical depth along a ray: the
+/// densities (kappa, amplitudes, base, gradient, the voxel grid's largest
+/// value) and the lengths (radius, widths).
+fn depth_fields(m: &MediumSpec) -> Vec<DepthField> {
+    let mut out: Vec<DepthField> = Vec::new();
+    match m {
+        MediumSpec::ConstantSphere(s) => {
+            out.push((
+                "kappa".into(),
+                s.kappa,
+                Box::new(|m, x| {
+                    if let MediumSpec::ConstantSphere(s) = m {
+                        s.kappa = x;
+                    }
+                }),
+            ));
+            out.push((
+                "radius".into(),
+                s.radius,
+                Box::new(|m, x| {
+                    if let MediumSpec::ConstantSphere(s) = m {
+                        s.radius = x;
+                    }
+                }),
+            ));
+        }
+        MediumSpec::GaussianBlobs(b) => {
+            for (i, blob) in b.blobs.iter().enumerate() {
+                out.push((
+                    format!("blobs[{i}].amplitude"),
+                    blob.amplitude,
+                    Box::new(move |m, x| {
+                        if let MediumSpec::GaussianBlobs(b) = m {
+                            b.blobs[i].amplitude = x;
+                        }
+                    }),
+                ));
+                out.push((
+                    format!("blobs[{i}].width"),
+                    blob.width,
+                    Box::new(move |m, x| {
+                        if let MediumSpec::GaussianBlobs(b) = m {
+                            b.blobs[i].width = x;
+                        }
+                    }),
+                ));
+            }
+        }
+        MediumSpec::LinearGradient(g) => {
+            out.push((
+                "radius".into(),
+                g.radius,
+                Box::new(|m, x| {
+                    if let MediumSpec::LinearGradient(g) = m {
+                        g.radius = x;
+                    }
+                }),
+            ));
+            out.push((
+                "base".into(),
+                g.base,
+                Box::new(|m, x| {
+                    if let MediumSpec::LinearGradient(g) = m {
+                        g.base = x;
+                    }
+                }),
+            ));
+            for k in 0..3 {
+                out.push((
+                    format!("gradient[{k}]"),
+                    g.gradient[k],
+                    Box::new(move |m, x| {
+                        if let MediumSpec::LinearGradient(g) = m {
+                            g.gradient[k] = x;
+                        }
+                    }),
+                ));
+            }
+        }
+        MediumSpec::VoxelGrid(v) => {
+            if let Some((i, &x)) = v
+                .data
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+            {
+                out.push((
+                    format!("data[{i}]"),
+                    x,
+                    Box::new(move |m, x| {
+                        if let MediumSpec::VoxelGrid(v) = m {
+                            v.data[i] = x;
+                        }
+                    }),
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// Whether the scene of `spec` fails to build or its optical depth bound
+/// along the ray is not finite.
+fn depth_overflows(spec: &SceneSpec) -> bool {
+    scene(spec).map_or(true, |s| {
+        let (sigma, depth) = s.anchored().0.depth_bound();
+        !(sigma.is_finite() && depth.is_finite())
+    })
+}
+
+/// `x` (> 0) rounded down to two significant digits, in scientific notation.
+fn two_digits_down(x: f64) -> String {
+    let e = x.log10().floor();
+    let mut m = (x / 10f64.powf(e) * 10.0).floor() / 10.0;
+    // The division can round a mantissa of 10 down to 9.99...
+    if m >= 10.0 {
+        m = 9.9;
+    }
+    format!("{m:.1}e{e}")
+}
+
+/// The error for a medium whose optical depth along the ray overflows f64
+/// with lambda = 1 (`sigma` and `depth` its bound as given), at the field
+/// that causes it: the one field of [`depth_fields`] that brings the bound
+/// below 1.8e308 alone when set to 1 (the most extreme of them, if several
+/// do), with the largest value it may take, the others as given, found by
+/// bisection. A medium no single field can repair is refused at its largest
+/// field, saying so.
+fn depth_fault(spec: &SceneSpec, medium: &MediumSpec, sigma: f64, depth: f64) -> SpecError {
+    let with = |set: &dyn Fn(&mut MediumSpec, f64), x: f64| {
+        let mut s = spec.clone();
+        if let Some(m) = s.medium.as_mut() {
+            set(m, x);
+        }
+        s
+    };
+    let fields: Vec<DepthField> = depth_fields(medium)
+        .into_iter()
+        .filter(|(_, x, _)| x.abs() > 1.0)
+        .collect();
+    let culprit = fields
+        .iter()
+        .filter(|(_, x, set)| !depth_overflows(&with(set.as_ref(), x.signum())))
+        .reduce(|a, b| if b.1.abs() > a.1.abs() { b } else { a });
+    let overflow = format!(
+        "the optical depth along the ray overflows f64 (lambda = {}; the largest extinction \
+         lambda v is {sigma:e}, and times the chord it bounds the depth by {depth:e})",
+        crate::error::shortened(spec.lambda.unwrap_or(1.0).to_string())
+    );
+    let Some((field, x, set)) = culprit else {
+        let Some((field, x, _)) = fields
+            .iter()
+            .reduce(|a, b| if b.1.abs() > a.1.abs() { b } else { a })
+        else {
+            return SpecError::at(
+                "scene.medium",
+                format!(
+                    "{overflow}: expected a medium whose optical depth along the ray stays \
+                     below 1.8e308"
+                ),
+            );
+        };
+        let others: Vec<String> = fields
+            .iter()
+            .filter(|(f, y, _)| f != field && y.abs() > 1.0)
+            .map(|(f, _, _)| format!("scene.medium.{f}"))
+            .collect();
+        return SpecError::at(
+            format!("scene.medium.{field}"),
+            format!(
+                "{}: {overflow}, and no value of this field alone brings it below 1.8e308: \
+                 expected smaller values here and at {}",
+                crate::error::shortened(x.to_string()),
+                others.join(", ")
+            ),
+        );
+    };
+    // The largest magnitude in [1, |x|] whose bound stays finite, bisected
+    // on the exponent.
+    let (mut lo, mut hi) = (0.0f64, x.abs().log2());
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if depth_overflows(&with(set.as_ref(), x.signum() * mid.exp2())) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let largest = two_digits_down(lo.exp2());
+    let range = if *x < 0.0 {
+        format!("at least -{largest}")
+    } else {
+        format!("at most {largest}")
+    };
+    SpecError::at(
+        format!("scene.medium.{field}"),
+        format!(
+            "{}: {overflow}: expected {field} {range} along this ray, with lambda and the \
+             medium's other fields as given (the optical depth must stay below 1.8e308)",
+            crate::error::shortened(x.to_string())
+        ),
+    )
 }
 
 fn vec3(v: [f64; 3]) -> Vec3 {
