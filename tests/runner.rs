@@ -1777,8 +1777,89 @@ fn every_number_error_states_the_range_the_field_accepts() {
     rejected(
         &VALID.replace("\"radius\": 1.0", "\"radius\": 1e400"),
         "scene.medium.radius",
-        "a number beyond the f64 range (its magnitude is above 1.8e308)",
+        "1e400 (line 7 column 85) is beyond the f64 range (its magnitude is above 1.8e308): \
+         expected a finite number",
     );
+}
+
+/// A whole number beyond the f64 range (1e400), or beyond what the field
+/// holds (1000000000000000000000, which JSON readers give as the float
+/// 1e21), is refused naming the range the field accepts (the hostile review
+/// of issue 10: 1e400 said only "expected a finite number", 1e21 "invalid
+/// type: floating point"); a whole number written with an exponent (1e3)
+/// is the whole number JSON Schema's `integer` says it is. The ranges are
+/// the schema's (`lightquad schema`: repeats 1..=1000, budgets
+/// 1..=100000000, reference.n 2..=100000, seed a u64).
+#[test]
+fn whole_numbers_beyond_the_range_name_the_range() {
+    let schema = bin().arg("schema").output().expect("runs");
+    let schema: serde_json::Value = serde_json::from_slice(&schema.stdout).expect("JSON");
+    let text = schema.to_string();
+    for range in [
+        "\"maximum\":1000,\"minimum\":1",
+        "\"maximum\":100000000,\"minimum\":1",
+        "\"maximum\":100000,\"minimum\":2",
+    ] {
+        assert!(text.contains(range), "the schema has no {range}");
+    }
+    let huge = "1000000000000000000000";
+    for (number, what) in [
+        ("1e400", "1e400 (line 13 column 18) is beyond the f64 range"),
+        (huge, "invalid value: floating point `1e+21`"),
+    ] {
+        rejected(
+            &VALID.replace("\"repeats\": 2", &format!("\"repeats\": {number}")),
+            "repeats",
+            &format!("{what}, expected a whole number in 1..=1000").replace(
+                "range, expected",
+                "range (its magnitude is above 1.8e308): expected",
+            ),
+        );
+        rejected(
+            &VALID.replace("\"seed\": 7", &format!("\"seed\": {number}")),
+            "seed",
+            "expected a whole number in 0..=18446744073709551615",
+        );
+        rejected(
+            &VALID.replace("[4, 16, 64]", &format!("[4, 16, {number}]")),
+            "budgets[2]",
+            "expected a whole number in 1..=100000000",
+        );
+        rejected(
+            &VALID.replace(
+                "{ \"type\": \"closed-form\" }",
+                &format!("{{ \"type\": \"converged\", \"n\": {number} }}"),
+            ),
+            "reference.n",
+            "expected a whole number in 2..=100000",
+        );
+    }
+    rejected(
+        &VALID.replace("[4, 16, 64]", "[4, 16, -1e400]"),
+        "budgets[2]",
+        "-1e400 (line 12 column 27) is beyond the f64 range (its magnitude is above 1.8e308): \
+         expected a whole number in 1..=100000000",
+    );
+    rejected(
+        &VALID.replace("\"name\": \"t\"", "\"name\": 1e400"),
+        "name",
+        "expected a name of 1 to 100 letters",
+    );
+    // Whole numbers with an exponent are read as such.
+    let dir = scratch("exponent");
+    let file = dir.join("e.json");
+    fs::write(
+        &file,
+        VALID
+            .replace("[4, 16, 64]", "[4, 1.6e1, 64.0]")
+            .replace("\"seed\": 7", "\"seed\": 1e5"),
+    )
+    .expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("2 rule(s) x 3 budget(s)"), "{out}");
+    let _ = fs::remove_dir_all(&dir);
 }
 
 /// A missing field is named at its own path, not at the object that lacks
