@@ -1867,26 +1867,85 @@ fn whole_numbers_beyond_the_range_name_the_range() {
 /// `scene.ray`. Every required field of a valid file, dropped in turn.
 #[test]
 fn a_missing_field_is_named_at_its_own_path() {
+    // What each accepts, as the schema (`lightquad schema`) and the README
+    // say: a ray's points are 3 numbers, a sphere's radius and density are
+    // numbers, the tags name their variants.
     let required = [
-        ("\"origin\": [-3.0, 0.3, 0.0], ", "scene.ray.origin"),
-        (", \"direction\": [1.0, 0.0, 0.0]", "scene.ray.direction"),
-        ("\"type\": \"constant-sphere\", ", "scene.medium.type"),
-        (", \"radius\": 1.0", "scene.medium.radius"),
-        (", \"kappa\": 2.0", "scene.medium.kappa"),
-        (", \"c\": 1.0", "scene.emission.c"),
-        ("\"rule\": \"stratified\"", "rules[1].rule"),
-        ("\"quantities\": [\"tau\", \"I_E\"],", "quantities"),
-        ("\"type\": \"closed-form\"", "reference.type"),
+        (
+            "\"origin\": [-3.0, 0.3, 0.0], ",
+            "scene.ray.origin",
+            "expected a list of 3 numbers",
+        ),
+        (
+            ", \"direction\": [1.0, 0.0, 0.0]",
+            "scene.ray.direction",
+            "expected a list of 3 numbers",
+        ),
+        (
+            "\"type\": \"constant-sphere\", ",
+            "scene.medium.type",
+            "expected one of `constant-sphere`, `gaussian-blobs`, `linear-gradient`, `voxel-grid`",
+        ),
+        (
+            ", \"radius\": 1.0",
+            "scene.medium.radius",
+            "expected a number (radius)",
+        ),
+        (
+            ", \"kappa\": 2.0",
+            "scene.medium.kappa",
+            "expected a number (density)",
+        ),
+        (
+            ", \"c\": 1.0",
+            "scene.emission.c",
+            "expected a number (the constant)",
+        ),
+        (
+            "\"rule\": \"stratified\"",
+            "rules[1].rule",
+            "expected one of trapezoid, simpson, gauss-legendre",
+        ),
+        (
+            "\"quantities\": [\"tau\", \"I_E\"],",
+            "quantities",
+            "expected a list, each one of `tau`, `ln_tau`, `I_E`, `I_B`, `I_L`, `I`",
+        ),
+        (
+            "\"type\": \"closed-form\"",
+            "reference.type",
+            "expected one of `closed-form`, `value`, `mitsuba`, `converged`",
+        ),
+        (
+            "\"name\": \"t\",",
+            "name",
+            "expected a string (short name (file-name safe",
+        ),
     ];
-    for (cut, path) in required {
+    for (cut, path, expected) in required {
         assert!(VALID.contains(cut), "{cut}");
         let field = path.rsplit('.').next().expect("field");
+        let field = field.split('[').next().expect("name");
         rejected(
             &VALID.replace(cut, ""),
             path,
-            &format!("the required field `{field}` is missing"),
+            &format!("the required field `{field}` is missing: {expected}"),
         );
     }
+    // Inside a list, the variant the file names.
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
+            "{ \"type\": \"gaussian-blobs\", \"blobs\": [{ \"centre\": [0, 0, 0], \"width\": 1.0 }] }",
+        ),
+        "scene.medium.blobs[0].amplitude",
+        "the required field `amplitude` is missing: expected a number (peak density)",
+    );
+    rejected(
+        &VALID.replace("[4, 16, 64]", "{ \"from\": 4, \"factor\": 2 }"),
+        "budgets.to",
+        "the required field `to` is missing: expected a whole number in 1..=100000000",
+    );
     rejected(
         &VALID.replace(
             "\"ray\": { \"origin\": [-3.0, 0.3, 0.0], \"direction\": [1.0, 0.0, 0.0] },",

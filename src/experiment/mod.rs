@@ -31,6 +31,7 @@
 //! # Ok::<(), lightquad::error::SpecError>(())
 //! ```
 
+pub mod expected;
 pub mod fit;
 pub mod html;
 pub mod markdown;

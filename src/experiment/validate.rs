@@ -246,7 +246,22 @@ fn error_at(path: &str, e: &impl std::fmt::Display) -> SpecError {
 /// Reads a parsed file as an experiment of family `F`, naming the JSON path
 /// of any fault.
 pub fn deserialize<F: Family>(json: serde_json::Value) -> Result<ExperimentSpec<F>, SpecError> {
-    serde_path_to_error::deserialize(json).map_err(path_error)
+    serde_path_to_error::deserialize(&json)
+        .map_err(path_error)
+        .map_err(|e| with_expected::<F>(e, &json))
+}
+
+/// A missing required field's error with what the field accepts, from the
+/// family's schema: serde names only the field ("the required field
+/// `radius` is missing").
+fn with_expected<F: Family>(mut e: SpecError, json: &serde_json::Value) -> SpecError {
+    if e.message.starts_with("the required field `") && !e.message.contains("expected") {
+        let schema = schemars::schema_for!(ExperimentSpec<F>).to_value();
+        if let Some(words) = super::expected::describe(&schema, json, &e.path) {
+            e.message = format!("{}: expected {words}", e.message);
+        }
+    }
+    e
 }
 
 /// Validates a parsed experiment whose file hashes to `hash`, as if its file
