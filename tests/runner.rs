@@ -2119,7 +2119,33 @@ fn file_system_faults_name_the_path_and_the_reason() {
     let msg = check(&file);
     assert!(
         msg.contains("at `reference.file`")
-            && msg.contains("other.json (not a Mitsuba values file: it has no `experiment_hash` and `quantities`")
+            && msg.contains("other.json: not a Mitsuba values file: it has no `experiment_hash` and `quantities`")
+            && !msg.contains("stale"),
+        "{msg}"
+    );
+    // Named like a bundled experiment whose (bundled) values were made from
+    // another file: the named file is still the fault, not those values'
+    // staleness (the hostile review of issue 10).
+    let bundled = VALID
+        .replace("\"name\": \"t\"", "\"name\": \"v-tau-stiff-sphere\"")
+        .replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"mitsuba\", \"file\": \"other.json\" }",
+        );
+    fs::write(&file, &bundled).expect("write");
+    let msg = check(&file);
+    assert!(
+        msg.contains("at `reference.file`")
+            && msg.contains("other.json: not a Mitsuba values file: it has no `experiment_hash` and `quantities`")
+            && !msg.contains("stale"),
+        "{msg}"
+    );
+    // Not JSON at all: said, with what a values file is.
+    fs::write(dir.join("other.json"), "x,y\n1,2\n").expect("write");
+    let msg = check(&file);
+    assert!(
+        msg.contains("other.json is not a Mitsuba values file (not JSON: ")
+            && msg.contains("expected the JSON file scripts/reference.sh writes")
             && !msg.contains("stale"),
         "{msg}"
     );
