@@ -397,6 +397,12 @@ impl family::Estimator for Tracker {
     }
 }
 
+/// Bytes a depth checkpoint of the cumulative scheme holds (`t` and its
+/// compensated depth, 24 bytes, in a B-tree's leaves of 11 slots that nodes
+/// visited in order leave about half full): 49 bytes an entry allocated at
+/// 2e5 trapezoid nodes (tests/memory_checkpoints.rs).
+pub const CHECKPOINT_BYTES: f64 = 48.0;
+
 /// The built scene with how it is evaluated.
 #[derive(Debug, Clone)]
 pub struct Built {
@@ -590,7 +596,11 @@ impl Family for Volume {
     }
 
     /// The rule's node table, and a second one of the same size under the
-    /// nested scheme (the inner optical depth's rule beside the outer one).
+    /// nested scheme (the inner optical depth's rule beside the outer one);
+    /// under the cumulative scheme, V-E and V-L also hold the depth
+    /// checkpoints of the graded piece being integrated: one entry per node
+    /// the outer rule visits (its evaluations, an error estimate's rules
+    /// included, and the piece's two ends), [`CHECKPOINT_BYTES`] each.
     fn memory(
         built: &Built,
         method: &Method<Tracker>,
@@ -603,11 +613,22 @@ impl Family for Volume {
         };
         let nested =
             built.scheme == DepthScheme::Nested || built.shadow == ShadowMethod::Quadrature;
-        let tables = match quantity {
-            Emission | Light | Total if nested => 2.0,
-            _ => 1.0,
+        let scene = &built.scene;
+        let emission = scene.emission.is_some();
+        let light = scene.light.is_some() && scene.medium.is_some();
+        let outer = match quantity {
+            Emission => emission,
+            Light => light,
+            Total => emission || light,
+            Tau | LnTau | Background => false,
         };
-        tables * crate::quadrature::Rule::memory(rule, budget, 1)
+        let tables = if outer && nested { 2.0 } else { 1.0 };
+        let checkpoints = if outer && built.scheme == DepthScheme::Cumulative {
+            CHECKPOINT_BYTES * (crate::quadrature::Rule::evaluations(rule, budget, 1) + 2.0)
+        } else {
+            0.0
+        };
+        tables * crate::quadrature::Rule::memory(rule, budget, 1) + checkpoints
     }
 
     /// Delta tracking estimates every term a renderer's walk scores
