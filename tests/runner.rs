@@ -2243,3 +2243,77 @@ fn a_sphere_of_radius_1e308_with_a_converged_reference_runs_in_seconds() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A table whose rows count more evaluations than their budget says why,
+/// in the Markdown and the HTML page (the hostile review of issue 10: V-E
+/// with Gauss–Legendre showed about 50 n evaluations unexplained). The
+/// independent facts: V-E's outer nodes walk the cumulative depth (about
+/// 12 lookups each), and Gauss–Legendre's estimate evaluates 3.5 n; the
+/// trapezoid on tau alone evaluates exactly its n nodes on the one smooth
+/// piece, so a table of those rows has no such line.
+#[test]
+fn evaluations_above_the_budget_are_explained_in_the_report() {
+    let (dir, out, o) = run_text(
+        "over-budget",
+        &VALID.replace(
+            "[ { \"rule\": \"gauss-legendre\" }, { \"rule\": \"stratified\" } ]",
+            "[ { \"rule\": \"gauss-legendre\" }, { \"rule\": \"trapezoid\" } ]",
+        ),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = fs::read_to_string(out.join("t/report.md")).expect("report");
+    let html = fs::read_to_string(out.join("t/index.html")).expect("html");
+    let tau = md.split("## tau").nth(1).expect("tau section");
+    let tau = tau.split("## ").next().expect("tau alone");
+    let emission = md.split("## I_E").nth(1).expect("I_E section");
+    // The rows themselves: I_E's Gauss–Legendre rows above n, tau's
+    // trapezoid rows at n.
+    let evaluations = |section: &str, rule: &str, n: usize| -> f64 {
+        let line = section
+            .lines()
+            .find(|l| l.starts_with(&format!("| {rule} | {n} |")))
+            .unwrap_or_else(|| panic!("no {rule} row at {n}"));
+        line.split('|')
+            .nth(6)
+            .expect("cell")
+            .trim()
+            .parse()
+            .expect("a number")
+    };
+    assert!(evaluations(emission, "gauss-legendre", 64) > 3.5 * 64.0);
+    assert!(evaluations(tau, "trapezoid", 64) <= 64.0);
+    let line = "Evaluations above n (up to ";
+    let why = "the cumulative optical depth";
+    let gl = "Gauss–Legendre's error estimate evaluates three companion rules";
+    let said = emission
+        .lines()
+        .find(|l| l.starts_with(line))
+        .expect("I_E explained");
+    assert!(said.contains(why) && said.contains(gl), "{said}");
+    assert!(
+        html.contains(line) && html.contains(why),
+        "no line in the HTML page"
+    );
+    // Tau's table has Gauss–Legendre's error estimate (3.5 n) but no depth
+    // walks; the line is there, and says the same.
+    assert!(tau.contains(line), "{tau}");
+    // A trapezoid-only tau experiment has no rows above n: no line.
+    let (dir2, out2, o) = run_text(
+        "at-budget",
+        &VALID
+            .replace(
+                "\"quantities\": [\"tau\", \"I_E\"]",
+                "\"quantities\": [\"tau\"]",
+            )
+            .replace(
+                "[ { \"rule\": \"gauss-legendre\" }, { \"rule\": \"stratified\" } ]",
+                "[ { \"rule\": \"trapezoid\" } ]",
+            ),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = fs::read_to_string(out2.join("t/report.md")).expect("report");
+    let html = fs::read_to_string(out2.join("t/index.html")).expect("html");
+    assert!(!md.contains(line) && !html.contains(line), "{md}");
+    let _ = fs::remove_dir_all(&dir);
+    let _ = fs::remove_dir_all(&dir2);
+}

@@ -428,6 +428,15 @@ impl Family for Volume {
     const EQUATIONS: &'static [&'static str] = &["V-tau", "V-E", "V-B", "V-Lp", "V-L", "V-I"];
     const BUDGET_UNIT: &'static str =
         "nodes or samples per smooth piece of the ray (walks for tracking)";
+    const OVER_BUDGET: &'static str = "every density lookup counts as an evaluation, and the \
+        budget is per piece: n goes to each smooth piece of the ray, and V-E and V-L cut their \
+        pieces further at optical depths 1, 2, 4, ... (graded pieces); each outer node of V-E and \
+        V-L walks the cumulative optical depth from the nearest visited node with 6-point \
+        panels (about 12 lookups a node, 6 (2 + log2 n) for rules that visit nodes out of \
+        order), or integrates it again with the rule under the nested scheme (about n^2), and \
+        shadow rays by quadrature nest a rule too; Gauss–Legendre's error estimate evaluates \
+        three companion rules (about 3.5 n in all); a tracker's walk looks the density up at \
+        each tentative collision";
 
     type SceneSpec = SceneSpec;
     type Scene = Built;
