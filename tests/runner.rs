@@ -1400,7 +1400,7 @@ fn long_names_and_files_that_are_not_regular_are_refused() {
     rejected(
         &zero,
         "reference.file",
-        "/dev/zero (is a device: expected a regular JSON file",
+        "/dev/zero: is a device: expected a regular JSON file",
     );
     let dir = scratch("fifo");
     let fifo = dir.join("f.json");

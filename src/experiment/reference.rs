@@ -214,7 +214,8 @@ pub fn mitsuba_values<Q: Quantity>(
 /// Why the file a Mitsuba reference names is not a values file, with what
 /// a values file is.
 fn not_values(location: &str, why: &str) -> String {
-    if why.starts_with("not a Mitsuba values file") {
+    if !why.starts_with("not JSON") {
+        // Not a values file, or not a regular file: said with what is expected.
         format!("{location}: {why}")
     } else {
         format!(
