@@ -417,6 +417,12 @@ pub trait Family: Sized + Send + Sync + 'static {
     /// What a budget counts, for reports ("evaluations per smooth piece of
     /// the ray", ...).
     const BUDGET_UNIT: &'static str;
+    /// Why a job may evaluate its integrand more often than its budget, for
+    /// the reports' rows where it does: "the rule's error estimate" by
+    /// default (Gauss–Legendre's three companion rules, about 3.5 n).
+    const OVER_BUDGET: &'static str = "the rule's own error estimate evaluates more than n \
+        nodes (Gauss–Legendre's three companion rules of about n, n and n/2 nodes: about 3.5 n \
+        in all)";
 
     /// The scene as written in an experiment file.
     type SceneSpec: Clone

@@ -777,15 +777,25 @@ fn media_whose_optical_depth_overflows_are_refused_at_check() {
         "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
         "{ \"type\": \"gaussian-blobs\", \"blobs\": [{ \"centre\": [0.0, 0.0, 0.0], \"amplitude\": 1e308, \"width\": 1.0 }, { \"centre\": [0.1, 0.0, 0.0], \"amplitude\": 1e308, \"width\": 1.0 }] }",
     );
-    rejected(&blobs, "scene.medium", "overflows f64");
+    rejected(
+        &blobs,
+        "scene.medium.blobs[0].amplitude",
+        "1e308: the optical depth along the ray overflows f64",
+    );
+    rejected(
+        &blobs,
+        "scene.medium.blobs[0].amplitude",
+        "no value of this field alone brings it below 1.8e308: expected smaller values here \
+         and at scene.medium.blobs[1].amplitude",
+    );
     let gradient = VALID.replace(
         "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
         "{ \"type\": \"linear-gradient\", \"centre\": [0, 0, 0], \"radius\": 1e300, \"base\": 1.0, \"gradient\": [0.8, 0, 0] }",
     );
     rejected(
         &gradient,
-        "scene.medium",
-        "optical depth along the ray overflows",
+        "scene.medium.radius",
+        "1e300: the optical depth along the ray overflows",
     );
     // The same gradient at radius 1e20 is fine.
     let fine = gradient.replace("1e300", "1e20");
@@ -796,6 +806,56 @@ fn media_whose_optical_depth_overflows_are_refused_at_check() {
     let (dir, _, o) = run_text("fine-gradient", &fine);
     assert!(o.status.success(), "{}", stderr(&o));
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// A constant sphere whose optical depth overflows is refused at the field
+/// that does it, with the value and the largest it may take (the hostile
+/// review of issue 10: kappa = 1e308 and radius = 1e308 were refused at
+/// `scene.medium` only). VALID's ray, y = 0.3 from the centre, has the
+/// chord 2 sqrt(1 - 0.3^2) = 1.908 in the unit sphere, so kappa may reach
+/// f64::MAX / 1.908 = 9.42e307; a sphere of radius 1e308 holds the ray's
+/// origin, so its chord from t = 0 is r + 3 (about r), and with kappa = 2
+/// the radius may reach f64::MAX / 2 = 8.99e307.
+#[test]
+fn a_sphere_whose_depth_overflows_is_refused_at_kappa_or_radius_with_the_range() {
+    let chord = 2.0 * (1.0f64 - 0.09).sqrt();
+    let kappa_max = f64::MAX / chord;
+    assert!((9.4e307..9.5e307).contains(&kappa_max), "{kappa_max:e}");
+    let with_kappa = |k: &str| VALID.replace("\"kappa\": 2.0", &format!("\"kappa\": {k}"));
+    rejected(
+        &with_kappa("1e308"),
+        "scene.medium.kappa",
+        "1e308: the optical depth along the ray overflows f64",
+    );
+    rejected(
+        &with_kappa("1e308"),
+        "scene.medium.kappa",
+        "expected kappa at most 9.4e307 along this ray",
+    );
+    let check = |text: &str| {
+        let dir = scratch("kappa-edge");
+        let file = dir.join("e.json");
+        fs::write(&file, text).expect("write");
+        let o = bin().arg("check").arg(&file).output().expect("runs");
+        let _ = fs::remove_dir_all(&dir);
+        o
+    };
+    // Either side of the bound the message gives.
+    let o = check(&with_kappa("9.4e307"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!check(&with_kappa("9.5e307")).status.success());
+    let radius_max = f64::MAX / 2.0;
+    assert!((8.9e307..9.0e307).contains(&radius_max));
+    rejected(
+        &VALID.replace("\"radius\": 1.0", "\"radius\": 1e308"),
+        "scene.medium.radius",
+        "1e308: the optical depth along the ray overflows f64",
+    );
+    rejected(
+        &VALID.replace("\"radius\": 1.0", "\"radius\": 1e308"),
+        "scene.medium.radius",
+        "expected radius at most 8.9e307 along this ray",
+    );
 }
 
 /// The CSV has as many fields on every line as in its header, product labels
@@ -1340,7 +1400,7 @@ fn long_names_and_files_that_are_not_regular_are_refused() {
     rejected(
         &zero,
         "reference.file",
-        "/dev/zero (is a device: expected a regular JSON file",
+        "/dev/zero: is a device: expected a regular JSON file",
     );
     let dir = scratch("fifo");
     let fifo = dir.join("f.json");
@@ -1717,8 +1777,89 @@ fn every_number_error_states_the_range_the_field_accepts() {
     rejected(
         &VALID.replace("\"radius\": 1.0", "\"radius\": 1e400"),
         "scene.medium.radius",
-        "a number beyond the f64 range (its magnitude is above 1.8e308)",
+        "1e400 (line 7 column 85) is beyond the f64 range (its magnitude is above 1.8e308): \
+         expected a finite number",
     );
+}
+
+/// A whole number beyond the f64 range (1e400), or beyond what the field
+/// holds (1000000000000000000000, which JSON readers give as the float
+/// 1e21), is refused naming the range the field accepts (the hostile review
+/// of issue 10: 1e400 said only "expected a finite number", 1e21 "invalid
+/// type: floating point"); a whole number written with an exponent (1e3)
+/// is the whole number JSON Schema's `integer` says it is. The ranges are
+/// the schema's (`lightquad schema`: repeats 1..=1000, budgets
+/// 1..=100000000, reference.n 2..=100000, seed a u64).
+#[test]
+fn whole_numbers_beyond_the_range_name_the_range() {
+    let schema = bin().arg("schema").output().expect("runs");
+    let schema: serde_json::Value = serde_json::from_slice(&schema.stdout).expect("JSON");
+    let text = schema.to_string();
+    for range in [
+        "\"maximum\":1000,\"minimum\":1",
+        "\"maximum\":100000000,\"minimum\":1",
+        "\"maximum\":100000,\"minimum\":2",
+    ] {
+        assert!(text.contains(range), "the schema has no {range}");
+    }
+    let huge = "1000000000000000000000";
+    for (number, what) in [
+        ("1e400", "1e400 (line 13 column 18) is beyond the f64 range"),
+        (huge, "invalid value: floating point `1e+21`"),
+    ] {
+        rejected(
+            &VALID.replace("\"repeats\": 2", &format!("\"repeats\": {number}")),
+            "repeats",
+            &format!("{what}, expected a whole number in 1..=1000").replace(
+                "range, expected",
+                "range (its magnitude is above 1.8e308): expected",
+            ),
+        );
+        rejected(
+            &VALID.replace("\"seed\": 7", &format!("\"seed\": {number}")),
+            "seed",
+            "expected a whole number in 0..=18446744073709551615",
+        );
+        rejected(
+            &VALID.replace("[4, 16, 64]", &format!("[4, 16, {number}]")),
+            "budgets[2]",
+            "expected a whole number in 1..=100000000",
+        );
+        rejected(
+            &VALID.replace(
+                "{ \"type\": \"closed-form\" }",
+                &format!("{{ \"type\": \"converged\", \"n\": {number} }}"),
+            ),
+            "reference.n",
+            "expected a whole number in 2..=100000",
+        );
+    }
+    rejected(
+        &VALID.replace("[4, 16, 64]", "[4, 16, -1e400]"),
+        "budgets[2]",
+        "-1e400 (line 12 column 27) is beyond the f64 range (its magnitude is above 1.8e308): \
+         expected a whole number in 1..=100000000",
+    );
+    rejected(
+        &VALID.replace("\"name\": \"t\"", "\"name\": 1e400"),
+        "name",
+        "expected a name of 1 to 100 letters",
+    );
+    // Whole numbers with an exponent are read as such.
+    let dir = scratch("exponent");
+    let file = dir.join("e.json");
+    fs::write(
+        &file,
+        VALID
+            .replace("[4, 16, 64]", "[4, 1.6e1, 64.0]")
+            .replace("\"seed\": 7", "\"seed\": 1e5"),
+    )
+    .expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("2 rule(s) x 3 budget(s)"), "{out}");
+    let _ = fs::remove_dir_all(&dir);
 }
 
 /// A missing field is named at its own path, not at the object that lacks
@@ -1726,26 +1867,85 @@ fn every_number_error_states_the_range_the_field_accepts() {
 /// `scene.ray`. Every required field of a valid file, dropped in turn.
 #[test]
 fn a_missing_field_is_named_at_its_own_path() {
+    // What each accepts, as the schema (`lightquad schema`) and the README
+    // say: a ray's points are 3 numbers, a sphere's radius and density are
+    // numbers, the tags name their variants.
     let required = [
-        ("\"origin\": [-3.0, 0.3, 0.0], ", "scene.ray.origin"),
-        (", \"direction\": [1.0, 0.0, 0.0]", "scene.ray.direction"),
-        ("\"type\": \"constant-sphere\", ", "scene.medium.type"),
-        (", \"radius\": 1.0", "scene.medium.radius"),
-        (", \"kappa\": 2.0", "scene.medium.kappa"),
-        (", \"c\": 1.0", "scene.emission.c"),
-        ("\"rule\": \"stratified\"", "rules[1].rule"),
-        ("\"quantities\": [\"tau\", \"I_E\"],", "quantities"),
-        ("\"type\": \"closed-form\"", "reference.type"),
+        (
+            "\"origin\": [-3.0, 0.3, 0.0], ",
+            "scene.ray.origin",
+            "expected a list of 3 numbers",
+        ),
+        (
+            ", \"direction\": [1.0, 0.0, 0.0]",
+            "scene.ray.direction",
+            "expected a list of 3 numbers",
+        ),
+        (
+            "\"type\": \"constant-sphere\", ",
+            "scene.medium.type",
+            "expected one of `constant-sphere`, `gaussian-blobs`, `linear-gradient`, `voxel-grid`",
+        ),
+        (
+            ", \"radius\": 1.0",
+            "scene.medium.radius",
+            "expected a number (radius)",
+        ),
+        (
+            ", \"kappa\": 2.0",
+            "scene.medium.kappa",
+            "expected a number (density)",
+        ),
+        (
+            ", \"c\": 1.0",
+            "scene.emission.c",
+            "expected a number (the constant)",
+        ),
+        (
+            "\"rule\": \"stratified\"",
+            "rules[1].rule",
+            "expected one of trapezoid, simpson, gauss-legendre",
+        ),
+        (
+            "\"quantities\": [\"tau\", \"I_E\"],",
+            "quantities",
+            "expected a list, each one of `tau`, `ln_tau`, `I_E`, `I_B`, `I_L`, `I`",
+        ),
+        (
+            "\"type\": \"closed-form\"",
+            "reference.type",
+            "expected one of `closed-form`, `value`, `mitsuba`, `converged`",
+        ),
+        (
+            "\"name\": \"t\",",
+            "name",
+            "expected a string (short name (file-name safe",
+        ),
     ];
-    for (cut, path) in required {
+    for (cut, path, expected) in required {
         assert!(VALID.contains(cut), "{cut}");
         let field = path.rsplit('.').next().expect("field");
+        let field = field.split('[').next().expect("name");
         rejected(
             &VALID.replace(cut, ""),
             path,
-            &format!("the required field `{field}` is missing"),
+            &format!("the required field `{field}` is missing: {expected}"),
         );
     }
+    // Inside a list, the variant the file names.
+    rejected(
+        &VALID.replace(
+            "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
+            "{ \"type\": \"gaussian-blobs\", \"blobs\": [{ \"centre\": [0, 0, 0], \"width\": 1.0 }] }",
+        ),
+        "scene.medium.blobs[0].amplitude",
+        "the required field `amplitude` is missing: expected a number (peak density)",
+    );
+    rejected(
+        &VALID.replace("[4, 16, 64]", "{ \"from\": 4, \"factor\": 2 }"),
+        "budgets.to",
+        "the required field `to` is missing: expected a whole number in 1..=100000000",
+    );
     rejected(
         &VALID.replace(
             "\"ray\": { \"origin\": [-3.0, 0.3, 0.0], \"direction\": [1.0, 0.0, 0.0] },",
@@ -1919,7 +2119,33 @@ fn file_system_faults_name_the_path_and_the_reason() {
     let msg = check(&file);
     assert!(
         msg.contains("at `reference.file`")
-            && msg.contains("other.json (not a Mitsuba values file: it has no `experiment_hash` and `quantities`")
+            && msg.contains("other.json: not a Mitsuba values file: it has no `experiment_hash` and `quantities`")
+            && !msg.contains("stale"),
+        "{msg}"
+    );
+    // Named like a bundled experiment whose (bundled) values were made from
+    // another file: the named file is still the fault, not those values'
+    // staleness (the hostile review of issue 10).
+    let bundled = VALID
+        .replace("\"name\": \"t\"", "\"name\": \"v-tau-stiff-sphere\"")
+        .replace(
+            "{ \"type\": \"closed-form\" }",
+            "{ \"type\": \"mitsuba\", \"file\": \"other.json\" }",
+        );
+    fs::write(&file, &bundled).expect("write");
+    let msg = check(&file);
+    assert!(
+        msg.contains("at `reference.file`")
+            && msg.contains("other.json: not a Mitsuba values file: it has no `experiment_hash` and `quantities`")
+            && !msg.contains("stale"),
+        "{msg}"
+    );
+    // Not JSON at all: said, with what a values file is.
+    fs::write(dir.join("other.json"), "x,y\n1,2\n").expect("write");
+    let msg = check(&file);
+    assert!(
+        msg.contains("other.json is not a Mitsuba values file (not JSON: ")
+            && msg.contains("expected the JSON file scripts/reference.sh writes")
             && !msg.contains("stale"),
         "{msg}"
     );
@@ -2016,4 +2242,78 @@ fn a_sphere_of_radius_1e308_with_a_converged_reference_runs_in_seconds() {
         "1e308: expected a radius in [1e-150, 1e150] where the printed light formulas",
     );
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// A table whose rows count more evaluations than their budget says why,
+/// in the Markdown and the HTML page (the hostile review of issue 10: V-E
+/// with Gauss–Legendre showed about 50 n evaluations unexplained). The
+/// independent facts: V-E's outer nodes walk the cumulative depth (about
+/// 12 lookups each), and Gauss–Legendre's estimate evaluates 3.5 n; the
+/// trapezoid on tau alone evaluates exactly its n nodes on the one smooth
+/// piece, so a table of those rows has no such line.
+#[test]
+fn evaluations_above_the_budget_are_explained_in_the_report() {
+    let (dir, out, o) = run_text(
+        "over-budget",
+        &VALID.replace(
+            "[ { \"rule\": \"gauss-legendre\" }, { \"rule\": \"stratified\" } ]",
+            "[ { \"rule\": \"gauss-legendre\" }, { \"rule\": \"trapezoid\" } ]",
+        ),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = fs::read_to_string(out.join("t/report.md")).expect("report");
+    let html = fs::read_to_string(out.join("t/index.html")).expect("html");
+    let tau = md.split("## tau").nth(1).expect("tau section");
+    let tau = tau.split("## ").next().expect("tau alone");
+    let emission = md.split("## I_E").nth(1).expect("I_E section");
+    // The rows themselves: I_E's Gauss–Legendre rows above n, tau's
+    // trapezoid rows at n.
+    let evaluations = |section: &str, rule: &str, n: usize| -> f64 {
+        let line = section
+            .lines()
+            .find(|l| l.starts_with(&format!("| {rule} | {n} |")))
+            .unwrap_or_else(|| panic!("no {rule} row at {n}"));
+        line.split('|')
+            .nth(6)
+            .expect("cell")
+            .trim()
+            .parse()
+            .expect("a number")
+    };
+    assert!(evaluations(emission, "gauss-legendre", 64) > 3.5 * 64.0);
+    assert!(evaluations(tau, "trapezoid", 64) <= 64.0);
+    let line = "Evaluations above n (up to ";
+    let why = "the cumulative optical depth";
+    let gl = "Gauss–Legendre's error estimate evaluates three companion rules";
+    let said = emission
+        .lines()
+        .find(|l| l.starts_with(line))
+        .expect("I_E explained");
+    assert!(said.contains(why) && said.contains(gl), "{said}");
+    assert!(
+        html.contains(line) && html.contains(why),
+        "no line in the HTML page"
+    );
+    // Tau's table has Gauss–Legendre's error estimate (3.5 n) but no depth
+    // walks; the line is there, and says the same.
+    assert!(tau.contains(line), "{tau}");
+    // A trapezoid-only tau experiment has no rows above n: no line.
+    let (dir2, out2, o) = run_text(
+        "at-budget",
+        &VALID
+            .replace(
+                "\"quantities\": [\"tau\", \"I_E\"]",
+                "\"quantities\": [\"tau\"]",
+            )
+            .replace(
+                "[ { \"rule\": \"gauss-legendre\" }, { \"rule\": \"stratified\" } ]",
+                "[ { \"rule\": \"trapezoid\" } ]",
+            ),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let md = fs::read_to_string(out2.join("t/report.md")).expect("report");
+    let html = fs::read_to_string(out2.join("t/index.html")).expect("html");
+    assert!(!md.contains(line) && !html.contains(line), "{md}");
+    let _ = fs::remove_dir_all(&dir);
+    let _ = fs::remove_dir_all(&dir2);
 }

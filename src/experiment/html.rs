@@ -486,6 +486,9 @@ fn section(page: &Page, s: &Section) -> String {
          Estimated error: the rule's own, mean over repeats, same scale (a standard error for random rules). \
          Highlighted rows carry a flag that questions the row; greyed rows are at the reference's accuracy.</p>"
     );
+    if let Some(line) = super::report::over_budget(page, &s.rows) {
+        let _ = writeln!(b, "<p class=\"note\">{}</p>", escape(&line));
+    }
     b
 }
 

@@ -31,6 +31,7 @@
 //! # Ok::<(), lightquad::error::SpecError>(())
 //! ```
 
+pub mod expected;
 pub mod fit;
 pub mod html;
 pub mod markdown;
@@ -139,10 +140,10 @@ fn load_bytes(
         file: file.clone(),
         source,
     };
-    let json = validate::parse_json(text).map_err(spec_error)?;
-    registry
-        .load_from(json, &file_hash(bytes), source.origin())
-        .map_err(spec_error)
+    validate::parse_and_load(text, |json| {
+        registry.load_from(json, &file_hash(bytes), source.origin())
+    })
+    .map_err(spec_error)
 }
 
 /// An experiment with the bytes it was loaded from.

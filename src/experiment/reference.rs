@@ -119,6 +119,9 @@ pub fn known_values<F: Family>(
                     location,
                     made_from,
                 } => return Err(stale_values(&location, &made_from, hash)),
+                Values::NotValues { location, why } => {
+                    return Err(SpecError::at(at, not_values(&location, &why)));
+                }
                 Values::Missing { looked } => {
                     return Err(SpecError::at(
                         at,
@@ -206,6 +209,21 @@ pub fn mitsuba_values<Q: Quantity>(
         return Err(stale_values(path, made_from, hash));
     }
     values_from_json(path, &json, quantities)
+}
+
+/// Why the file a Mitsuba reference names is not a values file, with what
+/// a values file is.
+fn not_values(location: &str, why: &str) -> String {
+    if !why.starts_with("not JSON") {
+        // Not a values file, or not a regular file: said with what is expected.
+        format!("{location}: {why}")
+    } else {
+        format!(
+            "{location} is not a Mitsuba values file ({why}): expected the JSON file \
+             scripts/reference.sh writes, with `experiment_hash`, a string, and `quantities`, an \
+             object of values"
+        )
+    }
 }
 
 fn stale_values(path: &str, made_from: &str, hash: &str) -> SpecError {
@@ -551,6 +569,9 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
                 exp.hash
             )),
         ),
+        Values::NotValues { location, why } => {
+            (serde_json::Value::Null, Some(not_values(&location, &why)))
+        }
         Values::Missing { looked } => (
             serde_json::Value::Null,
             Some(format!(

@@ -171,6 +171,7 @@ fn page<'a, F: Family>(
         equations: &spec.equations,
         budgets: &exp.budgets,
         budget_unit: F::BUDGET_UNIT,
+        over_budget: F::OVER_BUDGET,
         repeats: spec.repeats,
         seed: spec.seed,
         settings: F::settings(&spec.scene),

@@ -62,6 +62,9 @@ pub struct Page<'a> {
     pub budgets: &'a [usize],
     /// What a budget counts.
     pub budget_unit: &'static str,
+    /// Why a row may count more evaluations than its budget
+    /// ([`Family::OVER_BUDGET`](crate::family::Family::OVER_BUDGET)).
+    pub over_budget: &'static str,
     /// Repeats per (rule, budget).
     pub repeats: usize,
     /// The file's seed.
@@ -641,6 +644,9 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
             "## {q} (reference {reference})\n\n{}",
             table(page, &s.rows)
         );
+        if let Some(line) = over_budget(page, &s.rows) {
+            let _ = writeln!(md, "{line}");
+        }
         let _ = writeln!(
             md,
             "\n| rule | {} | fitted slope vs log evaluations (the cost) | {} |\n|---|---:|---:|{}",
@@ -767,6 +773,21 @@ fn table(page: &Page, rows: &[Row]) -> String {
         );
     }
     md
+}
+
+/// A line saying why evaluations exceed the budget, where a row's do (its
+/// mean evaluations above its n), naming the largest ratio; `None` where no
+/// row's do.
+pub fn over_budget(page: &Page, rows: &[Row]) -> Option<String> {
+    let worst = rows
+        .iter()
+        .filter(|r| r.budget > 0 && r.evaluations > r.budget as f64)
+        .map(|r| r.evaluations / r.budget as f64)
+        .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))))?;
+    Some(format!(
+        "Evaluations above n (up to {worst:.1} n in this table): {}.",
+        page.over_budget
+    ))
 }
 
 /// The label of rule `i` of the page.

@@ -146,6 +146,15 @@ pub enum Values {
         /// The hash they were made from.
         made_from: String,
     },
+    /// The file the reference names exists but is not a values file (another
+    /// JSON file, not JSON, a folder): said as such, not reported stale
+    /// because other values were found elsewhere.
+    NotValues {
+        /// The file.
+        location: String,
+        /// What it is instead.
+        why: String,
+    },
     /// Expected (the experiment names a values file, or is one of the bundled
     /// experiments with Mitsuba values) but found nowhere.
     Missing {
@@ -165,10 +174,18 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
     if let Origin::Folder(dir) = origin {
         if let Some(file) = named {
             let path = resolve(dir, file);
-            places.push((
-                path.display().to_string(),
-                read_text(&path).and_then(|t| values_json(&t)),
-            ));
+            let json = read_text(&path).and_then(|t| values_json(&t));
+            // A file that is there but is no values file is the fault, even
+            // where other (stale) values are found.
+            if let Err(why) = &json
+                && path.exists()
+            {
+                return Values::NotValues {
+                    location: path.display().to_string(),
+                    why: why.clone(),
+                };
+            }
+            places.push((path.display().to_string(), json));
         }
         let path = dir
             .join("..")

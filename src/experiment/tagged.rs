@@ -287,6 +287,22 @@ where
         fn visit_u64<E: Error>(self, x: u64) -> Result<T, E> {
             self.take(x.into(), serde::de::Unexpected::Unsigned(x))
         }
+        /// JSON has one kind of number: `1e5` is the whole number 100000
+        /// (as JSON Schema's `integer` says), read where f64 holds it
+        /// exactly; a larger one (`1e21`, or 1000000000000000000000, which
+        /// the JSON reader gives as a float) is out of the range, not of
+        /// the wrong kind.
+        fn visit_f64<E: Error>(self, x: f64) -> Result<T, E> {
+            const EXACT: f64 = 9_007_199_254_740_992.0; // 2^53
+            let got = serde::de::Unexpected::Float(x);
+            if x.fract() != 0.0 || !x.is_finite() {
+                Err(E::invalid_type(got, &self))
+            } else if x.abs() <= EXACT {
+                self.take(x as i128, got)
+            } else {
+                Err(E::invalid_value(got, &self))
+            }
+        }
     }
     d.deserialize_any(Whole {
         lo,

@@ -60,10 +60,115 @@ pub struct Experiment<F: Family> {
 /// format is checked by [`deserialize`]); a syntax error names the JSON path
 /// it is in, and its line and column.
 pub fn parse_json(text: &str) -> Result<serde_json::Value, SpecError> {
+    parse_raw(text).map_err(|(path, e)| error_at(&path, &e))
+}
+
+/// [`parse_json`] with the JSON path and serde's error as they are.
+fn parse_raw(text: &str) -> Result<serde_json::Value, (String, serde_json::Error)> {
     let de = &mut serde_json::Deserializer::from_str(text);
-    let Strict(json) = serde_path_to_error::deserialize(&mut *de).map_err(path_error)?;
-    de.end().map_err(|e| SpecError::at(".", e.to_string()))?;
+    let Strict(json) = serde_path_to_error::deserialize(&mut *de)
+        .map_err(|e| (e.path().to_string(), e.into_inner()))?;
+    de.end().map_err(|e| (".".to_string(), e))?;
     Ok(json)
+}
+
+/// Marks a number beyond the f64 range, put in its place as a string by
+/// [`parse_and_load`] so that the field's own reader says what it accepts.
+const BEYOND_F64: &str = "lightquad-beyond-f64:";
+
+/// Parses `text` and hands the JSON to `load` (the family's reader and
+/// validation), with a number beyond the f64 range (`1e400`) named with the
+/// range its field accepts: the JSON reader refuses such a number before
+/// any field's reader sees it, and said only "expected a finite number" of
+/// `"repeats": 1e400` (a whole number in 1..=1000). Each such number is
+/// read as a marked string; the field's reader then refuses it, saying what
+/// it expects, and the message is rewritten to name the number.
+pub fn parse_and_load<T>(
+    text: &str,
+    load: impl FnOnce(serde_json::Value) -> Result<T, SpecError>,
+) -> Result<T, SpecError> {
+    let mut text = std::borrow::Cow::Borrowed(text);
+    // The first number beyond the range, as the reader reported it.
+    let mut first: Option<(SpecError, String, String)> = None;
+    let json = loop {
+        match parse_raw(&text) {
+            Ok(json) => break json,
+            Err((path, e)) => {
+                let beyond = e.to_string().starts_with("number out of range");
+                let at = (e.line(), e.column());
+                let error = error_at(&path, &e);
+                let Some((start, end)) = beyond.then(|| number_at(&text, at.0, at.1)).flatten()
+                else {
+                    return Err(first.map_or(error, |f| f.0));
+                };
+                let literal = text[start..end].to_string();
+                let place = format!("line {} column {}", at.0, at.1);
+                first.get_or_insert((error, literal.clone(), place));
+                text = std::borrow::Cow::Owned(format!(
+                    "{}\"{BEYOND_F64}{literal}\"{}",
+                    &text[..start],
+                    &text[end..]
+                ));
+            }
+        }
+    };
+    let Some((original, literal, place)) = first else {
+        return load(json);
+    };
+    match load(json) {
+        Err(e) if e.message.contains(BEYOND_F64) => {
+            let marked = format!("{BEYOND_F64}{literal}");
+            let after = e
+                .message
+                .find(&marked)
+                .map_or("", |i| &e.message[i + marked.len()..]);
+            // serde's "..., expected X", or a check's "\"...\" is not X".
+            let expected = after
+                .find("expected ")
+                .map(|i| after[i + "expected ".len()..].to_string())
+                .or_else(|| after.strip_prefix("\" is not ").map(str::to_string))
+                .filter(|x| !x.is_empty() && !x.contains(BEYOND_F64))
+                .map_or("a finite number".to_string(), |x| {
+                    if x == "a number" {
+                        "a finite number".to_string()
+                    } else {
+                        x
+                    }
+                });
+            Err(SpecError::at(
+                e.path,
+                format!(
+                    "{} ({place}) is beyond the f64 range (its magnitude is above 1.8e308): \
+                     expected {expected}",
+                    crate::error::shortened(literal)
+                ),
+            ))
+        }
+        // Another fault came first, or the field took the marked string.
+        _ => Err(original),
+    }
+}
+
+/// The byte range of the number that ends at (or spans) 1-based `line` and
+/// `column` of `text`, as serde_json reports the position of a number it
+/// cannot hold.
+fn number_at(text: &str, line: usize, column: usize) -> Option<(usize, usize)> {
+    let line_start = if line <= 1 {
+        0
+    } else {
+        text.match_indices('\n').nth(line - 2)?.0 + 1
+    };
+    let bytes = text.as_bytes();
+    let is_number = |b: u8| b.is_ascii_digit() || matches!(b, b'+' | b'-' | b'.' | b'e' | b'E');
+    let mut end = (line_start + column).min(bytes.len());
+    while end < bytes.len() && is_number(bytes[end]) {
+        end += 1;
+    }
+    let mut start = end;
+    while start > line_start && is_number(bytes[start - 1]) {
+        start -= 1;
+    }
+    (start < end).then_some((start, end))
 }
 
 /// A JSON value read with a key given twice in an object refused (serde_json
@@ -127,7 +232,13 @@ impl<'de> serde::de::Visitor<'de> for StrictVisitor {
 
 /// A serde error at its JSON path (`.` for the root).
 fn path_error<E: std::fmt::Display>(e: serde_path_to_error::Error<E>) -> SpecError {
-    let (path, message) = super::tagged::located(&e.path().to_string(), &e.inner().to_string());
+    error_at(&e.path().to_string(), e.inner())
+}
+
+/// A serde error `e` at JSON path `path` (`.` for the root), with a path
+/// below it that an inner reader named moved into the path.
+fn error_at(path: &str, e: &impl std::fmt::Display) -> SpecError {
+    let (path, message) = super::tagged::located(path, &e.to_string());
     let message = super::tagged::plain_words(&message);
     SpecError::at(if path.is_empty() { ".".into() } else { path }, message)
 }
@@ -135,7 +246,22 @@ fn path_error<E: std::fmt::Display>(e: serde_path_to_error::Error<E>) -> SpecErr
 /// Reads a parsed file as an experiment of family `F`, naming the JSON path
 /// of any fault.
 pub fn deserialize<F: Family>(json: serde_json::Value) -> Result<ExperimentSpec<F>, SpecError> {
-    serde_path_to_error::deserialize(json).map_err(path_error)
+    serde_path_to_error::deserialize(&json)
+        .map_err(path_error)
+        .map_err(|e| with_expected::<F>(e, &json))
+}
+
+/// A missing required field's error with what the field accepts, from the
+/// family's schema: serde names only the field ("the required field
+/// `radius` is missing").
+fn with_expected<F: Family>(mut e: SpecError, json: &serde_json::Value) -> SpecError {
+    if e.message.starts_with("the required field `") && !e.message.contains("expected") {
+        let schema = schemars::schema_for!(ExperimentSpec<F>).to_value();
+        if let Some(words) = super::expected::describe(&schema, json, &e.path) {
+            e.message = format!("{}: expected {words}", e.message);
+        }
+    }
+    e
 }
 
 /// Validates a parsed experiment whose file hashes to `hash`, as if its file

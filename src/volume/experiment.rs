@@ -397,6 +397,12 @@ impl family::Estimator for Tracker {
     }
 }
 
+/// Bytes a depth checkpoint of the cumulative scheme holds (`t` and its
+/// compensated depth, 24 bytes, in a B-tree's leaves of 11 slots that nodes
+/// visited in order leave about half full): 49 bytes an entry allocated at
+/// 2e5 trapezoid nodes (tests/memory_checkpoints.rs).
+pub const CHECKPOINT_BYTES: f64 = 48.0;
+
 /// The built scene with how it is evaluated.
 #[derive(Debug, Clone)]
 pub struct Built {
@@ -422,6 +428,15 @@ impl Family for Volume {
     const EQUATIONS: &'static [&'static str] = &["V-tau", "V-E", "V-B", "V-Lp", "V-L", "V-I"];
     const BUDGET_UNIT: &'static str =
         "nodes or samples per smooth piece of the ray (walks for tracking)";
+    const OVER_BUDGET: &'static str = "every density lookup counts as an evaluation, and the \
+        budget is per piece: n goes to each smooth piece of the ray, and V-E and V-L cut their \
+        pieces further at optical depths 1, 2, 4, ... (graded pieces); each outer node of V-E and \
+        V-L walks the cumulative optical depth from the nearest visited node with 6-point \
+        panels (about 12 lookups a node, 6 (2 + log2 n) for rules that visit nodes out of \
+        order), or integrates it again with the rule under the nested scheme (about n^2), and \
+        shadow rays by quadrature nest a rule too; Gauss–Legendre's error estimate evaluates \
+        three companion rules (about 3.5 n in all); a tracker's walk looks the density up at \
+        each tentative collision";
 
     type SceneSpec = SceneSpec;
     type Scene = Built;
@@ -437,19 +452,19 @@ impl Family for Volume {
             let mut alone = scene.clone();
             alone.lambda = 1.0;
             let (s1, d1) = alone.anchored().0.depth_bound();
-            let path = if s1.is_finite() && d1.is_finite() {
-                "scene.lambda"
-            } else {
-                "scene.medium"
-            };
+            if !(s1.is_finite() && d1.is_finite())
+                && let Some(medium) = &spec.medium
+            {
+                return Err(depth_fault(spec, medium, sigma, depth));
+            }
             return Err(SpecError::at(
-                path,
+                "scene.lambda",
                 format!(
-                    "the optical depth along the ray overflows f64 (lambda = {:e}; the largest \
-                     extinction lambda v is {sigma:e}, and times the chord it bounds the depth \
-                     by {depth:e}): expected a medium and a lambda whose optical depth along the \
-                     ray stays below 1.8e308",
-                    scene.lambda
+                    "{}: the optical depth along the ray overflows f64 (the largest extinction \
+                     lambda v is {sigma:e}, and times the chord it bounds the depth by {depth:e}), \
+                     while with lambda = 1 it is finite: expected a lambda >= 0 whose optical \
+                     depth along the ray stays below 1.8e308",
+                    crate::error::shortened(scene.lambda.to_string())
                 ),
             ));
         }
@@ -590,7 +605,11 @@ impl Family for Volume {
     }
 
     /// The rule's node table, and a second one of the same size under the
-    /// nested scheme (the inner optical depth's rule beside the outer one).
+    /// nested scheme (the inner optical depth's rule beside the outer one);
+    /// under the cumulative scheme, V-E and V-L also hold the depth
+    /// checkpoints of the graded piece being integrated: one entry per node
+    /// the outer rule visits (its evaluations, an error estimate's rules
+    /// included, and the piece's two ends), [`CHECKPOINT_BYTES`] each.
     fn memory(
         built: &Built,
         method: &Method<Tracker>,
@@ -603,11 +622,22 @@ impl Family for Volume {
         };
         let nested =
             built.scheme == DepthScheme::Nested || built.shadow == ShadowMethod::Quadrature;
-        let tables = match quantity {
-            Emission | Light | Total if nested => 2.0,
-            _ => 1.0,
+        let scene = &built.scene;
+        let emission = scene.emission.is_some();
+        let light = scene.light.is_some() && scene.medium.is_some();
+        let outer = match quantity {
+            Emission => emission,
+            Light => light,
+            Total => emission || light,
+            Tau | LnTau | Background => false,
         };
-        tables * crate::quadrature::Rule::memory(rule, budget, 1)
+        let tables = if outer && nested { 2.0 } else { 1.0 };
+        let checkpoints = if outer && built.scheme == DepthScheme::Cumulative {
+            CHECKPOINT_BYTES * (crate::quadrature::Rule::evaluations(rule, budget, 1) + 2.0)
+        } else {
+            0.0
+        };
+        tables * crate::quadrature::Rule::memory(rule, budget, 1) + checkpoints
     }
 
     /// Delta tracking estimates every term a renderer's walk scores
@@ -1034,6 +1064,214 @@ fn closed_form(built: &Built, q: VolumeQuantity) -> Option<f64> {
         VolumeQuantity::Light => light(),
         VolumeQuantity::Total => Some(emission()? + background + light()?),
     }
+}
+
+/// A field of a medium that scales its optical depth bound: its path below
+/// `scene.medium`, its value, and how to set it.
+type DepthField = (String, f64, Box<dyn Fn(&mut MediumSpec, f64)>);
+
+/// The fields whose size scales a medium's optical depth along a ray: the
+/// densities (kappa, amplitudes, base, gradient, the voxel grid's largest
+/// value) and the lengths (radius, widths).
+fn depth_fields(m: &MediumSpec) -> Vec<DepthField> {
+    let mut out: Vec<DepthField> = Vec::new();
+    match m {
+        MediumSpec::ConstantSphere(s) => {
+            out.push((
+                "kappa".into(),
+                s.kappa,
+                Box::new(|m, x| {
+                    if let MediumSpec::ConstantSphere(s) = m {
+                        s.kappa = x;
+                    }
+                }),
+            ));
+            out.push((
+                "radius".into(),
+                s.radius,
+                Box::new(|m, x| {
+                    if let MediumSpec::ConstantSphere(s) = m {
+                        s.radius = x;
+                    }
+                }),
+            ));
+        }
+        MediumSpec::GaussianBlobs(b) => {
+            for (i, blob) in b.blobs.iter().enumerate() {
+                out.push((
+                    format!("blobs[{i}].amplitude"),
+                    blob.amplitude,
+                    Box::new(move |m, x| {
+                        if let MediumSpec::GaussianBlobs(b) = m {
+                            b.blobs[i].amplitude = x;
+                        }
+                    }),
+                ));
+                out.push((
+                    format!("blobs[{i}].width"),
+                    blob.width,
+                    Box::new(move |m, x| {
+                        if let MediumSpec::GaussianBlobs(b) = m {
+                            b.blobs[i].width = x;
+                        }
+                    }),
+                ));
+            }
+        }
+        MediumSpec::LinearGradient(g) => {
+            out.push((
+                "radius".into(),
+                g.radius,
+                Box::new(|m, x| {
+                    if let MediumSpec::LinearGradient(g) = m {
+                        g.radius = x;
+                    }
+                }),
+            ));
+            out.push((
+                "base".into(),
+                g.base,
+                Box::new(|m, x| {
+                    if let MediumSpec::LinearGradient(g) = m {
+                        g.base = x;
+                    }
+                }),
+            ));
+            for k in 0..3 {
+                out.push((
+                    format!("gradient[{k}]"),
+                    g.gradient[k],
+                    Box::new(move |m, x| {
+                        if let MediumSpec::LinearGradient(g) = m {
+                            g.gradient[k] = x;
+                        }
+                    }),
+                ));
+            }
+        }
+        MediumSpec::VoxelGrid(v) => {
+            if let Some((i, &x)) = v
+                .data
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+            {
+                out.push((
+                    format!("data[{i}]"),
+                    x,
+                    Box::new(move |m, x| {
+                        if let MediumSpec::VoxelGrid(v) = m {
+                            v.data[i] = x;
+                        }
+                    }),
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// Whether the scene of `spec` fails to build or its optical depth bound
+/// along the ray is not finite.
+fn depth_overflows(spec: &SceneSpec) -> bool {
+    scene(spec).map_or(true, |s| {
+        let (sigma, depth) = s.anchored().0.depth_bound();
+        !(sigma.is_finite() && depth.is_finite())
+    })
+}
+
+/// `x` (> 0) rounded down to two significant digits, in scientific notation.
+fn two_digits_down(x: f64) -> String {
+    let e = x.log10().floor();
+    let mut m = (x / 10f64.powf(e) * 10.0).floor() / 10.0;
+    // The division can round a mantissa of 10 down to 9.99...
+    if m >= 10.0 {
+        m = 9.9;
+    }
+    format!("{m:.1}e{e}")
+}
+
+/// The error for a medium whose optical depth along the ray overflows f64
+/// with lambda = 1 (`sigma` and `depth` its bound as given), at the field
+/// that causes it: the one field of [`depth_fields`] that brings the bound
+/// below 1.8e308 alone when set to 1 (the most extreme of them, if several
+/// do), with the largest value it may take, the others as given, found by
+/// bisection. A medium no single field can repair is refused at its largest
+/// field, saying so.
+fn depth_fault(spec: &SceneSpec, medium: &MediumSpec, sigma: f64, depth: f64) -> SpecError {
+    let with = |set: &dyn Fn(&mut MediumSpec, f64), x: f64| {
+        let mut s = spec.clone();
+        if let Some(m) = s.medium.as_mut() {
+            set(m, x);
+        }
+        s
+    };
+    let fields: Vec<DepthField> = depth_fields(medium)
+        .into_iter()
+        .filter(|(_, x, _)| x.abs() > 1.0)
+        .collect();
+    let culprit = fields
+        .iter()
+        .filter(|(_, x, set)| !depth_overflows(&with(set.as_ref(), x.signum())))
+        .reduce(|a, b| if b.1.abs() > a.1.abs() { b } else { a });
+    let overflow = format!(
+        "the optical depth along the ray overflows f64 (lambda = {}; the largest extinction \
+         lambda v is {sigma:e}, and times the chord it bounds the depth by {depth:e})",
+        crate::error::shortened(spec.lambda.unwrap_or(1.0).to_string())
+    );
+    let Some((field, x, set)) = culprit else {
+        let Some((field, x, _)) = fields
+            .iter()
+            .reduce(|a, b| if b.1.abs() > a.1.abs() { b } else { a })
+        else {
+            return SpecError::at(
+                "scene.medium",
+                format!(
+                    "{overflow}: expected a medium whose optical depth along the ray stays \
+                     below 1.8e308"
+                ),
+            );
+        };
+        let others: Vec<String> = fields
+            .iter()
+            .filter(|(f, y, _)| f != field && y.abs() > 1.0)
+            .map(|(f, _, _)| format!("scene.medium.{f}"))
+            .collect();
+        return SpecError::at(
+            format!("scene.medium.{field}"),
+            format!(
+                "{}: {overflow}, and no value of this field alone brings it below 1.8e308: \
+                 expected smaller values here and at {}",
+                crate::error::shortened(x.to_string()),
+                others.join(", ")
+            ),
+        );
+    };
+    // The largest magnitude in [1, |x|] whose bound stays finite, bisected
+    // on the exponent.
+    let (mut lo, mut hi) = (0.0f64, x.abs().log2());
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if depth_overflows(&with(set.as_ref(), x.signum() * mid.exp2())) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let largest = two_digits_down(lo.exp2());
+    let range = if *x < 0.0 {
+        format!("at least -{largest}")
+    } else {
+        format!("at most {largest}")
+    };
+    SpecError::at(
+        format!("scene.medium.{field}"),
+        format!(
+            "{}: {overflow}: expected {field} {range} along this ray, with lambda and the \
+             medium's other fields as given (the optical depth must stay below 1.8e308)",
+            crate::error::shortened(x.to_string())
+        ),
+    )
 }
 
 fn vec3(v: [f64; 3]) -> Vec3 {
