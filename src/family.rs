@@ -79,6 +79,12 @@ pub trait Estimator:
     fn is_random(&self) -> bool;
     /// Every estimator with default parameters (for listings and names).
     fn all() -> Vec<Self>;
+    /// The resolution per axis that a budget of `n` buys in `dim`
+    /// dimensions, against which the reports fit the order per axis: `n`
+    /// for walks and samples, the points per axis for a grid.
+    fn resolution(&self, n: usize, _dim: usize) -> f64 {
+        n as f64
+    }
 }
 
 /// The estimators of a family that has none beyond the quadrature rules.
@@ -143,7 +149,7 @@ impl<E: Estimator> Method<E> {
     pub fn resolution(&self, n: usize, dim: usize) -> f64 {
         match self {
             Method::Rule(r) => r.resolution(n, dim),
-            Method::Estimator(_) => n as f64,
+            Method::Estimator(e) => e.resolution(n, dim),
         }
     }
 

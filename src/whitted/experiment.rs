@@ -402,6 +402,17 @@ impl family::Estimator for Scheme {
     fn is_random(&self) -> bool {
         false
     }
+    /// Points per axis: `floor(sqrt(n))` for the grid and the corners,
+    /// `2^levels` for the finest subdivision; the centre ray's budget buys
+    /// nothing (`n`, where its error does not move).
+    fn resolution(&self, n: usize, _dim: usize) -> f64 {
+        let side = ((n as f64).sqrt().floor()).max(1.0);
+        match self {
+            Scheme::Centre => n as f64,
+            Scheme::Grid | Scheme::Corner => side,
+            Scheme::Adaptive { .. } => f64::from(1u32 << levels(n)),
+        }
+    }
     fn all() -> Vec<Self> {
         vec![
             Scheme::Centre,
