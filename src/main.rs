@@ -221,9 +221,12 @@ fn run(command: Command) -> Result<(), Failure> {
             };
             let text = source.read()?;
             let json = experiment::validate::parse_json(&String::from_utf8_lossy(&text))?;
-            let (image, rays) =
+            let (image, rays, warnings) =
                 lightquad::whitted::experiment::render_spec(&json, width, height, samples)
                     .map_err(|e| format!("{}: {e}", source.display()))?;
+            for w in &warnings {
+                eprintln!("warning: {}: {w}", source.display());
+            }
             image.write_png(&png)?;
             if let Some(p) = &pfm {
                 image.write_pfm(p)?;

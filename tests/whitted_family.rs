@@ -536,3 +536,81 @@ fn extreme_numbers_anywhere_are_errors_not_panics() {
         }
     }
 }
+
+/// `lightquad render` refuses what it cannot do rather than hanging or
+/// writing undefined pixels, and says the warnings `check` says (the hostile
+/// probe of issue 12): `--samples` of `u64::MAX` overflowed the ray count to
+/// 0 and ran forever; a mirror sphere of radius 1e30 around the camera
+/// wrote 183 NaN pixels of 4800 (black in the PNG) with exit 0; an energy
+/// gain was warned of by `check` but not by `render`.
+#[test]
+fn render_refuses_endless_and_undefined_images_and_warns() {
+    let dir = scratch("render-refuses");
+    let png = dir.join("r.png");
+    let endless = bin()
+        .args(["render", "--width", "1", "--height", "1", "--samples"])
+        .arg(u64::MAX.to_string())
+        .arg("--png")
+        .arg(&png)
+        .output()
+        .expect("runs");
+    assert!(!endless.status.success() && !png.exists());
+    assert!(
+        stderr(&endless).contains("1.845e19 primary rays: expected at most 1e9"),
+        "{}",
+        stderr(&endless)
+    );
+
+    let mut scene: Value = serde_json::from_str(
+        &fs::read_to_string(root().join("experiments/w-grey-test-scene.json")).expect("read"),
+    )
+    .expect("json");
+    scene["scene"]["objects"][1]["radius"] = json!(1e30);
+    let huge = dir.join("huge.json");
+    fs::write(&huge, scene.to_string()).expect("write");
+    let undefined = bin()
+        .args([
+            "render",
+            "--width",
+            "80",
+            "--height",
+            "60",
+            "--samples",
+            "16",
+            "--png",
+        ])
+        .arg(&png)
+        .arg(&huge)
+        .output()
+        .expect("runs");
+    assert!(!undefined.status.success() && !png.exists());
+    assert!(
+        stderr(&undefined).contains("pixels came out undefined"),
+        "{}",
+        stderr(&undefined)
+    );
+
+    scene["scene"]["objects"][1]["radius"] = json!(0.8);
+    scene["scene"]["objects"][1]["material"]["k_d"] = json!(0.9);
+    scene["scene"]["objects"][1]["material"]["k_s"] = json!(0.6);
+    let gain = dir.join("gain.json");
+    fs::write(&gain, scene.to_string()).expect("write");
+    let warned = bin()
+        .args(["render", "--width", "4", "--height", "3", "--png"])
+        .arg(&png)
+        .arg(&gain)
+        .output()
+        .expect("runs");
+    assert!(
+        warned.status.success() && png.exists(),
+        "{}",
+        stderr(&warned)
+    );
+    assert!(
+        stderr(&warned).contains("warning:")
+            && stderr(&warned).contains("scene.objects[1].material"),
+        "{}",
+        stderr(&warned)
+    );
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -923,7 +923,7 @@ pub fn render_spec(
     width: Option<usize>,
     height: Option<usize>,
     samples: usize,
-) -> Result<(super::image::Image, RayCount), SpecError> {
+) -> Result<(super::image::Image, RayCount, Vec<SpecError>), SpecError> {
     if json.get("family").and_then(|f| f.as_str()) != Some(Whitted::NAME) {
         return Err(SpecError::at(
             "family",
@@ -943,13 +943,41 @@ pub fn render_spec(
     spec.pixel = None;
     let built = build(&spec)?;
     let side = ((samples.max(1) as f64).sqrt().floor() as usize).max(1);
+    // Refuse what would run for hours: the primary rays, each of which may
+    // spawn up to `max_depth` generations more.
+    let primary = (spec.camera.width as f64) * (spec.camera.height as f64) * (side as f64).powi(2);
+    if primary > MAX_RENDER_RAYS {
+        return Err(SpecError::at(
+            "samples",
+            format!(
+                "{} x {} pixels at {side} x {side} rays a pixel are {primary:.3e} primary rays: expected at most {MAX_RENDER_RAYS:e} (fewer --samples or a smaller --width, --height)",
+                spec.camera.width, spec.camera.height
+            ),
+        ));
+    }
     let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
     let out = render::render(&built.scene, &Render::Grid { n: side }, &mut rng)
         .map_err(|e| SpecError::from_quad("scene", e))?;
+    // A pixel that is not a number is a fault of the scene's numbers, never
+    // a silent black pixel in the PNG.
+    let undefined = out.image.values.iter().filter(|v| !v.all_finite()).count();
+    if undefined > 0 {
+        return Err(SpecError::at(
+            "scene",
+            format!(
+                "{undefined} of {} pixels came out undefined (NaN or infinite): the scene's coordinates or sizes are beyond what f64 resolves along these rays (an object of size 1e30 around the camera, an eye 1e16 from the scene); expected a scene whose extents and distances stay within about 1e12 of each other",
+                out.image.values.len()
+            ),
+        ));
+    }
     let image = super::image::Image::new(spec.camera.width, spec.camera.height, out.image.values)
         .map_err(|e| SpecError::from_quad("scene.camera", e))?;
-    Ok((image, out.rays))
+    Ok((image, out.rays, built.warnings))
 }
+
+/// The most primary rays `lightquad render` traces (about a minute on one
+/// core at the bundled test scene's cost per ray).
+pub const MAX_RENDER_RAYS: f64 = 1e9;
 
 /// The ray kinds the scene traces, in words.
 fn kinds(scene: &Scene) -> String {
