@@ -16,10 +16,9 @@
 
 use std::f64::consts::PI;
 use std::fs;
-use std::path::PathBuf;
 
 mod common;
-use common::{bin, scratch, stderr};
+use common::{bin, bundled, root, scratch, stderr};
 
 use lightquad::domain::Vec3;
 use lightquad::experiment::validate::{Experiment, deserialize, validate};
@@ -32,30 +31,6 @@ use serde_json::{Value, json};
 
 fn rel(a: f64, b: f64) -> f64 {
     ((a - b) / b).abs()
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The bundled experiments of the family, `(path, parsed)`.
-fn bundled() -> Vec<(PathBuf, Value)> {
-    let mut out: Vec<(PathBuf, Value)> = fs::read_dir(root().join("experiments"))
-        .expect("experiments/")
-        .filter_map(Result::ok)
-        .map(|f| f.path())
-        .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with("r-") && n.ends_with(".json"))
-        })
-        .map(|p| {
-            let v = serde_json::from_str(&fs::read_to_string(&p).expect("read")).expect("json");
-            (p, v)
-        })
-        .collect();
-    out.sort_by(|a, b| a.0.cmp(&b.0));
-    out
 }
 
 /// An experiment of the family from its JSON, validated.
@@ -179,7 +154,7 @@ fn v3(x: f64, y: f64, z: f64) -> Vec3 {
 /// the settings say whether visibility was evaluated.
 #[test]
 fn the_bundled_rendering_experiments_validate_run_and_report_every_quantity() {
-    let files = bundled();
+    let files = bundled("r-");
     assert!(files.len() >= 6, "{} bundled r-* experiments", files.len());
     let check = bin()
         .arg("check")
@@ -867,7 +842,7 @@ fn quantities_rules_and_references_a_scene_cannot_serve_are_refused() {
 #[test]
 fn extreme_numbers_anywhere_in_a_bundled_file_are_errors_not_panics() {
     let registry = lightquad::families::builtin();
-    for (path, spec) in bundled() {
+    for (path, spec) in bundled("r-") {
         let mut leaves = Vec::new();
         fn walk(v: &Value, at: String, out: &mut Vec<String>) {
             match v {

@@ -10,40 +10,15 @@
 //! JSON path, and the energy warning printed; extreme numbers never panic.
 
 use std::fs;
-use std::path::PathBuf;
 
 mod common;
-use common::{bin, fitted_order, scratch, stderr};
+use common::{bin, bundled, fitted_order, root, scratch, stderr};
 
 use lightquad::experiment::validate::{Experiment, deserialize, validate};
 use lightquad::family::{Family, Method};
 use lightquad::whitted::experiment::{Scheme, Whitted, WhittedQuantity as Q, evaluate_counted};
 use rand::SeedableRng;
 use serde_json::{Value, json};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The bundled experiments of the family, `(path, parsed)`.
-fn bundled() -> Vec<(PathBuf, Value)> {
-    let mut out: Vec<(PathBuf, Value)> = fs::read_dir(root().join("experiments"))
-        .expect("experiments/")
-        .filter_map(Result::ok)
-        .map(|f| f.path())
-        .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with("w-") && n.ends_with(".json"))
-        })
-        .map(|p| {
-            let v = serde_json::from_str(&fs::read_to_string(&p).expect("read")).expect("json");
-            (p, v)
-        })
-        .collect();
-    out.sort_by(|a, b| a.0.cmp(&b.0));
-    out
-}
 
 fn load(json: Value) -> Experiment<Whitted> {
     validate::<Whitted>(deserialize(json).expect("parses"), "hash").expect("valid")
@@ -81,7 +56,7 @@ fn by(exp: &Experiment<Whitted>, method: Value, budget: usize, q: Q, seed: u64) 
 
 #[test]
 fn the_bundled_whitted_experiments_validate_run_and_cover_every_equation() {
-    let files = bundled();
+    let files = bundled("w-");
     assert!(files.len() >= 4, "{} bundled w-* experiments", files.len());
     let check = bin()
         .arg("check")
@@ -498,7 +473,7 @@ fn bad_scenes_are_refused_with_the_path_and_what_is_accepted() {
 #[test]
 fn extreme_numbers_anywhere_are_errors_not_panics() {
     let registry = lightquad::families::builtin();
-    let mut specs: Vec<Value> = bundled().into_iter().map(|(_, v)| v).collect();
+    let mut specs: Vec<Value> = bundled("w-").into_iter().map(|(_, v)| v).collect();
     specs.push(serde_json::from_str(GOOD).expect("json"));
     for spec in specs {
         let mut leaves = Vec::new();

@@ -84,3 +84,30 @@ pub fn scratch(tag: &str) -> std::path::PathBuf {
 pub fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
 }
+
+/// The crate's root folder.
+pub fn root() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The bundled experiments whose file names start with `prefix` (`r-`,
+/// `w-`), `(path, parsed)`, sorted by path.
+pub fn bundled(prefix: &str) -> Vec<(std::path::PathBuf, Json)> {
+    let mut out: Vec<(std::path::PathBuf, Json)> = std::fs::read_dir(root().join("experiments"))
+        .expect("experiments/")
+        .filter_map(Result::ok)
+        .map(|f| f.path())
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with(prefix) && n.ends_with(".json"))
+        })
+        .map(|p| {
+            let v =
+                serde_json::from_str(&std::fs::read_to_string(&p).expect("read")).expect("json");
+            (p, v)
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
