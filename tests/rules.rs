@@ -618,6 +618,64 @@ fn every_channel_keeps_its_own_scale_from_1e_minus_300_to_1e308() {
     }
 }
 
+/// The rescaled second pass keeps the budget: integrands whose values lie
+/// below 2^-500 (squares underflow) or above 2^500 (sums overflow) are taken
+/// again scaled, and that pass replays the first's draws and values instead
+/// of evaluating again (the hostile probe of issue 9: stratified sampling
+/// made 510 evaluations at a budget of 255 on a Gaussian peak of width 1e-4
+/// that no sample reached, G7-K15 90 at 45, Sobol' 64 at 47). Counted
+/// calls: at most the rule's own promise (`Rule::evaluations`, the budget
+/// itself but for Gauss-Legendre's estimate), and exactly what the estimate
+/// reports. Values against closed forms: `int_0^1 1e-200 (1 + u) du =
+/// 1.5e-200` and `int 1e300 (1 + u) = 1.5e300`, covered by the estimate.
+#[test]
+fn a_rescaled_second_pass_stays_within_the_budget() {
+    use std::cell::Cell;
+    type Case = (&'static str, fn(f64) -> f64, f64);
+    let cases: [Case; 3] = [
+        ("tiny", |u| 1e-200 * (1.0 + u), 1.5e-200),
+        ("huge", |u| 1e300 * (1.0 + u), 1.5e300),
+        // A Gaussian of width 1e-4 at 0, int = 1e-4 sqrt(pi)/2.
+        (
+            "peak",
+            |u| (-(u / 1e-4).powi(2)).exp(),
+            8.862_269_254_527_58e-5,
+        ),
+    ];
+    for rule in every_rule() {
+        let name = rule.label();
+        for (case, f, exact) in cases {
+            for n in [15usize, 45, 47, 95, 255, 1000] {
+                let calls = Cell::new(0u64);
+                let Ok(e) = rule.integrate::<1, f64, _, _>(n, &mut rng(n as u64), |u| {
+                    calls.set(calls.get() + 1);
+                    f(u[0])
+                }) else {
+                    continue;
+                };
+                let promise = (n as f64).max(rule.evaluations(n, 1)) as u64;
+                assert!(
+                    calls.get() <= promise && e.evaluations == calls.get(),
+                    "{name} {case} n = {n}: {} calls, {} reported, promise {promise}",
+                    calls.get(),
+                    e.evaluations
+                );
+                // The peak's nodes and samples read its tail at 1e-50 or 0:
+                // no rule can see a peak 1e45 times higher between them (the
+                // honesty battery's blind spot), so it is held to the budget
+                // only; the others to their value as well.
+                let off = (e.value - exact).abs();
+                assert!(
+                    case == "peak" || !e.reliable || off <= 10.0 * e.error.max(1e-15 * exact),
+                    "{name} {case} n = {n}: {:e} +- {:e}, exact {exact:e}",
+                    e.value,
+                    e.error
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn budgets_beyond_two_to_the_forty_are_refused_at_once() {
     // n = usize::MAX used to loop for centuries (the trapezoid) or wrap.

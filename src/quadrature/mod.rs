@@ -42,6 +42,7 @@
 
 pub mod nodes;
 pub mod product;
+mod replay;
 
 pub use product::Product;
 
@@ -127,7 +128,9 @@ pub trait Rule {
     /// lists); 0 for rules whose memory does not grow (Monte Carlo draws a
     /// sample at a time). An estimate from measured peak resident memory,
     /// so that a budget that would exhaust the machine is refused before it
-    /// runs (Gauss–Legendre at 1e8 nodes held 5.5 GB).
+    /// runs (Gauss–Legendre at 1e8 nodes held 5.5 GB). Not counted: the
+    /// replay logs of [`Rule::try_integrate`], at most 2 MiB per integral
+    /// under way.
     fn memory(&self, _n: usize, _dim: usize) -> f64 {
         0.0
     }
@@ -162,12 +165,26 @@ pub trait Rule {
 
     /// Estimates `int_{[0,1]^D} f(u) du` with a budget of about `n` evaluations,
     /// for an integrand that may fail: its first error stops the rule and is
-    /// returned as is. `n` above [`MAX_BUDGET`] is an error. A rule's sums,
-    /// differences and squares of finite values near the top of the f64 range
-    /// can overflow into an infinite or NaN estimate; then the integral is taken again of `f 2^-e`, with `2^e` the
-    /// largest `|f|` seen (an exact scaling), and scaled back. An estimate that
-    /// is still not finite is an error ([`QuadError::Overflow`]), never a
-    /// silent NaN. The second pass's evaluations are counted.
+    /// returned as is. `n` above [`MAX_BUDGET`] is an error.
+    ///
+    /// A rule's sums, differences and squares of values beyond `2^500` can
+    /// overflow into an infinite or NaN estimate, and squares of values below
+    /// `2^-500` underflow into a standard error of 0. So a pass stops at the
+    /// first value beyond `2^500` and the integral is taken again of
+    /// `f 2^-1023` in that channel (every finite value is then below 2), and
+    /// a channel whose values all lie below `2^-500` and whose error came out
+    /// 0 is taken again of `f 2^-e`, `2^e` its largest `|f|`: exact scalings,
+    /// undone on the estimate. An estimate that is still not finite is an
+    /// error ([`QuadError::Overflow`]), never a silent NaN.
+    ///
+    /// Passes after the first keep the budget: they replay the draws and
+    /// values logged so far (module `replay`, at most 1 MiB each) and
+    /// evaluate `f` only where the log ends or an adaptive rule, deciding on
+    /// scaled values, takes another path; every evaluation is counted, and
+    /// never more than the rule's own promise ([`Rule::evaluations`]) in all.
+    /// A pass that would go past it is abandoned: an estimate with an
+    /// underflowed error is then returned doubted, and an overflowed integral
+    /// is an error ([`QuadError::RescaleOverBudget`]).
     fn try_integrate<
         const D: usize,
         V: Value,
@@ -186,57 +203,111 @@ pub trait Rule {
                 format!("a budget of at most 2^40 = {MAX_BUDGET} evaluations"),
             ));
         }
-        // The largest |f| seen, per channel.
+        let promise = (n as u64).max(self.evaluations(n, D) as u64);
+        let mut points = replay::Log::<([f64; D], V)>::new();
+        let mut draws = replay::Log::<replay::Draw>::new();
+        // Evaluations of `f` so far, the largest |f| seen per channel, and
+        // the scaling exponent per channel.
+        let mut fresh = 0u64;
         let mut largest = V::zero();
-        let first = self.integrate_unguarded(n, rng, |u| {
-            let y = f(u)?;
-            largest = largest.zip(y, |l, y| l.max(y.abs()));
-            Ok(y)
-        })?;
-        // An infinite error is a rule's "no estimate", unless the values are
-        // large enough for its squares to have overflowed (a Monte Carlo
-        // standard error of values near 1e308).
-        let overflowed_error = (0..V::CHANNELS)
-            .any(|c| largest.channel(c) > HUGE && first.error.channel(c).is_infinite());
-        // Values below 2^-500 have squares that underflow: a random rule's
-        // standard error of an integrand near 1e-300 came out as 0. Only
-        // that symptom (a tiny channel with an error of exactly 0) pays a
-        // second pass; tiny values with a sound error (a deterministic
-        // rule's differences, deep in a stiff medium) do not.
-        let tiny = (0..V::CHANNELS).any(|c| {
-            largest.channel(c) > 0.0 && largest.channel(c) < TINY && first.error.channel(c) == 0.0
-        });
-        if sound(&first) && !overflowed_error && !tiny {
-            return Ok(first);
-        }
-        // Per channel, 2^e >= the largest |f|, so every scaled value is at
-        // most 1 in size, and a tiny channel's at least 1/2; channels
-        // between TINY and 1 keep e = 0 (scaling all channels by the largest
-        // one's 2^-e flushed a channel of 2.2e-308 beside one of 1.7e308 to
-        // 0, with an error of 0).
-        let e = largest.map(|l| {
-            if l > 0.0 && l < TINY {
-                l.log2().ceil().max(-1074.0)
-            } else {
-                l.log2().ceil().clamp(0.0, 1023.0)
+        let mut e = V::zero();
+        // The last complete estimate whose error underflowed, kept in case
+        // its rescaled pass cannot keep the budget.
+        let mut underflowed: Option<Estimate<V>> = None;
+        let mut passes = 0;
+        loop {
+            passes += 1;
+            points.rewind();
+            draws.rewind();
+            let scaled = (0..V::CHANNELS).any(|c| e.channel(c) != 0.0);
+            let (mut huge, mut over_budget) = (false, false);
+            let pass = self.integrate_unguarded(
+                n,
+                &mut replay::LoggedRng {
+                    inner: rng,
+                    log: &mut draws,
+                },
+                |u| {
+                    let y = match points.replay(|(p, _)| replay::bits(*p) == replay::bits(u)) {
+                        Some((_, y)) => y,
+                        None if fresh < promise => {
+                            fresh += 1;
+                            let y = f(u)?;
+                            points.append((u, y));
+                            y
+                        }
+                        None => {
+                            over_budget = true;
+                            return Err(QuadError::invalid("n", n, "(past the budget)"));
+                        }
+                    };
+                    largest = largest.zip(y, |l, y| l.max(y.abs()));
+                    // A channel beyond 2^500 not yet scaled: stop, and start
+                    // again scaled.
+                    if (0..V::CHANNELS).any(|c| e.channel(c) == 0.0 && y.channel(c).abs() > HUGE) {
+                        huge = true;
+                        return Err(QuadError::invalid("f", "> 2^500", "(scaled next)"));
+                    }
+                    Ok(if scaled {
+                        y.zip(e, |y, e| times_pow2(y, -e))
+                    } else {
+                        y
+                    })
+                },
+            );
+            if huge {
+                e = e.zip(largest, |e, l| if l > HUGE { 1023.0 } else { e });
+                continue;
             }
-        });
-        let second =
-            self.integrate_unguarded(n, rng, |u| Ok(f(u)?.zip(e, |y, e| times_pow2(y, -e))))?;
-        let scaled = Estimate {
-            value: second.value.zip(e, times_pow2),
-            error: second.error.zip(e, times_pow2),
-            evaluations: first.evaluations + second.evaluations,
-            ..second
-        };
-        if sound(&scaled) {
-            Ok(scaled)
-        } else {
-            Err(QuadError::Overflow {
-                rule: self.name(),
-                value: format!("{:?}", second.value),
-                exponent: e.max_abs() as i32,
-            })
+            if over_budget {
+                return match underflowed {
+                    Some(estimate) => Ok(Estimate {
+                        evaluations: fresh,
+                        ..estimate.doubted()
+                    }),
+                    None => Err(QuadError::RescaleOverBudget {
+                        rule: self.name(),
+                        budget: n,
+                        exponent: e.max_abs() as i32,
+                    }),
+                };
+            }
+            let pass = pass?;
+            let estimate = Estimate {
+                value: pass.value.zip(e, times_pow2),
+                error: pass.error.zip(e, times_pow2),
+                // One pass counts as the rule counts; several as `f` was called.
+                evaluations: if passes == 1 { pass.evaluations } else { fresh },
+                ..pass
+            };
+            // A channel below 2^-500 with an error of exactly 0, not yet
+            // scaled: its squares underflowed (a random rule's standard error
+            // of an integrand near 1e-300 came out 0). Tiny values with a
+            // sound error (a deterministic rule's differences, deep in a
+            // stiff medium) are left as they are.
+            let tiny = V::from_fn(|c| {
+                let l = largest.channel(c);
+                let untouched = e.channel(c) == 0.0;
+                if untouched && l > 0.0 && l < TINY && estimate.error.channel(c) == 0.0 {
+                    l.log2().ceil().max(-1074.0)
+                } else {
+                    0.0
+                }
+            });
+            if underflowed.is_none() && (0..V::CHANNELS).any(|c| tiny.channel(c) != 0.0) {
+                e = e.zip(tiny, |e, t| e + t);
+                underflowed = Some(estimate);
+                continue;
+            }
+            return if sound(&estimate) {
+                Ok(estimate)
+            } else {
+                Err(QuadError::Overflow {
+                    rule: self.name(),
+                    value: format!("{:?}", pass.value),
+                    exponent: e.max_abs() as i32,
+                })
+            };
         }
     }
 

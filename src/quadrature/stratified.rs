@@ -143,8 +143,6 @@ impl Rule for Stratified {
                     let d = a.channel(k) - 2.0 * b.channel(k) + c.channel(k);
                     // A row's end cells: the first difference too, which
                     // sees a value growing toward the boundary.
-                    // A row's end cells: the first difference too, which
-                    // sees a value growing toward the boundary.
                     let first = if pos == 2 { (a.channel(k) - b.channel(k)).abs() } else { 0.0 };
                     let last = if pos == m - 1 { (c.channel(k) - b.channel(k)).abs() } else { 0.0 };
                     let end = first.max(last).powi(2);
