@@ -423,3 +423,40 @@ fn on_a_smooth_pixel_the_grid_and_jittered_go_as_n_to_the_minus_one_sobol_faster
     assert!((oj + 1.0).abs() < 0.1, "jittered {oj}");
     assert!((os + 1.5).abs() < 0.2, "sobol {os}");
 }
+
+/// The parallel render (bands of rows on rayon's threads) is the serial
+/// render: the bundled test scene at 40 x 30 by W-SS's 3 x 3 grid gives the
+/// same pixels, bit for bit, and the same rays by kind as `render`; a random
+/// rule's image is the same on one thread and on three (each band draws from
+/// its own seeded generator).
+#[test]
+fn the_parallel_render_is_the_serial_render() {
+    use lightquad::quadrature::AnyRule;
+    use lightquad::whitted::experiment::scene_of;
+    use lightquad::whitted::render::render_parallel;
+    let text = std::fs::read_to_string(common::root().join("experiments/w-grey-test-scene.json"))
+        .expect("bundled scene");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let scene = scene_of(&json, Some(40), Some(30)).expect("scene").scene;
+    let grid = Scheme::Grid { n: 3 };
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+    let serial = render(&scene, &grid, &mut rng).expect("serial");
+    let parallel = render_parallel(&scene, &grid, 0).expect("parallel");
+    assert_eq!(serial.rays, parallel.rays);
+    assert!(serial.rays.shadow > 0 && serial.rays.reflection > 0 && serial.rays.refraction > 0);
+    assert_eq!(serial.image.values, parallel.image.values);
+    let rule = Scheme::Rule {
+        rule: AnyRule::by_name("stratified").expect("rule"),
+        n: 4,
+    };
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+            .install(|| render_parallel(&scene, &rule, 7).expect("render"))
+    };
+    let (one, three) = (on(1), on(3));
+    assert_eq!(one.image.values, three.image.values);
+    assert_eq!(one.rays, three.rays);
+}

@@ -930,33 +930,21 @@ pub fn render_spec(
             "expected a `whitted` experiment file (\"family\": \"whitted\")",
         ));
     }
-    let scene = json
-        .get("scene")
-        .cloned()
-        .ok_or_else(|| SpecError::at("scene", "the required field `scene` is missing"))?;
-    let mut spec: SceneSpec = serde_path_to_error::deserialize(scene).map_err(|e| {
-        let (path, message) = tagged::located(&e.path().to_string(), &e.inner().to_string());
-        SpecError::at(format!("scene.{path}"), message)
-    })?;
-    spec.camera.width = width.unwrap_or(spec.camera.width);
-    spec.camera.height = height.unwrap_or(spec.camera.height);
-    spec.pixel = None;
-    let built = build(&spec)?;
+    let built = scene_of(json, width, height)?;
+    let (spec_width, spec_height) = (built.scene.camera.width(), built.scene.camera.height());
     let side = ((samples.max(1) as f64).sqrt().floor() as usize).max(1);
     // Refuse what would run for hours: the primary rays, each of which may
     // spawn up to `max_depth` generations more.
-    let primary = (spec.camera.width as f64) * (spec.camera.height as f64) * (side as f64).powi(2);
+    let primary = (spec_width as f64) * (spec_height as f64) * (side as f64).powi(2);
     if primary > MAX_RENDER_RAYS {
         return Err(SpecError::at(
             "samples",
             format!(
-                "{} x {} pixels at {side} x {side} rays a pixel are {primary:.3e} primary rays: expected at most {MAX_RENDER_RAYS:e} (fewer --samples or a smaller --width, --height)",
-                spec.camera.width, spec.camera.height
+                "{spec_width} x {spec_height} pixels at {side} x {side} rays a pixel are {primary:.3e} primary rays: expected at most {MAX_RENDER_RAYS:e} (fewer --samples or a smaller --width, --height)"
             ),
         ));
     }
-    let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
-    let out = render::render(&built.scene, &Render::Grid { n: side }, &mut rng)
+    let out = render::render_parallel(&built.scene, &Render::Grid { n: side }, 0)
         .map_err(|e| SpecError::from_quad("scene", e))?;
     // A pixel that is not a number is a fault of the scene's numbers, never
     // a silent black pixel in the PNG.
@@ -970,9 +958,31 @@ pub fn render_spec(
             ),
         ));
     }
-    let image = super::image::Image::new(spec.camera.width, spec.camera.height, out.image.values)
+    let image = super::image::Image::new(spec_width, spec_height, out.image.values)
         .map_err(|e| SpecError::from_quad("scene.camera", e))?;
     Ok((image, out.rays, built.warnings))
+}
+
+/// The scene of a `whitted` experiment file's `scene` (its camera at
+/// `width x height` where given), built and checked as `check` does; the
+/// file's `pixel` is ignored.
+pub fn scene_of(
+    json: &serde_json::Value,
+    width: Option<usize>,
+    height: Option<usize>,
+) -> Result<Built, SpecError> {
+    let scene = json
+        .get("scene")
+        .cloned()
+        .ok_or_else(|| SpecError::at("scene", "the required field `scene` is missing"))?;
+    let mut spec: SceneSpec = serde_path_to_error::deserialize(scene).map_err(|e| {
+        let (path, message) = tagged::located(&e.path().to_string(), &e.inner().to_string());
+        SpecError::at(format!("scene.{path}"), message)
+    })?;
+    spec.camera.width = width.unwrap_or(spec.camera.width);
+    spec.camera.height = height.unwrap_or(spec.camera.height);
+    spec.pixel = None;
+    build(&spec)
 }
 
 /// The most primary rays `lightquad render` traces (about a minute on one

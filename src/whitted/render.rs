@@ -169,6 +169,46 @@ pub fn render(
     render_block(scene, [0, 0], cam.width(), cam.height(), scheme, rng)
 }
 
+/// The whole image by `scheme` on rayon's threads, in bands of rows, each
+/// band drawing from its own generator seeded by `(seed, band)`: the same
+/// image for every thread count. The image-wide schemes (corner rays shared
+/// between neighbouring pixels, adaptive subdivision) share rays across band
+/// edges and are rendered whole, on one thread.
+pub fn render_parallel(scene: &Scene, scheme: &Scheme, seed: u64) -> Result<Rendered, QuadError> {
+    use rand::SeedableRng;
+    use rayon::prelude::*;
+    let cam = &scene.camera;
+    let (width, height) = (cam.width(), cam.height());
+    if matches!(scheme, Scheme::Corner { .. } | Scheme::Adaptive { .. }) {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        return render(scene, scheme, &mut rng);
+    }
+    // Bands of a few rows: enough of them to balance the threads.
+    const BAND: usize = 4;
+    let bands: Vec<usize> = (0..height.div_ceil(BAND)).collect();
+    let parts = bands
+        .par_iter()
+        .map(|&b| {
+            let mut rng = rand_pcg::Pcg64::new(u128::from(seed), 2 * b as u128 + 1);
+            let rows = BAND.min(height - b * BAND);
+            render_block(scene, [0, b * BAND], width, rows, scheme, &mut rng)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut rays = RayCount::default();
+    let mut image = Estimated {
+        values: Vec::with_capacity(width * height),
+        errors: Vec::with_capacity(width * height),
+        reliable: true,
+    };
+    for part in parts {
+        rays.add(part.rays);
+        image.values.extend(part.image.values);
+        image.errors.extend(part.image.errors);
+        image.reliable &= part.image.reliable;
+    }
+    Ok(Rendered { image, rays })
+}
+
 /// The fraction of the block's pixels covered by some object (1 where the
 /// primary ray hits, 0 where it escapes), by `scheme`; primary rays counted.
 pub fn coverage_block(
