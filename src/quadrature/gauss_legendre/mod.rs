@@ -181,39 +181,66 @@ fn fill_symmetric(
             wl[i] = scale * node.weight;
             wh[len - 1 - i] = scale * node.weight;
         };
-        // Nodes with tabulated Bessel zeros (or a small n) one by one; the rest
-        // in a branch-free loop per expansion order.
-        let special = if n <= TABLE_MAX_ORDER {
-            len
-        } else {
-            bessel::TABULATED.saturating_sub(first_k - 1).min(len)
-        };
-        for i in 0..special {
-            store(i, node_unchecked(n, first_k + i));
+        // A small n from the table; a larger one in blocks: McMahon's
+        // expansion for the Bessel zeros of the whole block (the tabulated
+        // first zeros, k <= 20, put in after), then the expansion per node,
+        // each a loop of straight-line per-node code that the compiler
+        // vectorises across nodes (packed SIMD); then the block is stored
+        // to its mirrored places.
+        if n <= TABLE_MAX_ORDER {
+            for i in 0..len {
+                store(i, node_unchecked(n, first_k + i));
+            }
+            return;
         }
-        // Four nodes per step in lock step (SIMD lanes), then the remainder.
         macro_rules! bulk {
             ($terms:literal) => {{
-                const L: usize = 4;
-                let mut i = special;
-                while i + L <= len {
-                    let k = Lanes(std::array::from_fn(|l| (first_k + i + l) as f64));
-                    let (a, a_lo, p) = bessel::mcmahon(k, n);
-                    let node = bogaert::node_from::<L, $terms>(n, a, a_lo, p);
-                    for l in 0..L {
+                const BLOCK: usize = 64;
+                let mut ba = [0.0; BLOCK];
+                let mut ba_lo = [0.0; BLOCK];
+                let mut bp = [0.0; BLOCK];
+                let mut bx = [0.0; BLOCK];
+                let mut by = [0.0; BLOCK];
+                let mut bw = [0.0; BLOCK];
+                let mut i = 0;
+                while i < len {
+                    let m = (len - i).min(BLOCK);
+                    let k0 = first_k + i;
+                    for (j, ((a, a_lo), p)) in ba[..m]
+                        .iter_mut()
+                        .zip(&mut ba_lo[..m])
+                        .zip(&mut bp[..m])
+                        .enumerate()
+                    {
+                        let (ka, ka_lo, kp) = bessel::mcmahon(Lanes([(k0 + j) as f64]), n);
+                        (*a, *a_lo, *p) = (ka.0[0], ka_lo.0[0], kp.0[0]);
+                    }
+                    for k in k0..(k0 + m).min(bessel::TABULATED + 1) {
+                        let j = k - k0;
+                        (ba[j], ba_lo[j], bp[j]) = bessel::alpha_and_weight_factor(k, n);
+                    }
+                    for j in 0..m {
+                        let node = bogaert::node_from::<1, $terms>(
+                            n,
+                            Lanes([ba[j]]),
+                            Lanes([ba_lo[j]]),
+                            Lanes([bp[j]]),
+                        );
+                        bx[j] = node.x.0[0];
+                        by[j] = node.one_minus_x.0[0];
+                        bw[j] = node.weight.0[0];
+                    }
+                    for j in 0..m {
                         store(
-                            i + l,
+                            i + j,
                             HalfNode {
-                                x: node.x.0[l],
-                                one_minus_x: node.one_minus_x.0[l],
-                                weight: node.weight.0[l],
+                                x: bx[j],
+                                one_minus_x: by[j],
+                                weight: bw[j],
                             },
                         );
                     }
-                    i += L;
-                }
-                for i in i..len {
-                    store(i, bogaert::node(n, first_k + i));
+                    i += m;
                 }
             }};
         }
