@@ -10,8 +10,9 @@
 //!   double-double ([`newton`]) and against 40-digit tables.
 //! - n > 100: Bogaert's iteration-free asymptotic expansion ([`bogaert`]), O(n),
 //!   in parallel over both cores for large n, accurate to a few ulps (tested
-//!   against 40-digit values). Nodes are
-//! computed from their angle `theta_k`, so `1 - |x_k|` is available to full
+//!   against 40-digit values).
+//!
+//! Nodes are computed from their angle `theta_k`, so `1 - |x_k|` is available to full
 //! relative precision even where `x_k` rounds to `+-1`; the unit-interval rule
 //! uses it to keep nodes near 0 accurate (near-singular integrands need that).
 //! Unit-interval rules are cached per n.
