@@ -1,8 +1,11 @@
 //! Quadrature benchmarks.
 //!
-//! - `gl_nodes/*`: Gauss–Legendre node and weight generation for n = 10, 1e3,
-//!   1e5, 1e6: lightquad against the crates `gauss-quad` and `bilby` (both
-//!   implement Bogaert's method), serial and parallel, in the same run.
+//! - `gl_nodes/*`: Gauss–Legendre node and weight generation (the whole rule,
+//!   uncached) for n = 1, 2, 5, 10, 20, 50, 100, 1e3, 1e4, 1e5, 1e6: lightquad
+//!   against the crates `gauss-quad` and `bilby` (both implement Bogaert's
+//!   method), serial and parallel, in the same run. For n <= 100 `table`
+//!   borrows the compiled-in rule; `lightquad-owned` adds copying it into two
+//!   `Vec`s, as the peers' constructors return owned rules.
 //! - `gl_integrate/*`: integrating `cos(50 x)` over [-1, 1] at n = 1e6 with
 //!   cached nodes, against the same peers.
 //! - `sum_overhead/*`: the shared compensated summation against a bare loop
@@ -12,18 +15,30 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use lightquad::quadrature::gauss_legendre::{table, unit_nodes};
+use lightquad::quadrature::gauss_legendre::{TABLE_MAX_ORDER, table, unit_nodes};
 use lightquad::quadrature::nodes::product_sum;
 
 fn gl_nodes(c: &mut Criterion) {
     let mut g = c.benchmark_group("gl_nodes");
     g.warm_up_time(Duration::from_millis(500));
-    for n in [10usize, 1_000, 100_000, 1_000_000] {
+    for n in [
+        1usize, 2, 5, 10, 20, 50, 100, 1_000, 10_000, 100_000, 1_000_000,
+    ] {
         g.sample_size(if n >= 100_000 { 20 } else { 50 });
-        g.measurement_time(Duration::from_secs(if n >= 100_000 { 4 } else { 2 }));
+        g.measurement_time(Duration::from_millis(match n {
+            0..=100 => 1000,
+            101..=99_999 => 2000,
+            _ => 4000,
+        }));
         g.bench_with_input(BenchmarkId::new("lightquad", n), &n, |b, &n| {
             b.iter(|| table(black_box(n)))
         });
+        if n <= TABLE_MAX_ORDER {
+            // table(n) borrows the compiled-in rule; what owned copies cost.
+            g.bench_with_input(BenchmarkId::new("lightquad-owned", n), &n, |b, &n| {
+                b.iter(|| table(black_box(n)).map(|t| (t.x.into_owned(), t.w.into_owned())))
+            });
+        }
         g.bench_with_input(BenchmarkId::new("bilby", n), &n, |b, &n| {
             b.iter(|| bilby::GaussLegendre::new(black_box(n)))
         });

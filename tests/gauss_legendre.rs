@@ -3,15 +3,18 @@
 //! error of the first inexact degree, and integrals with closed forms at
 //! n = 1e3, 1e5, 1e6.
 //!
-//! Tolerances: n <= 100 (Newton, finished in double-double) must be correctly
-//! rounded to within one ulp; n > 100 (Bogaert's expansion, evaluated with a
+//! Tolerances: n <= 100 (compiled-in tables, correctly rounded from 60-digit
+//! values) within one ulp of the 40-digit tables and of Newton's method in
+//! double-double, an independent computation at every n <= 100; n > 100 (Bogaert's expansion, evaluated with a
 //! double-double angle) within 1 eps absolute for nodes and 2 eps relative for
 //! `1 - |x|` and the weights (measured worst: 0.5 and 1.2).
 
 mod common;
 use common::*;
 use lightquad::QuadError;
-use lightquad::quadrature::gauss_legendre::{half_node, table, unit_nodes};
+use lightquad::quadrature::gauss_legendre::{
+    TABLE_MAX_ORDER, bogaert, half_node, newton, table, unit_nodes,
+};
 use lightquad::quadrature::{GaussLegendre, Rule};
 
 #[test]
@@ -45,6 +48,68 @@ fn nodes_and_weights_match_40_digit_tables_for_n_up_to_100() {
                     <= EPS
             );
         }
+    }
+}
+
+/// Distance in ulps between two finite f64 of the same sign (0 to 0 is 0).
+fn ulps(a: f64, b: f64) -> u64 {
+    if a == b {
+        return 0;
+    }
+    (a.to_bits() as i64 - b.to_bits() as i64).unsigned_abs()
+}
+
+#[test]
+fn compiled_table_matches_newton_in_double_double_for_every_n_up_to_100() {
+    // The table was rounded from 60-digit values by a script; Newton's method
+    // on the three-term recurrence, finished in double-double in the crate,
+    // computes the same rules independently (from Bogaert's start). Every
+    // node, 1 - x and weight agrees to one ulp.
+    assert_eq!(TABLE_MAX_ORDER, 100);
+    let mut worst = [0u64; 3];
+    for n in 1..=TABLE_MAX_ORDER {
+        for k in 1..=n.div_ceil(2) {
+            let t = half_node(n, k).expect("valid node");
+            let r = newton::node(n, k, bogaert::node(n, k));
+            let d = [
+                ulps(t.x, r.x),
+                ulps(t.one_minus_x, r.one_minus_x),
+                ulps(t.weight, r.weight),
+            ];
+            for (w, d) in worst.iter_mut().zip(d) {
+                *w = (*w).max(d);
+            }
+            assert!(
+                d.iter().all(|&d| d <= 1),
+                "n={n} k={k}: table {t:?} vs Newton {r:?} ({d:?} ulps)"
+            );
+        }
+    }
+    eprintln!("table vs Newton-DD, worst ulps (x, 1 - x, w): {worst:?}");
+}
+
+#[test]
+fn tabulated_rules_are_symmetric_sum_to_one_and_exact_for_degree_2n_minus_1() {
+    for n in 1..=TABLE_MAX_ORDER {
+        // table() mirrors the half rule: ascending, x[i] = -x[n-1-i].
+        let t = table(n).expect("valid n");
+        assert_eq!((t.x.len(), t.w.len()), (n, n));
+        for i in 0..n {
+            assert_eq!(t.x[i], -t.x[n - 1 - i], "n={n} i={i}");
+            assert_eq!(t.w[i], t.w[n - 1 - i], "n={n} i={i}");
+            if i > 0 {
+                assert!(t.x[i - 1] < t.x[i], "n={n} i={i}: not ascending");
+            }
+        }
+        // On [0, 1]: sum w = 1 (each weight is rounded once, so to half an
+        // ulp of the sum) and int_0^1 u^(2n-1) du = 1/(2n).
+        let unit = unit_nodes(n).expect("valid n");
+        let sum_w = lightquad::sum::sum_f64(unit.w.iter().copied());
+        assert!((sum_w - 1.0).abs() <= EPS, "n={n}: sum w = {sum_w}");
+        let d = 2 * n as i32 - 1;
+        let got = 0.5 * shifted_monomial(&t, d);
+        let exact = 1.0 / (2.0 * n as f64);
+        assert!(rel(got, exact) <= 1e-14, "n={n}: {got} vs {exact}");
     }
 }
 
@@ -94,7 +159,7 @@ fn sampled_nodes_match_40_digit_values_for_large_n() {
 /// to a few ulps.
 fn shifted_monomial(t: &lightquad::quadrature::gauss_legendre::Table, d: i32) -> f64 {
     let n = t.x.len();
-    lightquad::sum::sum_f64(t.x.iter().zip(&t.w).enumerate().map(|(i, (x, w))| {
+    lightquad::sum::sum_f64(t.x.iter().zip(t.w.iter()).enumerate().map(|(i, (x, w))| {
         let k = if *x < 0.0 { i + 1 } else { n - i };
         let y = half_node(n, k).expect("valid node").one_minus_x;
         let power = if *x < 0.0 {
@@ -129,8 +194,11 @@ fn not_exact_for_degree_2n_and_the_error_is_the_closed_form() {
     // (Abramowitz & Stegun 25.4.30.)
     for n in 1..=12usize {
         let t = table(n).expect("valid n");
-        let q =
-            lightquad::sum::sum_f64(t.x.iter().zip(&t.w).map(|(x, w)| w * x.powi(2 * n as i32)));
+        let q = lightquad::sum::sum_f64(
+            t.x.iter()
+                .zip(t.w.iter())
+                .map(|(x, w)| w * x.powi(2 * n as i32)),
+        );
         let exact = 2.0 / (2.0 * n as f64 + 1.0);
         let lgamma = |k: usize| (1..=k).map(|j| (j as f64).ln()).sum::<f64>();
         let predicted = ((2 * n + 1) as f64 * 2f64.ln() + 4.0 * lgamma(n)
@@ -157,7 +225,11 @@ fn large_n_weights_sum_to_two_and_cos_50x_is_exact() {
         let t = table(n).expect("valid n");
         let sum_w = lightquad::sum::sum_f64(t.w.iter().copied());
         assert!((sum_w - 2.0).abs() <= 1e-13, "n={n}: sum w = {sum_w}");
-        let q = lightquad::sum::sum_f64(t.x.iter().zip(&t.w).map(|(x, w)| w * (50.0 * x).cos()));
+        let q = lightquad::sum::sum_f64(
+            t.x.iter()
+                .zip(t.w.iter())
+                .map(|(x, w)| w * (50.0 * x).cos()),
+        );
         assert!((q - exact).abs() <= 1e-13, "n={n}: {q} vs {exact}");
     }
 }

@@ -80,11 +80,11 @@ fn agrees_with_bilby_and_gauss_quad_and_is_at_least_as_accurate() {
             let k = node["k"].as_u64().expect("k") as usize;
             let (x, w) = (num(&node["x"]), num(&node["weight"]));
             let i = n - k;
-            for (slot, (xs, ws)) in
-                worst
-                    .iter_mut()
-                    .zip([(&ours.x, &ours.w), (&bx, &bw), (&gx, &gw)])
-            {
+            for (slot, (xs, ws)) in worst.iter_mut().zip([
+                (&ours.x[..], &ours.w[..]),
+                (&bx[..], &bw[..]),
+                (&gx[..], &gw[..]),
+            ]) {
                 slot.0 = slot.0.max((xs[i] - x).abs() / EPS);
                 slot.1 = slot.1.max(rel(ws[i], w) / EPS);
             }

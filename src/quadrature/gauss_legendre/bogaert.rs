@@ -26,7 +26,8 @@
 //! The expansion is uniform in k, so one formula serves interior and boundary
 //! nodes. Terms are dropped where they fall below a tenth of an ulp for every k
 //! (the thresholds are stated at the constants). The truncation error
-//! `O(v^8)` is below double precision for n > 100; smaller n use Newton's method.
+//! `O(v^8)` is below double precision for n > 100; smaller n are tabulated
+//! (`small_table`).
 //!
 //! Only one `sin_cos` is evaluated per node (an inline polynomial, module `trig`):
 //! `cos theta` and `1 - cos theta` follow from `sin alpha`, `cos alpha` and the

@@ -4,12 +4,15 @@
 //! polynomial `P_n` and `w_k = 2 / ((1 - x_k^2) P_n'(x_k)^2)`; exact for
 //! polynomials of degree `2n - 1`.
 //!
-//! - n <= 100: Newton's method on the three-term recurrence ([`newton`]), O(n^2).
+//! - n <= 100: compiled-in tables ([`small_table`], generated once by
+//!   `scripts/gen_gauss_legendre_table.py` at 60 digits), every value correctly
+//!   rounded; tested against Newton's method on the three-term recurrence in
+//!   double-double ([`newton`]) and against 40-digit tables.
 //! - n > 100: Bogaert's iteration-free asymptotic expansion ([`bogaert`]), O(n),
-//!   in parallel over both cores for large n.
+//!   in parallel over both cores for large n, accurate to a few ulps (tested
+//!   against 40-digit values).
 //!
-//! Both are accurate to a few ulps (tested against 40-digit tables). Nodes are
-//! computed from their angle `theta_k`, so `1 - |x_k|` is available to full
+//! Nodes are computed from their angle `theta_k`, so `1 - |x_k|` is available to full
 //! relative precision even where `x_k` rounds to `+-1`; the unit-interval rule
 //! uses it to keep nodes near 0 accurate (near-singular integrands need that).
 //! Unit-interval rules are cached per n.
@@ -19,8 +22,10 @@ pub mod bogaert;
 mod double_double;
 pub mod lanes;
 pub mod newton;
+pub mod small_table;
 mod trig;
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -39,18 +44,59 @@ use lanes::Lanes;
 
 /// Largest order accepted (a table takes 16 bytes a node).
 pub const MAX_ORDER: usize = 100_000_000;
-/// Orders up to this use Newton's method; above it, Bogaert's expansion.
-pub const NEWTON_MAX_ORDER: usize = 100;
+/// Orders up to this are read from the compiled-in table; above it,
+/// Bogaert's expansion.
+pub const TABLE_MAX_ORDER: usize = small_table::MAX_TABULATED;
 /// Below this order the table is built on one thread.
 const PARALLEL_FROM: usize = 1 << 15;
 
 /// The n-point Gauss–Legendre rule on `[-1, 1]`, nodes ascending.
+///
+/// For `n <= TABLE_MAX_ORDER` both slices are borrowed from the compiled-in
+/// tables (no allocation, nothing computed); above, they are owned.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
     /// Nodes `x_i`, ascending.
-    pub x: Vec<f64>,
+    pub x: Cow<'static, [f64]>,
     /// Weights `w_i`, summing to 2.
-    pub w: Vec<f64>,
+    pub w: Cow<'static, [f64]>,
+}
+
+/// Length of all tabulated rules one after another, `sum_{n <= 100} n`.
+const FULL_LEN: usize = TABLE_MAX_ORDER * (TABLE_MAX_ORDER + 1) / 2;
+/// Nodes of every tabulated rule in full, ascending, order n at
+/// `n (n - 1)/2` ([`full_rule`]); built at compile time from the half table.
+static FULL_X: [f64; FULL_LEN] = mirrored(0, true);
+/// Weights of every tabulated rule in full, laid out as [`FULL_X`].
+static FULL_W: [f64; FULL_LEN] = mirrored(2, false);
+
+/// Column `col` of the tabulated half rules mirrored into full rules
+/// ascending in x: entry `i < n/2` of order n is row `k = i + 1` (negated when
+/// `negate_lower`: the node `-x_k`), entry `i >= n/2` is row `k = n - i`
+/// (the middle row of an odd rule at `i = n/2`).
+const fn mirrored(col: usize, negate_lower: bool) -> [f64; FULL_LEN] {
+    let mut out = [0.0; FULL_LEN];
+    let mut n = 1;
+    while n <= TABLE_MAX_ORDER {
+        let (start, half) = (n * (n - 1) / 2, n * n / 4);
+        let mut i = 0;
+        while i < n {
+            let lower = i < n / 2;
+            let k = if lower { i + 1 } else { n - i };
+            let v = small_table::HALF_NODES[half + k - 1][col];
+            out[start + i] = if negate_lower && lower { -v } else { v };
+            i += 1;
+        }
+        n += 1;
+    }
+    out
+}
+
+/// The tabulated rule of order `n <= TABLE_MAX_ORDER` in full: (nodes
+/// ascending, weights), starting at `sum_{m<n} m = n (n - 1)/2`.
+fn full_rule(n: usize) -> (&'static [f64], &'static [f64]) {
+    let start = n * (n - 1) / 2;
+    (&FULL_X[start..start + n], &FULL_W[start..start + n])
 }
 
 /// Checks an order n.
@@ -81,12 +127,26 @@ pub fn half_node(n: usize, k: usize) -> Result<HalfNode, QuadError> {
     Ok(node_unchecked(n, k))
 }
 
+/// The tabulated half rule of order `n <= TABLE_MAX_ORDER`: rows
+/// `[x_k, 1 - x_k, w_k]`, k = 1..=ceil(n/2) from `x = +1`. The rule of order
+/// n starts at row `sum_{m<n} ceil(m/2) = floor(n^2/4)`.
+fn tabulated(n: usize) -> &'static [[f64; 3]] {
+    let start = n * n / 4;
+    &small_table::HALF_NODES[start..start + n.div_ceil(2)]
+}
+
 /// [`half_node`] for an `n` and `k` the caller has checked.
 fn node_unchecked(n: usize, k: usize) -> HalfNode {
+    if n <= TABLE_MAX_ORDER {
+        let [x, one_minus_x, weight] = tabulated(n)[k - 1];
+        return HalfNode {
+            x,
+            one_minus_x,
+            weight,
+        };
+    }
     let mut node = bogaert::node(n, k);
-    if n <= NEWTON_MAX_ORDER {
-        node = newton::node(n, k, node);
-    } else if 2 * k == n + 1 {
+    if 2 * k == n + 1 {
         // The middle node of an odd rule is exactly zero.
         node.x = 0.0;
         node.one_minus_x = 1.0;
@@ -122,39 +182,66 @@ fn fill_symmetric(
             wl[i] = scale * node.weight;
             wh[len - 1 - i] = scale * node.weight;
         };
-        // Nodes with tabulated Bessel zeros (or a small n) one by one; the rest
-        // in a branch-free loop per expansion order.
-        let special = if n <= NEWTON_MAX_ORDER {
-            len
-        } else {
-            bessel::TABULATED.saturating_sub(first_k - 1).min(len)
-        };
-        for i in 0..special {
-            store(i, node_unchecked(n, first_k + i));
+        // A small n from the table; a larger one in blocks: McMahon's
+        // expansion for the Bessel zeros of the whole block (the tabulated
+        // first zeros, k <= 20, put in after), then the expansion per node,
+        // each a loop of straight-line per-node code that the compiler
+        // vectorises across nodes (packed SIMD); then the block is stored
+        // to its mirrored places.
+        if n <= TABLE_MAX_ORDER {
+            for i in 0..len {
+                store(i, node_unchecked(n, first_k + i));
+            }
+            return;
         }
-        // Four nodes per step in lock step (SIMD lanes), then the remainder.
         macro_rules! bulk {
             ($terms:literal) => {{
-                const L: usize = 4;
-                let mut i = special;
-                while i + L <= len {
-                    let k = Lanes(std::array::from_fn(|l| (first_k + i + l) as f64));
-                    let (a, a_lo, p) = bessel::mcmahon(k, n);
-                    let node = bogaert::node_from::<L, $terms>(n, a, a_lo, p);
-                    for l in 0..L {
+                const BLOCK: usize = 64;
+                let mut ba = [0.0; BLOCK];
+                let mut ba_lo = [0.0; BLOCK];
+                let mut bp = [0.0; BLOCK];
+                let mut bx = [0.0; BLOCK];
+                let mut by = [0.0; BLOCK];
+                let mut bw = [0.0; BLOCK];
+                let mut i = 0;
+                while i < len {
+                    let m = (len - i).min(BLOCK);
+                    let k0 = first_k + i;
+                    for (j, ((a, a_lo), p)) in ba[..m]
+                        .iter_mut()
+                        .zip(&mut ba_lo[..m])
+                        .zip(&mut bp[..m])
+                        .enumerate()
+                    {
+                        let (ka, ka_lo, kp) = bessel::mcmahon(Lanes([(k0 + j) as f64]), n);
+                        (*a, *a_lo, *p) = (ka.0[0], ka_lo.0[0], kp.0[0]);
+                    }
+                    for k in k0..(k0 + m).min(bessel::TABULATED + 1) {
+                        let j = k - k0;
+                        (ba[j], ba_lo[j], bp[j]) = bessel::alpha_and_weight_factor(k, n);
+                    }
+                    for j in 0..m {
+                        let node = bogaert::node_from::<1, $terms>(
+                            n,
+                            Lanes([ba[j]]),
+                            Lanes([ba_lo[j]]),
+                            Lanes([bp[j]]),
+                        );
+                        bx[j] = node.x.0[0];
+                        by[j] = node.one_minus_x.0[0];
+                        bw[j] = node.weight.0[0];
+                    }
+                    for j in 0..m {
                         store(
-                            i + l,
+                            i + j,
                             HalfNode {
-                                x: node.x.0[l],
-                                one_minus_x: node.one_minus_x.0[l],
-                                weight: node.weight.0[l],
+                                x: bx[j],
+                                one_minus_x: by[j],
+                                weight: bw[j],
                             },
                         );
                     }
-                    i += L;
-                }
-                for i in i..len {
-                    store(i, bogaert::node(n, first_k + i));
+                    i += m;
                 }
             }};
         }
@@ -184,10 +271,20 @@ fn fill_symmetric(
 /// Computes the n-point rule on `[-1, 1]` (not cached: see [`unit_nodes`]).
 pub fn table(n: usize) -> Result<Table, QuadError> {
     check_order(n)?;
+    if n <= TABLE_MAX_ORDER {
+        let (x, w) = full_rule(n);
+        return Ok(Table {
+            x: Cow::Borrowed(x),
+            w: Cow::Borrowed(w),
+        });
+    }
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
     fill_symmetric(n, &mut x, &mut w, 1.0, |node| (-node.x, node.x));
-    Ok(Table { x, w })
+    Ok(Table {
+        x: Cow::Owned(x),
+        w: Cow::Owned(w),
+    })
 }
 
 /// The n-point rule mapped to `[0, 1]` (`u = (1 + x)/2`, weights `w/2`),

@@ -1,0 +1,150 @@
+#!/usr/bin/env python3
+"""Generate the compiled-in Gauss-Legendre tables for n = 1..=100.
+
+Run from the repository root:
+
+    pip install -r scripts/requirements-reference.txt
+    python3 scripts/gen_gauss_legendre_table.py
+
+Writes src/quadrature/gauss_legendre/small_table.rs: for every n = 1..=100 the
+nonnegative half of the n-point rule on [-1, 1] (the rule is symmetric),
+nodes k = 1..=ceil(n/2) counted from x = +1, each as three f64 correctly
+rounded from the exact value: x_k, 1 - x_k (computed before rounding, so it
+keeps full relative precision near x = 1) and the weight w_k.
+
+Method (the same as gauss_legendre_small.json of gen_quadrature_reference.py):
+Newton's method on x at mp.dps = 60, P_n and P_n' from the three-term
+recurrence, iterated until |dx| < 1e-55; w = 2 / ((1 - x^2) P_n'(x)^2); the
+middle node of an odd rule is exactly 0.  Rounding to f64 is round-to-nearest
+of the 60-digit value (mpmath's to_float with round_nearest), which is the
+correctly rounded f64 unless the true value lies within ~1e-55 of a midpoint
+between two f64 -- checked below: the 60-digit value must not lie within
+1e-25 ulp of a midpoint.
+
+Checks (the script aborts if any fails): sum w = 2 and exactness for
+x^(2n-2) and x^(2n-1) to 1e-45; agreement to 1e-45 with mpmath's independent
+Golub-Welsch routine mp.gauss_quadrature(n, "legendre"); nodes strictly
+decreasing in k and inside (0, 1].
+"""
+
+from pathlib import Path
+
+import mpmath
+from mpmath import mp, mpf
+from mpmath.libmp import round_nearest, to_float
+
+REPO = Path(__file__).resolve().parent.parent
+OUT = REPO / "src" / "quadrature" / "gauss_legendre" / "small_table.rs"
+SCRIPT = "scripts/gen_gauss_legendre_table.py"
+MAX_N = 100
+DPS = 60
+
+
+def check(cond, msg):
+    """assert that survives `python -O`."""
+    if not cond:
+        raise AssertionError(msg)
+
+
+def legendre_pair(n, x):
+    """(P_n(x), P_{n-1}(x)) by the three-term recurrence."""
+    p_prev, p = mpf(1), mpf(x)
+    for k in range(1, n):
+        p_prev, p = p, ((2 * k + 1) * x * p - k * p_prev) / (k + 1)
+    return p, p_prev
+
+
+def half_rule(n):
+    """[(x, 1 - x, w)] for k = 1..ceil(n/2), x_k counted from +1."""
+    tol = mpf(10) ** (-(DPS - 5))
+    out = []
+    for k in range(1, n // 2 + 1):
+        x = mp.cos((4 * k - 1) * mp.pi / (4 * n + 2)) * (
+            1 - mpf(1) / (8 * n ** 2) + mpf(1) / (8 * n ** 3))
+        for _ in range(100):
+            p, q = legendre_pair(n, x)
+            dp = n * (x * p - q) / (x * x - 1)
+            dx = -p / dp
+            x += dx
+            if abs(dx) < tol:
+                break
+        else:
+            raise AssertionError(f"Newton did not converge: n={n} k={k}")
+        p, q = legendre_pair(n, x)
+        dp = n * (x * p - q) / (x * x - 1)
+        out.append((x, 1 - x, 2 / ((1 - x * x) * dp * dp)))
+    if n % 2 == 1:
+        _, q = legendre_pair(n, mpf(0))
+        dp = n * q  # P_n'(0) = n P_{n-1}(0)
+        out.append((mpf(0), mpf(1), 2 / (dp * dp)))
+    return out
+
+
+def rounded(v):
+    """The f64 nearest v, checked not to be a near-tie."""
+    f = to_float(v._mpf_, rnd=round_nearest)
+    if v != 0:
+        # Distance from the midpoints next to f, relative to v.
+        up = mpmath.mpf(float.fromhex(f.hex()))  # exact
+        ulp = mpf(2) ** (mpmath.floor(mpmath.log(abs(v), 2)) - 52)
+        frac = abs((v - up) / ulp)
+        check(abs(frac - mpf("0.5")) > mpf("1e-25"), f"near-tie rounding {v}")
+    return f
+
+
+def main():
+    rows = []
+    with mp.workdps(DPS):
+        tol = mpf("1e-45")
+        for n in range(1, MAX_N + 1):
+            half = half_rule(n)
+            check(len(half) == (n + 1) // 2, f"n={n}: half length")
+            xs = [h[0] for h in half]
+            check(all(a > b for a, b in zip(xs, xs[1:])), f"n={n}: not decreasing")
+            check(all(0 <= a <= 1 for a in xs), f"n={n}: node outside [0, 1]")
+            full = [(-x, w) for (x, _, w) in half if x != 0] + [
+                (x, w) for (x, _, w) in reversed(half)]
+            check(len(full) == n, f"n={n}: full length")
+            check(abs(mp.fsum(w for _, w in full) - 2) < tol, f"n={n}: sum w != 2")
+            for m in (2 * n - 2, 2 * n - 1):
+                exact = mpf(0) if m % 2 else mpf(2) / (m + 1)
+                got = mp.fsum(w * x ** m for x, w in full)
+                check(abs(got - exact) < tol, f"n={n}: x^{m} not exact")
+            gx, gw = mp.gauss_quadrature(n, "legendre")
+            ref = sorted(zip(gx, gw), key=lambda t: t[0])
+            for (x, w), (rx, rw) in zip(sorted(full, key=lambda t: t[0]), ref):
+                check(abs(x - rx) < tol and abs(w - rw) < tol,
+                      f"n={n}: disagreement with mp.gauss_quadrature")
+            rows.append([tuple(rounded(v) for v in h) for h in half])
+
+    total = sum(len(r) for r in rows)
+    check(total == (MAX_N + 1) ** 2 // 4, "offsets: sum ceil(n/2) != (N+1)^2/4")
+    lines = [
+        f"//! Generated by `{SCRIPT}` (mpmath {mpmath.__version__}); do not edit.",
+        "//!",
+        "//! Gauss-Legendre rules on `[-1, 1]` for n = 1..=100, nonnegative half:",
+        "//! for each n the nodes k = 1..=ceil(n/2) counted from `x = +1`, as",
+        "//! `[x_k, 1 - x_k, w_k]`, each the correctly rounded f64 of a value computed",
+        f"//! by Newton's method at mp.dps = {DPS} (|dx| < 1e-55) and checked against",
+        "//! mpmath's Golub-Welsch rule to 1e-45, `sum w = 2` and exactness for",
+        "//! `x^(2n-2)`, `x^(2n-1)`. The rule of order n starts at row `n^2 / 4`",
+        "//! (integer division: `sum_{m<n} ceil(m/2)`).",
+        "",
+        "/// Highest order tabulated.",
+        f"pub const MAX_TABULATED: usize = {MAX_N};",
+        "",
+        "/// `[x_k, 1 - x_k, w_k]` of every tabulated rule, by n then k.",
+        "#[rustfmt::skip]",
+        f"pub static HALF_NODES: [[f64; 3]; {total}] = [",
+    ]
+    for n, r in enumerate(rows, start=1):
+        lines.append(f"    // n = {n}")
+        for x, y, w in r:
+            lines.append(f"    [{x!r}, {y!r}, {w!r}],")
+    lines.append("];")
+    OUT.write_text("\n".join(lines) + "\n")
+    print(f"wrote {OUT.relative_to(REPO)} ({OUT.stat().st_size} bytes, {total} rows)")
+
+
+if __name__ == "__main__":
+    main()
