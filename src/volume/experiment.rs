@@ -512,17 +512,16 @@ impl Family for Volume {
         })
     }
 
-    /// A term, or their sum I, whose bound from the scene's numbers passes
-    /// the f64 range: each term was finite and I's sum overflowed at run
-    /// (I_E of 1e308 before a background of 1.7e308), every job failing.
+    /// I, whose bound from the scene's numbers passes the f64 range: each
+    /// term was finite and their sum overflowed at run (I_E of 1e308 before
+    /// a background of 1.7e308), every job failing. A bound: an I just
+    /// below 1.8e308 may be refused, and its terms asked for alone. (Each
+    /// term alone is integrated with the integrand rescaled, and fails its
+    /// job, with the reason, only where its value itself overflows.)
     fn lacks(built: &Built, q: VolumeQuantity) -> Option<String> {
         let (e, b, l) = term_bounds(&built.scene);
         let beyond = |x: f64| !x.is_finite();
         match q {
-            VolumeQuantity::Emission if beyond(e) => Some(format!(
-                "I_E can reach {e:.2e} (scene.emission's largest radiance times the chord), beyond \
-                 the f64 range: expected an emission whose integral stays below 1.8e308"
-            )),
             VolumeQuantity::Total if beyond(e + b + l) => Some(format!(
                 "I = I_E + I_B + I_L can reach {:.2e}, beyond the f64 range (I_E up to {e:.2e} \
                  from scene.emission, I_B up to {b:.2e} from scene.background, I_L up to {l:.2e} from \
