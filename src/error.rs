@@ -92,7 +92,7 @@ impl QuadError {
         QuadError::InvalidParameter {
             name: name.into(),
             value: shortened(value.to_string()),
-            accepted: accepted.into(),
+            accepted: short_numbers(&accepted.into()),
         }
     }
 }
@@ -111,6 +111,64 @@ pub fn shortened(value: String) -> String {
         Some((cut, _)) => format!("{}... ({} bytes)", &value[..cut], value.len()),
         None => value,
     }
+}
+
+/// `text` with every number written in more than 24 characters put in
+/// scientific notation, as a person reads it: Rust prints an f64 in full, so a
+/// box corner of -1e308 came out as its 309 digits in the middle of a sentence
+/// (and 1e-300 as 300 zeros). Shorter numbers, and digits inside a word (a
+/// hash, a file name), are left as they are.
+///
+/// ```
+/// use lightquad::error::short_numbers;
+/// let long = format!("a number > min[0] = {} here", -1e308);
+/// assert_eq!(short_numbers(&long), "a number > min[0] = -1e308 here");
+/// assert_eq!(short_numbers(&format!("{} and 0.25", 1e-300)), "1e-300 and 0.25");
+/// assert_eq!(short_numbers("hash 3c979872b2e1078a, n = 16"), "hash 3c979872b2e1078a, n = 16");
+/// ```
+pub fn short_numbers(text: &str) -> String {
+    const LONGEST: usize = 24;
+    let bytes = text.as_bytes();
+    let word = |b: u8| b.is_ascii_alphanumeric() || b == b'_';
+    let mut out = String::with_capacity(text.len());
+    let mut copied = 0;
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts = bytes[i].is_ascii_digit()
+            || (bytes[i] == b'-' && bytes.get(i + 1).is_some_and(u8::is_ascii_digit));
+        if !starts || (i > 0 && (word(bytes[i - 1]) || bytes[i - 1] == b'.')) {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        i += 1;
+        while i < bytes.len() && bytes[i].is_ascii_digit() {
+            i += 1;
+        }
+        if i + 1 < bytes.len() && bytes[i] == b'.' && bytes[i + 1].is_ascii_digit() {
+            i += 1;
+            while i < bytes.len() && bytes[i].is_ascii_digit() {
+                i += 1;
+            }
+        }
+        if i < bytes.len() && word(bytes[i]) {
+            // Part of a word (a hash, an identifier): not a number.
+            while i < bytes.len() && word(bytes[i]) {
+                i += 1;
+            }
+            continue;
+        }
+        let token = &text[start..i];
+        if token.len() > LONGEST
+            && let Ok(x) = token.parse::<f64>()
+        {
+            out.push_str(&text[copied..start]);
+            out.push_str(&format!("{x:e}"));
+            copied = i;
+        }
+    }
+    out.push_str(&text[copied..]);
+    out
 }
 
 /// Checks that `x` is finite, naming the parameter otherwise.
@@ -146,7 +204,7 @@ impl SpecError {
     pub fn at(path: impl Into<String>, message: impl Into<String>) -> Self {
         SpecError {
             path: path.into(),
-            message: message.into(),
+            message: short_numbers(&message.into()),
         }
     }
 
@@ -163,7 +221,7 @@ impl SpecError {
         };
         SpecError {
             path,
-            message: e.to_string(),
+            message: short_numbers(&e.to_string()),
         }
     }
 }

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
+use lightquad::error::short_numbers;
 use lightquad::experiment;
 use lightquad::experiment::Source;
 use lightquad::experiment::run::RunOptions;
@@ -106,7 +107,7 @@ enum Command {
         /// Image height in pixels (default: the file's).
         #[arg(long)]
         height: Option<usize>,
-        /// Rays per pixel on W-SS's grid, rounded down to a square (9: 3 x 3).
+        /// Rays per pixel on W-SS's grid, at least 1, rounded down to a square (9: 3 x 3).
         #[arg(long, default_value_t = 9)]
         samples: usize,
     },
@@ -117,7 +118,7 @@ fn main() -> ExitCode {
     match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", short_numbers(&e.to_string()));
             ExitCode::FAILURE
         }
     }
@@ -189,7 +190,11 @@ fn run(command: Command) -> Result<(), Failure> {
             for f in sources(files)? {
                 let exp = experiment::load_source(&registry, &f)?;
                 for w in exp.warnings() {
-                    eprintln!("warning: {}: {w}", f.display());
+                    eprintln!(
+                        "warning: {}: {}",
+                        f.display(),
+                        short_numbers(&w.to_string())
+                    );
                 }
                 let (rules, budgets, repeats) = exp.shape();
                 writeln!(
@@ -215,21 +220,49 @@ fn run(command: Command) -> Result<(), Failure> {
             height,
             samples,
         } => {
+            if samples == 0 {
+                return Err(
+                    "invalid --samples = 0: expected a number of rays per pixel >= 1 \
+                            (rounded down to a square: 1, 4, 9, ...)"
+                        .into(),
+                );
+            }
+            if let Some(p) = &pfm
+                && same_file(&png, p)
+            {
+                return Err(format!(
+                    "--png and --pfm both name {}: expected two different files (the second \
+                     would overwrite the first)",
+                    png.display()
+                )
+                .into());
+            }
             let source = match file {
                 Some(f) => Source::File(f),
                 None => Source::Bundled("w-grey-test-scene.json"),
             };
-            let text = source.read()?;
-            let json = experiment::validate::parse_json(&String::from_utf8_lossy(&text))?;
+            let in_file = |e: &dyn std::fmt::Display| format!("{}: {e}", source.display());
+            let text = source.read().map_err(|e| in_file(&e))?;
+            let text =
+                std::str::from_utf8(&text).map_err(|e| in_file(&format!("not UTF-8: {e}")))?;
+            let json = experiment::validate::parse_json(text).map_err(|e| in_file(&e))?;
             let (image, rays, warnings) =
                 lightquad::whitted::experiment::render_spec(&json, width, height, samples)
-                    .map_err(|e| format!("{}: {e}", source.display()))?;
+                    .map_err(|e| in_file(&e))?;
             for w in &warnings {
-                eprintln!("warning: {}: {w}", source.display());
+                eprintln!(
+                    "warning: {}: {}",
+                    source.display(),
+                    short_numbers(&w.to_string())
+                );
             }
-            image.write_png(&png)?;
+            image
+                .write_png(&png)
+                .map_err(|e| format!("cannot write the PNG: {e}"))?;
             if let Some(p) = &pfm {
-                image.write_pfm(p)?;
+                image
+                    .write_pfm(p)
+                    .map_err(|e| format!("cannot write the PFM: {e}"))?;
             }
             writeln!(
                 out,
@@ -252,6 +285,33 @@ fn run(command: Command) -> Result<(), Failure> {
     }
     out.flush()?;
     Ok(())
+}
+
+/// Whether `a` and `b` name one file: the same path once made absolute and
+/// rid of `.` and `..`, or, where both exist, the same canonical file (a
+/// link to the other).
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    use std::path::Component;
+    let plain = |p: &std::path::Path| {
+        let mut out = PathBuf::new();
+        for c in std::path::absolute(p)
+            .unwrap_or_else(|_| p.to_path_buf())
+            .components()
+        {
+            match c {
+                Component::CurDir => {}
+                Component::ParentDir => {
+                    out.pop();
+                }
+                other => out.push(other),
+            }
+        }
+        out
+    };
+    if plain(a) == plain(b) {
+        return true;
+    }
+    matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
 }
 
 /// The experiments of `run` and `check`: the files, or the bundled suite.

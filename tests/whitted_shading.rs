@@ -95,6 +95,34 @@ fn w61_with_phong_at_one_hit_is_the_formula_with_its_numbers() {
     assert_eq!((rays.primary, rays.shadow), (1, 1));
 }
 
+/// A Phong exponent of 0 is legal, the constant lobe: `max(0, R . A)^0 =
+/// 1`, so the highlight is `k_s I` also where the mirror direction turns
+/// away from the viewer (IEEE's `0^0 = 1`), as documented on `Material`.
+#[test]
+fn a_phong_exponent_of_zero_is_a_constant_lobe() {
+    let m = Material {
+        k_a: 0.0,
+        k_d: 0.6,
+        k_s: 0.3,
+        k_t: 0.0,
+        phong: 0.0,
+        ior: 1.0,
+        colour: Rgb::new(1.0, 1.0, 1.0),
+    };
+    // The eye at 30 degrees and the light at 70 degrees on the same side:
+    // R_q . A = cos(100 degrees) < 0.
+    let (s30, c30) = (0.5_f64, 3f64.sqrt() / 2.0);
+    let eye = v3(2.0 * s30, 0.0, 2.0 * c30);
+    let (s70, c70) = (70f64.to_radians().sin(), 70f64.to_radians().cos());
+    let light = Light::point(v3(4.0 * s70, 0.0, 4.0 * c70), white(1.0)).expect("l");
+    let r_dot_a = -s70 * s30 + c70 * c30;
+    assert!(r_dot_a < -0.17);
+    let sc = scene(vec![floor(m)], vec![light], white(0.0), 0);
+    let mut rays = RayCount::default();
+    let got = trace(&sc, &Ray::new(eye, -eye / eye.norm()), 0, &mut rays);
+    close(got, white(0.6 * c70 + 0.3), 1e-14);
+}
+
 /// A sphere between the hit and the light: `S_q = 0`, the ambient term only.
 #[test]
 fn a_shadowed_hit_keeps_only_the_ambient_term() {

@@ -205,7 +205,7 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
                 }
             }
             Err(e) => {
-                out.failure = Some(format!("{}: {e}", q.name()));
+                out.failure = Some(crate::error::short_numbers(&format!("{}: {e}", q.name())));
                 return out;
             }
         }

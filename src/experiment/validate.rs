@@ -144,8 +144,18 @@ pub fn parse_and_load<T>(
                 ),
             ))
         }
-        // Another fault came first, or the field took the marked string.
-        _ => Err(original),
+        // The field took the marked string: it reads text (a name, a
+        // description), and a number is none, however large.
+        Ok(_) => Err(SpecError::at(
+            original.path,
+            format!(
+                "{} ({place}) is a number (beyond the f64 range, its magnitude above 1.8e308): \
+                 expected a string",
+                crate::error::shortened(literal)
+            ),
+        )),
+        // Another fault, a real one, came before the field was read.
+        Err(other) => Err(other),
     }
 }
 

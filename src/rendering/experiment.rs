@@ -602,6 +602,13 @@ impl family::Quantity for RenderingQuantity {
             LArea,
         ]
     }
+
+    /// Irradiance and radiance are never negative: emitters' radiances and
+    /// the BRDFs are `>= 0` (checked where the scene is read), so a literal
+    /// reference below 0 is a mistake, refused at its path.
+    fn bounds(&self) -> (f64, f64) {
+        (0.0, f64::INFINITY)
+    }
 }
 
 /// Multiple importance sampling of light and BRDF samples, the family's
@@ -1314,11 +1321,75 @@ fn renamed(e: QuadError, from: &str, to: &str) -> QuadError {
     }
 }
 
-/// Refuses a surface whose coordinates pass [`MAX_COORDINATE`].
-fn bounded(path: &str, o: &Occluder) -> Result<(), SpecError> {
+/// The position and size fields of an emitter, by name.
+fn emitter_numbers(spec: &EmitterSpec) -> Vec<(&'static str, Vec<f64>)> {
+    match spec {
+        EmitterSpec::Rectangle(r) => vec![
+            ("origin", r.origin.to_vec()),
+            ("edge_u", r.edge_u.to_vec()),
+            ("edge_v", r.edge_v.to_vec()),
+        ],
+        EmitterSpec::Disk(d) => vec![("centre", d.centre.to_vec()), ("radius", vec![d.radius])],
+        EmitterSpec::Triangle(t) => {
+            vec![
+                ("a", t.a.to_vec()),
+                ("b", t.b.to_vec()),
+                ("c", t.c.to_vec()),
+            ]
+        }
+        EmitterSpec::Sphere(s) => vec![("centre", s.centre.to_vec()), ("radius", vec![s.radius])],
+        EmitterSpec::Environment(_) | EmitterSpec::Cap(_) => vec![],
+    }
+}
+
+/// The position and size fields of an occluder, by name.
+fn occluder_numbers(spec: &OccluderSpec) -> Vec<(&'static str, Vec<f64>)> {
+    match spec {
+        OccluderSpec::Sphere(s) => vec![("centre", s.centre.to_vec()), ("radius", vec![s.radius])],
+        OccluderSpec::Disk(d) => vec![("centre", d.centre.to_vec()), ("radius", vec![d.radius])],
+        OccluderSpec::Rectangle(r) => vec![
+            ("origin", r.origin.to_vec()),
+            ("edge_u", r.edge_u.to_vec()),
+            ("edge_v", r.edge_v.to_vec()),
+        ],
+        OccluderSpec::Triangle(t) => {
+            vec![
+                ("a", t.a.to_vec()),
+                ("b", t.b.to_vec()),
+                ("c", t.c.to_vec()),
+            ]
+        }
+    }
+}
+
+/// Refuses a surface whose coordinates pass [`MAX_COORDINATE`]: at the
+/// field of `fields` (its name and numbers) holding a number beyond it
+/// (`scene.emitters[0].centre[0]`), or at the surface where only the sum of
+/// fields reaches beyond it (an origin and an edge each of 6e99).
+fn bounded(path: &str, o: &Occluder, fields: &[(&str, Vec<f64>)]) -> Result<(), SpecError> {
     let extent = o.extent();
     if extent.is_finite() && extent <= MAX_COORDINATE {
         return Ok(());
+    }
+    for (field, values) in fields {
+        if let Some((i, v)) = values
+            .iter()
+            .enumerate()
+            .find(|(_, v)| v.is_nan() || v.abs() > MAX_COORDINATE)
+        {
+            let at = if values.len() > 1 {
+                format!("{path}.{field}[{i}]")
+            } else {
+                format!("{path}.{field}")
+            };
+            return Err(SpecError::at(
+                at,
+                format!(
+                    "{v:e} is beyond {MAX_COORDINATE:e}: expected coordinates and sizes up to \
+                     {MAX_COORDINATE:e} (squared distances of larger ones overflow f64)"
+                ),
+            ));
+        }
     }
     Err(SpecError::at(
         path,
@@ -1389,13 +1460,17 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
     let r = &spec.receiver;
     let receiver = Receiver::new(vec3(r.point), vec3(r.normal))
         .map_err(|e| SpecError::from_quad("scene.receiver", e))?;
-    if receiver.point().amax() > MAX_COORDINATE {
+    if let Some((i, v)) = r
+        .point
+        .iter()
+        .enumerate()
+        .find(|(_, v)| v.abs() > MAX_COORDINATE)
+    {
         return Err(SpecError::at(
-            "scene.receiver.point",
+            format!("scene.receiver.point[{i}]"),
             format!(
-                "{:?} has a coordinate beyond {MAX_COORDINATE:e}: expected coordinates up to \
-                 {MAX_COORDINATE:e} (squared distances of larger ones overflow f64)",
-                r.point
+                "{v:e} is beyond {MAX_COORDINATE:e}: expected coordinates up to \
+                 {MAX_COORDINATE:e} (squared distances of larger ones overflow f64)"
             ),
         ));
     }
@@ -1441,11 +1516,11 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         ));
     }
     let mut emitters = Vec::with_capacity(spec.emitters.len());
-    for (i, e) in spec.emitters.iter().enumerate() {
+    for (i, e_spec) in spec.emitters.iter().enumerate() {
         let at = format!("scene.emitters[{i}]");
-        let e = emitter(e).map_err(|err| SpecError::from_quad(&at, err))?;
+        let e = emitter(e_spec).map_err(|err| SpecError::from_quad(&at, err))?;
         if let Some(o) = e.occluder() {
-            bounded(&at, &o)?;
+            bounded(&at, &o, &emitter_numbers(e_spec))?;
         }
         // Every form's domain must exist from the receiver: a receiver
         // inside a sphere light has none, nor does a light too small to
@@ -1478,10 +1553,10 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         emitters.push(e);
     }
     let mut occluders = Vec::with_capacity(spec.occluders.len());
-    for (j, o) in spec.occluders.iter().enumerate() {
+    for (j, o_spec) in spec.occluders.iter().enumerate() {
         let at = format!("scene.occluders[{j}]");
-        let o = occluder(o).map_err(|err| SpecError::from_quad(&at, err))?;
-        bounded(&at, &o)?;
+        let o = occluder(o_spec).map_err(|err| SpecError::from_quad(&at, err))?;
+        bounded(&at, &o, &occluder_numbers(o_spec))?;
         occluders.push(o);
     }
     Ok(Built {

@@ -445,6 +445,7 @@ impl Family for Volume {
 
     fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         let scene = scene(spec)?;
+        within_reach(spec)?;
         // Products the terms use, checked here rather than failing every job:
         // the fault is lambda's where the medium alone (lambda = 1) is fine.
         let (sigma, depth) = scene.anchored().0.depth_bound();
@@ -468,6 +469,25 @@ impl Family for Volume {
                 ),
             ));
         }
+        if let Some(light) = &scene.light
+            && let Some(albedo) = light.albedo
+        {
+            // V-L's integrand is at most albedo sigma / (4 pi) I_p.
+            let per_unit = albedo * sigma / (4.0 * std::f64::consts::PI);
+            if !(light.intensity * per_unit).is_finite() {
+                return Err(SpecError::at(
+                    "scene.light.intensity",
+                    format!(
+                        "{:e}: times the largest scattering coefficient with the phase, albedo \
+                         lambda v / (4 pi) = {per_unit:.2e}, I_L's integrand reaches {:.2e}, beyond \
+                         the f64 range: expected an intensity at most {:.1e} in this medium",
+                        light.intensity,
+                        light.intensity * per_unit,
+                        round_down(f64::MAX / per_unit)
+                    ),
+                ));
+            }
+        }
         Ok(Built {
             scene,
             scheme: match spec.depth_scheme {
@@ -490,6 +510,27 @@ impl Family for Volume {
                 _ => None,
             },
         })
+    }
+
+    /// I, whose bound from the scene's numbers passes the f64 range: each
+    /// term was finite and their sum overflowed at run (I_E of 1e308 before
+    /// a background of 1.7e308), every job failing. A bound: an I just
+    /// below 1.8e308 may be refused, and its terms asked for alone. (Each
+    /// term alone is integrated with the integrand rescaled, and fails its
+    /// job, with the reason, only where its value itself overflows.)
+    fn lacks(built: &Built, q: VolumeQuantity) -> Option<String> {
+        let (e, b, l) = term_bounds(&built.scene);
+        let beyond = |x: f64| !x.is_finite();
+        match q {
+            VolumeQuantity::Total if beyond(e + b + l) => Some(format!(
+                "I = I_E + I_B + I_L can reach {:.2e}, beyond the f64 range (I_E up to {e:.2e} \
+                 from scene.emission, I_B up to {b:.2e} from scene.background, I_L up to {l:.2e} from \
+                 scene.light.intensity): expected terms whose sum stays below 1.8e308 (lower the \
+                 largest, or ask for the terms alone)",
+                e + b + l
+            )),
+            _ => None,
+        }
     }
 
     fn scene_audit(built: &Built) -> Option<String> {
@@ -1413,6 +1454,105 @@ fn printed_forms(spec: &SceneSpec) -> Result<Option<(printed::Sphere, Vec<Printe
         },
         spec.printed.clone(),
     )))
+}
+
+/// `x` with two significant digits, rounded toward 0 (a bound to print).
+fn round_down(x: f64) -> f64 {
+    if !(x.is_finite() && x > 0.0) {
+        return x;
+    }
+    let scale = 10f64.powi(x.log10().floor() as i32 - 1);
+    (x / scale).floor() * scale
+}
+
+/// Upper bounds of I_E, I_B and I_L from the scene's numbers: V-E's largest
+/// emitted radiance on each piece of the support times its length (for
+/// emission proportional to the density, `k v`, at most `k / lambda` as
+/// well: `int tau lambda v = 1 - tau`); I_b; and I_p albedo / (4 pi) times
+/// `min(1, the depth bound)` with an albedo (the scattered fraction of the
+/// light), I_p times the chord in the document's reduced form.
+fn term_bounds(scene: &VolumeScene) -> (f64, f64, f64) {
+    let (scene, _) = scene.anchored();
+    let pieces = |m: &Arc<dyn Medium>| -> Vec<(f64, f64)> {
+        m.support(&scene.ray, scene.t_min, scene.t_max)
+            .iter()
+            .map(|p| {
+                (
+                    m.max_density(&scene.ray, p.start(), p.end()),
+                    p.end() - p.start(),
+                )
+            })
+            .collect()
+    };
+    let medium = scene.medium.as_ref().map(pieces).unwrap_or_default();
+    let chord: f64 = medium.iter().map(|(_, len)| len).sum();
+    let mass: f64 = medium.iter().map(|(v, len)| v * len).sum();
+    let emission = match &scene.emission {
+        None => 0.0,
+        Some(EmissionMap::Constant(c)) => c * chord,
+        Some(EmissionMap::Proportional(k)) if scene.lambda > 0.0 => {
+            k * mass.min(1.0 / scene.lambda)
+        }
+        Some(EmissionMap::Proportional(k)) => k * mass,
+        Some(EmissionMap::Table(t)) => t.points().iter().map(|p| p.1).fold(0.0, f64::max) * chord,
+        Some(EmissionMap::Field(f)) => pieces(f).iter().map(|(v, len)| v * len).sum(),
+    };
+    let light = scene.light.as_ref().map_or(0.0, |l| match l.albedo {
+        Some(a) => l.intensity * a / (4.0 * std::f64::consts::PI) * (scene.lambda * mass).min(1.0),
+        None => l.intensity * chord,
+    });
+    (emission, scene.background.unwrap_or(0.0), light)
+}
+
+/// The largest distance from the ray's origin to a sphere's centre that is
+/// accepted: the chord is found from `c - o` and its square, which
+/// overflows f64 beyond about 1.34e154 (an origin at -1e155 before a sphere
+/// at 1e154 was read as a miss, and every term as 0, with no fault).
+pub const MAX_REACH: f64 = 1e154;
+
+/// Refuses a sphere (of a constant or linear-gradient medium, or such an
+/// emission field) whose centre's distance from the ray's origin, or its
+/// square, overflows f64, at the centre's path. (Gaussian blobs and voxel
+/// grids meet the ray without that square.)
+fn within_reach(spec: &SceneSpec) -> Result<(), SpecError> {
+    let origin = vec3(spec.ray.origin);
+    let centre = |m: &MediumSpec| match m {
+        MediumSpec::ConstantSphere(s) => Some(s.centre),
+        MediumSpec::LinearGradient(g) => Some(g.centre),
+        _ => None,
+    };
+    let field = match &spec.emission {
+        Some(EmissionSpec::Field(FieldEmissionSpec { field })) => Some(field),
+        _ => None,
+    };
+    let spheres = [
+        ("scene.medium", spec.medium.as_ref()),
+        ("scene.emission.field", field),
+    ];
+    for (at, m) in spheres {
+        let Some(c) = m.and_then(centre) else {
+            continue;
+        };
+        let d = vec3(c) - origin;
+        let scale = d.amax();
+        let distance = match scale {
+            0.0 => 0.0,
+            s if s.is_finite() => s * (d / s).norm(),
+            _ => f64::INFINITY,
+        };
+        if distance.is_nan() || distance > MAX_REACH {
+            return Err(SpecError::at(
+                format!("{at}.centre"),
+                format!(
+                    "{c:?} is {distance:.2e} from the ray's origin {:?}: expected a centre within \
+                     {MAX_REACH:e} of scene.ray.origin (the chord is found from the square of \
+                     that distance, which overflows f64 beyond 1.3e154)",
+                    spec.ray.origin
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn scene(s: &SceneSpec) -> Result<VolumeScene, SpecError> {

@@ -143,7 +143,7 @@ pub struct CameraSpec {
     /// The image's up direction (not along the viewing direction).
     #[serde(deserialize_with = "tagged::array")]
     pub up: [f64; 3],
-    /// The vertical field of view in degrees, in `(0, 180)`.
+    /// The vertical field of view in degrees, in `[1e-4, 180)`.
     pub fov_y: f64,
     /// Pixels across, `1..=16384`.
     pub width: usize,
@@ -287,7 +287,9 @@ pub struct MaterialSpec {
     /// `k_t` in `[0, 1]`.
     #[serde(default)]
     pub k_t: f64,
-    /// The Phong exponent `n` in `[0, 1e8]`.
+    /// The Phong exponent `n` in `[0, 1e8]`. `n = 0` is legal, a constant
+    /// lobe: `(R . V)^0 = 1`, so the highlight is `k_s I_j` for every light
+    /// `j` above the surface's horizon and unshadowed, wherever the viewer is.
     #[serde(default = "one")]
     pub phong: f64,
     /// The index of refraction inside, in `[0.001, 1000]`.
@@ -783,15 +785,21 @@ fn rgb(v: [f64; 3]) -> Rgb {
     Rgb::new(v[0], v[1], v[2])
 }
 
-/// Refuses a number beyond [`MAX_COORDINATE`] at `path`.
+/// Refuses a number beyond [`MAX_COORDINATE`] among `values`, the array
+/// (or the one number) at `path`, at its own path (`scene.camera.eye[0]`).
 fn bounded(path: &str, values: &[f64]) -> Result<(), SpecError> {
     match values
         .iter()
-        .find(|v| v.is_nan() || v.abs() > MAX_COORDINATE)
+        .enumerate()
+        .find(|(_, v)| v.is_nan() || v.abs() > MAX_COORDINATE)
     {
         None => Ok(()),
-        Some(v) => Err(SpecError::at(
-            path,
+        Some((i, v)) => Err(SpecError::at(
+            if values.len() > 1 {
+                format!("{path}[{i}]")
+            } else {
+                path.to_string()
+            },
             format!(
                 "{v:e} is beyond {MAX_COORDINATE:e}: expected coordinates, sizes and \
                  intensities up to {MAX_COORDINATE:e} (squared distances of larger ones \
@@ -814,24 +822,29 @@ fn material(spec: &MaterialSpec) -> Material {
 }
 
 fn object(spec: &ObjectSpec, at: &str) -> Result<Object, SpecError> {
-    let (shape, m, numbers) = match spec {
+    let (shape, m, fields): (_, _, Vec<(&str, &[f64])>) = match spec {
         ObjectSpec::Sphere(s) => (
             Shape::sphere(vec3(s.centre), s.radius),
             &s.material,
-            [&s.centre[..], &[s.radius]].concat(),
+            vec![
+                ("centre", &s.centre[..]),
+                ("radius", std::slice::from_ref(&s.radius)),
+            ],
         ),
         ObjectSpec::Plane(p) => (
             Shape::plane(vec3(p.point), vec3(p.normal)),
             &p.material,
-            [&p.point[..], &p.normal[..]].concat(),
+            vec![("point", &p.point[..]), ("normal", &p.normal[..])],
         ),
         ObjectSpec::Triangle(t) => (
             Shape::triangle(vec3(t.a), vec3(t.b), vec3(t.c)),
             &t.material,
-            [&t.a[..], &t.b[..], &t.c[..]].concat(),
+            vec![("a", &t.a[..]), ("b", &t.b[..]), ("c", &t.c[..])],
         ),
     };
-    bounded(at, &numbers)?;
+    for (field, values) in fields {
+        bounded(&format!("{at}.{field}"), values)?;
+    }
     let shape = shape.map_err(|e| SpecError::from_quad(at, e))?;
     let material = material(m);
     material
@@ -844,10 +857,9 @@ fn object(spec: &ObjectSpec, at: &str) -> Result<Object, SpecError> {
 /// path from the file's root.
 fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
     let c = &spec.camera;
-    bounded(
-        "scene.camera",
-        &[&c.eye[..], &c.look_at[..], &c.up[..]].concat(),
-    )?;
+    bounded("scene.camera.eye", &c.eye)?;
+    bounded("scene.camera.look_at", &c.look_at)?;
+    bounded("scene.camera.up", &c.up)?;
     let forward = vec3(c.look_at) - vec3(c.eye);
     if forward == Vec3::zeros() {
         return Err(SpecError::at(
@@ -867,11 +879,13 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         let at = format!("scene.lights[{k}]");
         let light = match l {
             LightSpec::Point(p) => {
-                bounded(&at, &[&p.position[..], &p.intensity[..]].concat())?;
+                bounded(&format!("{at}.position"), &p.position)?;
+                bounded(&format!("{at}.intensity"), &p.intensity)?;
                 Light::point(vec3(p.position), rgb(p.intensity))
             }
             LightSpec::Directional(d) => {
-                bounded(&at, &[&d.toward_light[..], &d.intensity[..]].concat())?;
+                bounded(&format!("{at}.toward_light"), &d.toward_light)?;
+                bounded(&format!("{at}.intensity"), &d.intensity)?;
                 Light::directional(vec3(d.toward_light), rgb(d.intensity))
             }
         };
@@ -932,7 +946,13 @@ pub fn render_spec(
     }
     let built = scene_of(json, width, height)?;
     let (spec_width, spec_height) = (built.scene.camera.width(), built.scene.camera.height());
-    let side = ((samples.max(1) as f64).sqrt().floor() as usize).max(1);
+    if samples == 0 {
+        return Err(SpecError::at(
+            "samples",
+            "0 rays a pixel: expected at least 1 (rounded down to a square: 1, 4, 9, ...)",
+        ));
+    }
+    let side = ((samples as f64).sqrt().floor() as usize).max(1);
     // Refuse what would run for hours: the primary rays, each of which may
     // spawn up to `max_depth` generations more.
     let primary = (spec_width as f64) * (spec_height as f64) * (side as f64).powi(2);

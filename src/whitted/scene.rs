@@ -50,7 +50,9 @@ pub struct Material {
     pub k_s: f64,
     /// `k_t`, transmission, in `[0, 1]`.
     pub k_t: f64,
-    /// The Phong exponent `n >= 0`.
+    /// The Phong exponent `n >= 0`; `n = 0` is a constant lobe, the
+    /// highlight `k_s I_j` from every unshadowed light above the horizon,
+    /// wherever the viewer is (`max(0, R . V)^0 = 1`, as IEEE's `0^0`).
     pub phong: f64,
     /// The index of refraction inside the object, `> 0`.
     pub ior: f64,
@@ -218,10 +220,17 @@ pub struct Camera {
 /// The largest image side, in pixels.
 pub const MAX_SIDE: usize = 1 << 14;
 
+/// The narrowest vertical field of view accepted, in degrees: a pixel of a
+/// [`MAX_SIDE`]-pixel-high image then spans about 1e-10 of the unit
+/// viewing direction, and a sample 1e-3 of a pixel apart still some 1e3
+/// units in the last place (a field of view of 1e-320 degrees has a
+/// tangent of 0, and every ray of the image is the same).
+pub const MIN_FOV_Y: f64 = 1e-4;
+
 impl Camera {
     /// The camera at `eye` looking along `forward` with `up` as the image's
     /// up (not parallel to `forward`), vertical field of view `fov_y`
-    /// degrees in `(0, 180)`, and `width x height` pixels (each in
+    /// degrees in `[MIN_FOV_Y, 180)`, and `width x height` pixels (each in
     /// `1..=16384`).
     pub fn new(
         eye: Vec3,
@@ -244,11 +253,15 @@ impl Camera {
         let up = right.cross(&forward);
         require_finite("fov_y", fov_y)?;
         let tan_half = (0.5 * fov_y.to_radians()).tan();
-        if !(fov_y > 0.0 && fov_y < 180.0 && tan_half > 0.0 && tan_half.is_finite()) {
+        if !((MIN_FOV_Y..180.0).contains(&fov_y) && tan_half > 0.0 && tan_half.is_finite()) {
             return Err(QuadError::invalid(
                 "fov_y",
                 fov_y,
-                "a vertical field of view in degrees in (0, 180)",
+                format!(
+                    "a vertical field of view in degrees in [{MIN_FOV_Y:e}, 180) (narrower, the \
+                     rays through neighbouring points of a {MAX_SIDE}-pixel-high image differ by \
+                     too few digits of f64; 180 and wider has no pinhole image)"
+                ),
             ));
         }
         for (name, side) in [("width", width), ("height", height)] {

@@ -1,0 +1,313 @@
+//! The leftovers of issue 10's input checks and issue 12's `render` flags,
+//! on the real binary: every refusal names the JSON path (or the flag), the
+//! value in a short form and what is accepted.
+
+use serde_json::{Value, json};
+use std::fs;
+
+mod common;
+use common::{bin, root, scratch, stderr};
+
+/// A bundled experiment with `edit` applied, checked by the binary.
+fn check_edited(file: &str, edit: impl FnOnce(&mut Value)) -> std::process::Output {
+    let mut v: Value = serde_json::from_str(
+        &fs::read_to_string(root().join("experiments").join(file)).expect("read"),
+    )
+    .expect("json");
+    v["name"] = json!("edited");
+    edit(&mut v);
+    check_text(&v.to_string())
+}
+
+fn check_text(text: &str) -> std::process::Output {
+    let dir = scratch("leftovers");
+    let f = dir.join("e.json");
+    fs::write(&f, text).expect("write");
+    let o = bin().arg("check").arg(&f).output().expect("runs");
+    let _ = fs::remove_dir_all(&dir);
+    o
+}
+
+/// Refused, at `path`, with every piece of `what` in the message, and no
+/// number written out in more than 24 digits.
+fn refused(o: &std::process::Output, path: &str, what: &[&str]) {
+    let msg = stderr(o);
+    assert!(!o.status.success(), "accepted; stderr: {msg}");
+    assert!(
+        msg.contains(&format!("at `{path}`")),
+        "no `{path}` in: {msg}"
+    );
+    for w in what {
+        assert!(msg.contains(w), "no {w:?} in: {msg}");
+    }
+    let longest = msg
+        .split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max()
+        .unwrap_or(0);
+    assert!(longest <= 24, "a number of {longest} digits in: {msg}");
+    assert!(!msg.contains("panicked"), "{msg}");
+}
+
+/// A voxel grid's min of -1e308 was echoed as its 309 digits in the max's
+/// message; t_min = 1e300 as 301 digits in t_max's.
+#[test]
+fn huge_numbers_are_echoed_in_a_short_form() {
+    let o = check_edited("v-i-total-voxel-grid.json", |v| {
+        v["scene"]["medium"]["min"] = json!([-1e308, -1.0, -1.0]);
+        v["scene"]["medium"]["max"] = json!([1e308, 1.0, 1.0]);
+    });
+    refused(
+        &o,
+        "scene.medium.max[0]",
+        &["max[0] = 1e308", "min[0] = -1e308", "finite box width"],
+    );
+    let o = check_edited("v-e-constant-sphere.json", |v| {
+        v["scene"]["t_min"] = json!(1e300);
+        v["scene"]["t_max"] = json!(1.0);
+    });
+    refused(&o, "scene.t_max", &["t_min = 1e300"]);
+    // The library's helper, as every message goes through it.
+    use lightquad::error::short_numbers;
+    let long = format!("{} and {} and 12.5, hash 3c979872b2e1078a", -1e308, 1e-300);
+    assert_eq!(
+        short_numbers(&long),
+        "-1e308 and 1e-300 and 12.5, hash 3c979872b2e1078a"
+    );
+}
+
+/// Sphere centres, ray origins, light intensities and emission near 1e308
+/// passed `check` and then read as a miss (every term 0, no fault) or
+/// failed every job: the products used are checked, at the field's path.
+#[test]
+fn products_that_overflow_at_run_are_refused_at_check() {
+    // |o - c| overflows: the sphere the ray crosses was read as a miss.
+    let o = check_edited("v-e-constant-sphere.json", |v| {
+        v["scene"]["ray"]["origin"] = json!([-1e308, 0.3, 0.0]);
+        v["scene"]["medium"]["centre"] = json!([1e308, 0.0, 0.0]);
+    });
+    refused(
+        &o,
+        "scene.medium.centre",
+        &[
+            "[1e308, 0.0, 0.0]",
+            "[-1e308, 0.3, 0.0]",
+            "within 1e154 of scene.ray.origin",
+        ],
+    );
+    // Its square overflows: 1.1e155 apart.
+    let o = check_edited("v-e-constant-sphere.json", |v| {
+        v["scene"]["ray"]["origin"] = json!([-1e155, 0.3, 0.0]);
+        v["scene"]["medium"]["centre"] = json!([1e154, 0.0, 0.0]);
+    });
+    refused(&o, "scene.medium.centre", &["1.10e155", "1e154"]);
+    // 1e153 apart is accepted, and the chord found (a closed form > 0).
+    let o = check_edited("v-e-constant-sphere.json", |v| {
+        v["scene"]["ray"]["origin"] = json!([-1e153, 0.3, 0.0]);
+    });
+    assert!(o.status.success(), "{}", stderr(&o));
+    // I_p times the scattering coefficient overflows I_L's integrand.
+    let o = check_edited("v-l-single-scattering.json", |v| {
+        v["scene"]["light"]["intensity"] = json!(1.7e308);
+        v["scene"]["medium"]["kappa"] = json!(1e10);
+    });
+    refused(
+        &o,
+        "scene.light.intensity",
+        &[
+            "1.7e308",
+            "I_L's integrand",
+            "expected an intensity at most 2.8e299",
+        ],
+    );
+    // The bound, f64::MAX 4 pi / (albedo 0.8 kappa 1e10) = 2.82e299, is
+    // accepted.
+    let o = check_edited("v-l-single-scattering.json", |v| {
+        v["scene"]["light"]["intensity"] = json!(2.8e299);
+        v["scene"]["medium"]["kappa"] = json!(1e10);
+    });
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Each term finite, their sum I beyond f64 (every job failed at run).
+    let o = check_edited("v-i-total-voxel-grid.json", |v| {
+        v["scene"]["emission"] = json!({"type": "constant", "c": 1e308});
+        v["scene"]["background"] = json!(1.7e308);
+    });
+    refused(
+        &o,
+        "quantities[0]",
+        &[
+            "I = I_E + I_B + I_L can reach",
+            "scene.background",
+            "scene.emission",
+            "below 1.8e308",
+        ],
+    );
+    // The terms alone stay computable.
+    let o = check_edited("v-i-total-voxel-grid.json", |v| {
+        v["scene"]["background"] = json!(1.7e308);
+        v["scene"]["lambda"] = json!(0.0);
+        v["quantities"] = json!(["I_B", "tau"]);
+    });
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The Whitted and rendering families name the coordinate itself.
+    let o = check_edited("w-6-1-phong-pixel.json", |v| {
+        v["scene"]["camera"]["eye"][1] = json!(1e308);
+    });
+    refused(&o, "scene.camera.eye[1]", &["1e308 is beyond 1e100"]);
+    let o = check_edited("w-6-1-phong-pixel.json", |v| {
+        v["scene"]["objects"][0]["centre"][2] = json!(-1e200);
+    });
+    refused(
+        &o,
+        "scene.objects[0].centre[2]",
+        &["-1e200 is beyond 1e100"],
+    );
+    let o = check_edited("w-6-1-phong-pixel.json", |v| {
+        v["scene"]["lights"][0]["intensity"][0] = json!(1e308);
+    });
+    refused(&o, "scene.lights[0].intensity[0]", &["1e308", "1e100"]);
+    let o = check_edited("r-sphere-below-horizon.json", |v| {
+        v["scene"]["emitters"][0]["centre"][0] = json!(1e308);
+    });
+    refused(
+        &o,
+        "scene.emitters[0].centre[0]",
+        &["1e308 is beyond 1e100"],
+    );
+    let o = check_edited("r-sphere-below-horizon.json", |v| {
+        v["scene"]["receiver"]["point"][2] = json!(-1e300);
+    });
+    refused(&o, "scene.receiver.point[2]", &["-1e300 is beyond 1e100"]);
+}
+
+/// Irradiance and radiance are never negative: a literal reference of -1
+/// for E_area was accepted.
+#[test]
+fn negative_literal_references_of_nonnegative_quantities_are_refused() {
+    let o = check_edited("r-sphere-below-horizon.json", |v| {
+        v["quantities"] = json!(["E_area", "E_cone"]);
+        v["reference"] = json!({"type": "value", "values": {"E_area": -1.0, "E_cone": 0.03}});
+    });
+    refused(
+        &o,
+        "reference.values.E_area",
+        &["-1 is not a value E_area can take", "a number >= 0"],
+    );
+    let o = check_edited("r-sphere-below-horizon.json", |v| {
+        v["quantities"] = json!(["E_area"]);
+        v["reference"] = json!({"type": "value", "values": {"E_area": 0.0296}});
+    });
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// `"description": 1e400` said "expected a finite number".
+#[test]
+fn a_number_beyond_f64_as_the_description_asks_for_a_string() {
+    let text =
+        fs::read_to_string(root().join("experiments/v-e-constant-sphere.json")).expect("read");
+    let start = text.find("\"description\": \"").expect("a description");
+    let end = start + text[start + 16..].find('"').expect("closing quote") + 17;
+    let o = check_text(&format!(
+        "{}\"description\": 1e400{}",
+        &text[..start],
+        &text[end..]
+    ));
+    refused(&o, "description", &["1e400", "line 4", "expected a string"]);
+}
+
+/// `lightquad render`'s own faults (the hostile probe of issue 12).
+#[test]
+fn render_flags_and_files_are_checked_and_named() {
+    let dir = scratch("render-flags");
+    let png = dir.join("r.png");
+    let render = |args: &[&str]| {
+        bin()
+            .arg("render")
+            .args(["--width", "4", "--height", "3"])
+            .args(args)
+            .output()
+            .expect("runs")
+    };
+    let p = png.to_str().expect("utf-8");
+    // --samples 0 silently became 1.
+    let o = render(&["--samples", "0", "--png", p]);
+    assert!(!o.status.success() && !png.exists(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--samples = 0") && stderr(&o).contains(">= 1"),
+        "{}",
+        stderr(&o)
+    );
+    // --png and --pfm on one file: one overwrote the other.
+    let same = dir.join("./sub/../r.png");
+    let o = render(&["--png", p, "--pfm", same.to_str().expect("utf-8")]);
+    assert!(!o.status.success() && !png.exists(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--png and --pfm both name") && stderr(&o).contains("r.png"),
+        "{}",
+        stderr(&o)
+    );
+    // A missing file, a folder and a file that is not JSON are named.
+    let missing = dir.join("nope.json");
+    let o = render(&["--png", p, missing.to_str().expect("utf-8")]);
+    assert!(!o.status.success(), "accepted");
+    assert!(stderr(&o).contains("nope.json"), "{}", stderr(&o));
+    let o = render(&["--png", p, dir.to_str().expect("utf-8")]);
+    assert!(
+        !o.status.success() && stderr(&o).contains(dir.to_str().expect("utf-8")),
+        "{}",
+        stderr(&o)
+    );
+    let garbage = dir.join("garbage.json");
+    fs::write(&garbage, "{\"family\": ").expect("write");
+    let o = render(&["--png", p, garbage.to_str().expect("utf-8")]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("garbage.json"),
+        "{}",
+        stderr(&o)
+    );
+    // An unwritable PNG names itself.
+    let o = render(&[
+        "--png",
+        dir.join("no/such/folder.png").to_str().expect("utf-8"),
+    ]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("no/such/folder.png"),
+        "{}",
+        stderr(&o)
+    );
+    // Two files and --samples 1 work.
+    let pfm = dir.join("r.pfm");
+    let o = render(&[
+        "--samples",
+        "1",
+        "--png",
+        p,
+        "--pfm",
+        pfm.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(png.exists() && pfm.exists());
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// The narrowest field of view is stated, and a Phong exponent of 0 is the
+/// documented constant lobe, accepted.
+#[test]
+fn the_fov_minimum_is_stated_and_phong_zero_is_accepted() {
+    let o = check_edited("w-6-1-phong-pixel.json", |v| {
+        v["scene"]["camera"]["fov_y"] = json!(1e-5);
+    });
+    refused(
+        &o,
+        "scene.camera.fov_y",
+        &["fov_y = 0.00001", "[1e-4, 180)"],
+    );
+    let o = check_edited("w-6-1-phong-pixel.json", |v| {
+        v["scene"]["camera"]["fov_y"] = json!(1e-4);
+    });
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = check_edited("w-6-1-phong-pixel.json", |v| {
+        v["scene"]["objects"][0]["material"]["phong"] = json!(0.0);
+    });
+    assert!(o.status.success(), "{}", stderr(&o));
+}
