@@ -58,11 +58,11 @@ pub enum QuadError {
         /// The scaling exponent.
         exponent: i32,
     },
-    /// The integral overflowed f64, and the rescaled second pass would
-    /// evaluate past the budget (an adaptive rule took another path than the
-    /// first, or the first outgrew the tape the second replays).
+    /// The integrand exceeded `2^500`, and its rescaled pass would evaluate
+    /// past the budget (an adaptive rule took another path than the first,
+    /// or the first outgrew the log the second replays).
     #[error(
-        "rule `{rule}`: the integral overflows f64 at this scale, and taking it again scaled by 2^-{exponent} would evaluate past the budget of {budget} (an adaptive rule took another path, or the pass outgrew its replay tape); scale the integrand nearer 1"
+        "rule `{rule}`: the integrand exceeded 2^500 (its sums or squares may overflow f64), and taking it again scaled by 2^-{exponent} would evaluate past the budget of {budget} (an adaptive rule took another path, or the pass outgrew its replay log); scale the integrand nearer 1"
     )]
     RescaleOverBudget {
         /// Rule name.

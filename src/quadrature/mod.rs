@@ -170,12 +170,13 @@ pub trait Rule {
     /// A rule's sums, differences and squares of values beyond `2^500` can
     /// overflow into an infinite or NaN estimate, and squares of values below
     /// `2^-500` underflow into a standard error of 0. So a pass stops at the
-    /// first value beyond `2^500` and the integral is taken again of
-    /// `f 2^-1023` in that channel (every finite value is then below 2), and
+    /// first finite value beyond `2^500` (while its log holds it) and the
+    /// integral is taken again of `f 2^-e` in that channel, `2^e` the largest
+    /// `|f|` seen; a pass past its log that overflowed is taken again so; and
     /// a channel whose values all lie below `2^-500` and whose error came out
-    /// 0 is taken again of `f 2^-e`, `2^e` its largest `|f|`: exact scalings,
-    /// undone on the estimate. An estimate that is still not finite is an
-    /// error ([`QuadError::Overflow`]), never a silent NaN.
+    /// 0 is taken again of `f 2^-e` too: exact scalings, undone on the
+    /// estimate. An estimate that is still not finite is an error
+    /// ([`QuadError::Overflow`]), never a silent NaN.
     ///
     /// Passes after the first keep the budget: they replay the draws and
     /// values logged so far (module `replay`, at most 1 MiB each) and
@@ -183,8 +184,11 @@ pub trait Rule {
     /// scaled values, takes another path; every evaluation is counted, and
     /// never more than the rule's own promise ([`Rule::evaluations`]) in all.
     /// A pass that would go past it is abandoned: an estimate with an
-    /// underflowed error is then returned doubted, and an overflowed integral
-    /// is an error ([`QuadError::RescaleOverBudget`]).
+    /// underflowed error is then returned doubted (so beyond the log, 65536
+    /// one-dimensional evaluations, stratified sampling of an integrand near
+    /// 1e-300 gives an error of 0, doubted, where evaluating twice gave a
+    /// real one), and a pass that met values beyond `2^500` is an error
+    /// ([`QuadError::RescaleOverBudget`]).
     fn try_integrate<
         const D: usize,
         V: Value,
@@ -206,14 +210,18 @@ pub trait Rule {
         let promise = (n as u64).max(self.evaluations(n, D) as u64);
         let mut points = replay::Log::<([f64; D], V)>::new();
         let mut draws = replay::Log::<replay::Draw>::new();
-        // Evaluations of `f` so far, the largest |f| seen per channel, and
-        // the scaling exponent per channel.
+        // Evaluations of `f` so far, the largest finite |f| seen per
+        // channel, and the scaling exponent per channel.
         let mut fresh = 0u64;
         let mut largest = V::zero();
         let mut e = V::zero();
+        // The exponent that brings a channel's largest |f| to at most 1.
+        let exponent_of = |l: f64| l.log2().ceil().clamp(-1074.0, 1023.0);
         // The last complete estimate whose error underflowed, kept in case
-        // its rescaled pass cannot keep the budget.
+        // its rescaled pass cannot keep the budget; whether a complete
+        // pass's overflow has been rescaled.
         let mut underflowed: Option<Estimate<V>> = None;
+        let mut rescaled_overflow = false;
         let mut passes = 0;
         loop {
             passes += 1;
@@ -228,35 +236,52 @@ pub trait Rule {
                     log: &mut draws,
                 },
                 |u| {
-                    let y = match points.replay(|(p, _)| replay::bits(*p) == replay::bits(u)) {
-                        Some((_, y)) => y,
-                        None if fresh < promise => {
-                            fresh += 1;
-                            let y = f(u)?;
-                            points.append((u, y));
-                            y
-                        }
-                        None => {
-                            over_budget = true;
-                            return Err(QuadError::invalid("n", n, "(past the budget)"));
-                        }
-                    };
-                    largest = largest.zip(y, |l, y| l.max(y.abs()));
-                    // A channel beyond 2^500 not yet scaled: stop, and start
-                    // again scaled.
-                    if (0..V::CHANNELS).any(|c| e.channel(c) == 0.0 && y.channel(c).abs() > HUGE) {
-                        huge = true;
-                        return Err(QuadError::invalid("f", "> 2^500", "(scaled next)"));
-                    }
-                    Ok(if scaled {
+                    let (y, logged) =
+                        match points.replay(|(p, _)| replay::bits(*p) == replay::bits(u)) {
+                            Some((_, y)) => (y, true),
+                            None if fresh < promise => {
+                                fresh += 1;
+                                let y = f(u)?;
+                                (y, points.append((u, y)))
+                            }
+                            None => {
+                                over_budget = true;
+                                return Err(QuadError::invalid("n", n, "(past the budget)"));
+                            }
+                        };
+                    largest = largest.zip(y, |l, y| if y.is_finite() { l.max(y.abs()) } else { l });
+                    let y = if scaled {
                         y.zip(e, |y, e| times_pow2(y, -e))
                     } else {
                         y
-                    })
+                    };
+                    // A finite value beyond 2^500 at the current scale, while
+                    // the log holds the pass: stop, and start again scaled
+                    // (past the log the pass runs on, and is rescaled only if
+                    // its estimate overflowed).
+                    let beyond = (0..V::CHANNELS).any(|c| {
+                        let v = y.channel(c);
+                        v.is_finite() && v.abs() > HUGE
+                    });
+                    if beyond && logged {
+                        huge = true;
+                        return Err(QuadError::invalid("f", "> 2^500", "(scaled next)"));
+                    }
+                    Ok(y)
                 },
             );
+            // The channels whose largest |f| is beyond 2^500 at their scale.
+            let rescale = |e: V, largest: V| {
+                e.zip(largest, |e, l| {
+                    if times_pow2(l, -e) > HUGE {
+                        exponent_of(l)
+                    } else {
+                        e
+                    }
+                })
+            };
             if huge {
-                e = e.zip(largest, |e, l| if l > HUGE { 1023.0 } else { e });
+                e = rescale(e, largest);
                 continue;
             }
             if over_budget {
@@ -280,6 +305,21 @@ pub trait Rule {
                 evaluations: if passes == 1 { pass.evaluations } else { fresh },
                 ..pass
             };
+            // A pass that ran past its log with values beyond 2^500 and
+            // overflowed (a value that is not finite, or an infinite error
+            // where the values' squares overflowed): once more, scaled.
+            let overflowed = !sound(&pass)
+                || (0..V::CHANNELS).any(|c| {
+                    times_pow2(largest.channel(c), -e.channel(c)) > HUGE
+                        && pass.error.channel(c).is_infinite()
+                });
+            let wider = rescale(e, largest);
+            let changed = (0..V::CHANNELS).any(|c| wider.channel(c) != e.channel(c));
+            if overflowed && !rescaled_overflow && changed {
+                rescaled_overflow = true;
+                e = wider;
+                continue;
+            }
             // A channel below 2^-500 with an error of exactly 0, not yet
             // scaled: its squares underflowed (a random rule's standard error
             // of an integrand near 1e-300 came out 0). Tiny values with a
@@ -289,7 +329,7 @@ pub trait Rule {
                 let l = largest.channel(c);
                 let untouched = e.channel(c) == 0.0;
                 if untouched && l > 0.0 && l < TINY && estimate.error.channel(c) == 0.0 {
-                    l.log2().ceil().max(-1074.0)
+                    exponent_of(l)
                 } else {
                     0.0
                 }

@@ -16,8 +16,8 @@
 //!   adaptive rule, whose decisions on the scaled values differ) the caller
 //!   evaluates, counted, and the log continues from there.
 //!
-//! Each log holds at most [`LOG_BYTES`], so memory stays bounded (and a
-//! deterministic rule's log of draws stays empty); a pass
+//! Each log holds at most [`LOG_BYTES`], so memory stays bounded (a rule
+//! that draws nothing leaves its log of draws empty); a pass
 //! beyond that evaluates again, counted, within the budget.
 
 use std::convert::Infallible;
@@ -69,17 +69,21 @@ impl<T: Copy> Log<T> {
     }
 
     /// Logs a fresh item at the cursor (the end of the log after a
-    /// [`Log::replay`] of `None`), while the log is within its cap.
+    /// [`Log::replay`] of `None`), while the log is within its cap; true when
+    /// it was logged.
     #[inline]
-    pub fn append(&mut self, item: T) {
+    pub fn append(&mut self, item: T) -> bool {
         let len = self.items.len();
         if self.cursor == len && len < self.cap {
             if len == self.items.capacity() {
                 // Doubling, but never past the cap.
-                self.items.reserve_exact(len.clamp(64, self.cap - len));
+                self.items.reserve_exact(len.max(64).min(self.cap - len));
             }
             self.items.push(item);
             self.cursor += 1;
+            true
+        } else {
+            false
         }
     }
 
@@ -122,7 +126,7 @@ impl<R: rand::Rng + ?Sized> rand::TryRng for LoggedRng<'_, R> {
             return Ok(x);
         }
         let x = self.inner.next_u32();
-        self.log.append(Draw::U32(x));
+        let _ = self.log.append(Draw::U32(x));
         Ok(x)
     }
 
@@ -131,7 +135,7 @@ impl<R: rand::Rng + ?Sized> rand::TryRng for LoggedRng<'_, R> {
             return Ok(x);
         }
         let x = self.inner.next_u64();
-        self.log.append(Draw::U64(x));
+        let _ = self.log.append(Draw::U64(x));
         Ok(x)
     }
 
@@ -147,6 +151,17 @@ impl<R: rand::Rng + ?Sized> rand::TryRng for LoggedRng<'_, R> {
 mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
+
+    /// A log of large entries fills to its cap without a panic (the growth
+    /// step was `clamp(64, cap - len)`, which panics when `cap - len < 64`)
+    /// and then logs nothing more.
+    #[test]
+    fn a_log_of_large_entries_fills_to_its_cap() {
+        let mut log = Log::<[u8; 600]>::new();
+        let cap = LOG_BYTES / 600;
+        let logged = (0..cap + 10).filter(|_| log.append([0; 600])).count();
+        assert_eq!(logged, cap);
+    }
 
     /// A second pass reads the first pass's draws back, and a pass that asks
     /// for something else draws afresh from the caller's generator.

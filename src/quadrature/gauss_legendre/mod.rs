@@ -499,11 +499,13 @@ fn algebraic(m: f64, d2: f64, halving: f64) -> f64 {
     }
     let target = halving / (m * d2.abs());
     let ratio = |p: f64| (p.exp2() - 1.0) / p;
-    // (2^p - 1)/p is ln 2 at p -> 0: a smaller target is an order below any
-    // positive p, taken at the smallest searched.
+    // (2^p - 1)/p > ln 2 for every p > 0: a smaller target contradicts the
+    // algebraic model (a kink or jump, where D and d2 are both of the size of
+    // the error, gives about 1/m), and taking it at a tiny p overestimated
+    // such errors 1e4-fold.
     let (mut lo, mut hi) = (1e-3f64, 60.0f64);
     if ratio(lo) >= target {
-        hi = lo;
+        return 0.0;
     } else if ratio(hi) <= target {
         lo = hi;
     }
