@@ -246,7 +246,7 @@ pub trait Rule {
                             }
                             None => {
                                 over_budget = true;
-                                return Err(QuadError::invalid("n", n, "(past the budget)"));
+                                return Err(pass_stopped());
                             }
                         };
                     largest = largest.zip(y, |l, y| if y.is_finite() { l.max(y.abs()) } else { l });
@@ -259,13 +259,9 @@ pub trait Rule {
                     // the log holds the pass: stop, and start again scaled
                     // (past the log the pass runs on, and is rescaled only if
                     // its estimate overflowed).
-                    let beyond = (0..V::CHANNELS).any(|c| {
-                        let v = y.channel(c);
-                        v.is_finite() && v.abs() > HUGE
-                    });
-                    if beyond && logged {
+                    if y.max_abs() > HUGE && logged && beyond(&y) {
                         huge = true;
-                        return Err(QuadError::invalid("f", "> 2^500", "(scaled next)"));
+                        return Err(pass_stopped());
                     }
                     Ok(y)
                 },
@@ -396,6 +392,22 @@ const TINY: f64 = 3.054936363499605e-151; // 2^-500
 /// rule's way of saying it has no estimate, not an overflow).
 fn sound<V: Value>(e: &Estimate<V>) -> bool {
     e.value.all_finite() && (0..V::CHANNELS).all(|c| !e.error.channel(c).is_nan())
+}
+
+/// Whether a channel of `y` is finite and beyond `2^500`.
+#[cold]
+fn beyond<V: Value>(y: &V) -> bool {
+    (0..V::CHANNELS).any(|c| {
+        let v = y.channel(c);
+        v.is_finite() && v.abs() > HUGE
+    })
+}
+
+/// The error that stops a pass of [`Rule::try_integrate`] to be taken again
+/// (never returned to the caller).
+#[cold]
+fn pass_stopped() -> QuadError {
+    QuadError::invalid("pass", "stopped", "(taken again scaled)")
 }
 
 /// The largest `m` with `m^dim <= n` (`n` itself for `dim <= 1`).
