@@ -185,10 +185,9 @@ pub fn render_parallel(scene: &Scene, scheme: &Scheme, seed: u64) -> Result<Rend
     }
     // Bands of a few rows: enough of them to balance the threads.
     const BAND: usize = 4;
-    let bands: Vec<usize> = (0..height.div_ceil(BAND)).collect();
-    let parts = bands
-        .par_iter()
-        .map(|&b| {
+    let parts = (0..height.div_ceil(BAND))
+        .into_par_iter()
+        .map(|b| {
             let mut rng = rand_pcg::Pcg64::new(u128::from(seed), 2 * b as u128 + 1);
             let rows = BAND.min(height - b * BAND);
             render_block(scene, [0, b * BAND], width, rows, scheme, &mut rng)
