@@ -210,6 +210,11 @@ pub trait Rule {
         let promise = (n as u64).max(self.evaluations(n, D) as u64);
         let mut points = replay::Log::<([f64; D], V)>::new();
         let mut draws = replay::Log::<replay::Draw>::new();
+        points.reserve(promise);
+        if self.is_random() {
+            // About a draw per coordinate (a hint: the log grows past it).
+            draws.reserve(promise.saturating_mul(D as u64));
+        }
         // Evaluations of `f` so far, the largest finite |f| seen per
         // channel, and the scaling exponent per channel.
         let mut fresh = 0u64;
@@ -239,16 +244,21 @@ pub trait Rule {
                     &mut replay::LoggedRng {
                         inner: rng,
                         log: &mut draws,
+                        replaying: false,
                     },
+                    #[inline(always)]
                     |u| {
                         let y = f(u)?;
                         fresh += 1;
-                        largest =
-                            largest.zip(y, |l, y| if y.is_finite() { l.max(y.abs()) } else { l });
-                        let logged = points.append((u, y));
-                        if y.max_abs() > HUGE && logged && beyond(&y) {
-                            huge = true;
-                            return Err(pass_stopped());
+                        // The log keeps the largest |f| of what it holds
+                        // (folded only when needed); past it, it is kept here.
+                        if points.push((u, y)) {
+                            if y.max_abs() > HUGE && beyond(&y) {
+                                huge = true;
+                                return Err(pass_stopped());
+                            }
+                        } else {
+                            largest = largest.zip(y, finite_max);
                         }
                         Ok(y)
                     },
@@ -259,6 +269,7 @@ pub trait Rule {
                     &mut replay::LoggedRng {
                         inner: rng,
                         log: &mut draws,
+                        replaying: true,
                     },
                     |u| {
                         let (y, logged) =
@@ -274,8 +285,7 @@ pub trait Rule {
                                     return Err(pass_stopped());
                                 }
                             };
-                        largest =
-                            largest.zip(y, |l, y| if y.is_finite() { l.max(y.abs()) } else { l });
+                        largest = largest.zip(y, finite_max);
                         let y = if scaled {
                             y.zip(e, |y, e| times_pow2(y, -e))
                         } else {
@@ -303,6 +313,22 @@ pub trait Rule {
                     }
                 })
             };
+            // After the first pass, `largest` covers what went past the log;
+            // the log's own values are folded in when a decision needs them
+            // (a value beyond 2^500, an estimate or error that is not finite
+            // or an error of 0), so a plain pass does no bookkeeping for it.
+            if passes == 1
+                && (huge
+                    || pass.as_ref().is_ok_and(|p| {
+                        !sound(p)
+                            || (0..V::CHANNELS).any(|c| {
+                                let err = p.error.channel(c);
+                                err == 0.0 || err.is_infinite()
+                            })
+                    }))
+            {
+                largest = points.fold(largest, |l, (_, y)| l.zip(*y, finite_max));
+            }
             if huge {
                 e = rescale(e, largest);
                 continue;
@@ -419,6 +445,12 @@ const TINY: f64 = 3.054936363499605e-151; // 2^-500
 /// rule's way of saying it has no estimate, not an overflow).
 fn sound<V: Value>(e: &Estimate<V>) -> bool {
     e.value.all_finite() && (0..V::CHANNELS).all(|c| !e.error.channel(c).is_nan())
+}
+
+/// `max(l, |y|)` over finite `y` (the largest finite magnitude seen).
+#[inline(always)]
+fn finite_max(l: f64, y: f64) -> f64 {
+    if y.is_finite() { l.max(y.abs()) } else { l }
 }
 
 /// Whether a channel of `y` is finite and beyond `2^500`.

@@ -68,6 +68,30 @@ impl<T: Copy> Log<T> {
         }
     }
 
+    /// Makes room for `n` items at once, never past the cap.
+    pub fn reserve(&mut self, n: u64) {
+        let room = n.min((self.cap - self.items.len()) as u64) as usize;
+        self.items.reserve_exact(room);
+    }
+
+    /// Logs a fresh item at the end, within the [`Log::reserve`]d room, during
+    /// a first pass (which replays nothing and leaves the cursor to
+    /// [`Log::rewind`]): a bounds check and a store. True when it was logged.
+    #[inline(always)]
+    pub fn push(&mut self, item: T) -> bool {
+        if self.items.len() < self.items.capacity() {
+            self.items.push(item);
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Folds `f` over every item logged.
+    pub fn fold<A>(&self, init: A, f: impl FnMut(A, &T) -> A) -> A {
+        self.items.iter().fold(init, f)
+    }
+
     /// Logs a fresh item at the cursor (the end of the log after a
     /// [`Log::replay`] of `None`), while the log is within its cap; true when
     /// it was logged.
@@ -76,14 +100,30 @@ impl<T: Copy> Log<T> {
         let len = self.items.len();
         if self.cursor == len && len < self.cap {
             if len == self.items.capacity() {
-                // Doubling, but never past the cap.
-                self.items.reserve_exact(len.max(64).min(self.cap - len));
+                self.grow();
             }
             self.items.push(item);
             self.cursor += 1;
             true
         } else {
             false
+        }
+    }
+
+    /// Room for more items: doubling, never past the cap.
+    #[cold]
+    fn grow(&mut self) {
+        let len = self.items.len();
+        self.items.reserve_exact(len.max(64).min(self.cap - len));
+    }
+
+    /// Logs `item` at the end of a full log, growing it while within the cap
+    /// (a first pass's draws, past the room reserved for them).
+    #[cold]
+    fn grow_with(&mut self, item: T) {
+        if self.items.len() < self.cap {
+            self.grow();
+            self.items.push(item);
         }
     }
 
@@ -116,26 +156,47 @@ pub struct LoggedRng<'a, R: ?Sized> {
     pub inner: &'a mut R,
     /// The draws of the passes so far.
     pub log: &'a mut Log<Draw>,
+    /// False in a first pass: nothing to replay, every draw is fresh.
+    pub replaying: bool,
+}
+
+impl<R: rand::Rng + ?Sized> LoggedRng<'_, R> {
+    /// A fresh draw, logged: in a first pass at the end of the log, else at
+    /// the cursor where the replay ended.
+    #[inline(always)]
+    fn fresh(&mut self, draw: Draw) {
+        if self.replaying {
+            let _ = self.log.append(draw);
+        } else if self.log.items.len() < self.log.items.capacity() {
+            self.log.items.push(draw);
+        } else {
+            self.log.grow_with(draw);
+        }
+    }
 }
 
 impl<R: rand::Rng + ?Sized> rand::TryRng for LoggedRng<'_, R> {
     type Error = Infallible;
 
     fn try_next_u32(&mut self) -> Result<u32, Infallible> {
-        if let Some(Draw::U32(x)) = self.log.replay(|d| matches!(d, Draw::U32(_))) {
-            return Ok(x);
+        if self.replaying {
+            if let Some(Draw::U32(x)) = self.log.replay(|d| matches!(d, Draw::U32(_))) {
+                return Ok(x);
+            }
         }
         let x = self.inner.next_u32();
-        let _ = self.log.append(Draw::U32(x));
+        self.fresh(Draw::U32(x));
         Ok(x)
     }
 
     fn try_next_u64(&mut self) -> Result<u64, Infallible> {
-        if let Some(Draw::U64(x)) = self.log.replay(|d| matches!(d, Draw::U64(_))) {
-            return Ok(x);
+        if self.replaying {
+            if let Some(Draw::U64(x)) = self.log.replay(|d| matches!(d, Draw::U64(_))) {
+                return Ok(x);
+            }
         }
         let x = self.inner.next_u64();
-        let _ = self.log.append(Draw::U64(x));
+        self.fresh(Draw::U64(x));
         Ok(x)
     }
 
@@ -173,6 +234,7 @@ mod tests {
             let mut r = LoggedRng {
                 inner: &mut rng,
                 log: &mut log,
+                replaying: true,
             };
             (0..4).map(|_| r.next_u64()).collect()
         };
@@ -180,6 +242,7 @@ mod tests {
         let mut r = LoggedRng {
             inner: &mut rng,
             log: &mut log,
+            replaying: true,
         };
         let again: Vec<u64> = (0..4).map(|_| r.next_u64()).collect();
         assert_eq!(first, again);
@@ -191,6 +254,7 @@ mod tests {
         let mut r = LoggedRng {
             inner: &mut rng,
             log: &mut log,
+            replaying: true,
         };
         assert_eq!(r.next_u64(), first[0]);
         let _ = r.next_u32();
@@ -198,6 +262,7 @@ mod tests {
         let mut r = LoggedRng {
             inner: &mut rng,
             log: &mut log,
+            replaying: true,
         };
         assert_eq!(r.next_u64(), first[0]);
         assert_ne!(r.next_u64(), first[1]);
