@@ -179,10 +179,10 @@ impl<R: rand::Rng + ?Sized> rand::TryRng for LoggedRng<'_, R> {
     type Error = Infallible;
 
     fn try_next_u32(&mut self) -> Result<u32, Infallible> {
-        if self.replaying {
-            if let Some(Draw::U32(x)) = self.log.replay(|d| matches!(d, Draw::U32(_))) {
-                return Ok(x);
-            }
+        if self.replaying
+            && let Some(Draw::U32(x)) = self.log.replay(|d| matches!(d, Draw::U32(_)))
+        {
+            return Ok(x);
         }
         let x = self.inner.next_u32();
         self.fresh(Draw::U32(x));
@@ -190,10 +190,10 @@ impl<R: rand::Rng + ?Sized> rand::TryRng for LoggedRng<'_, R> {
     }
 
     fn try_next_u64(&mut self) -> Result<u64, Infallible> {
-        if self.replaying {
-            if let Some(Draw::U64(x)) = self.log.replay(|d| matches!(d, Draw::U64(_))) {
-                return Ok(x);
-            }
+        if self.replaying
+            && let Some(Draw::U64(x)) = self.log.replay(|d| matches!(d, Draw::U64(_)))
+        {
+            return Ok(x);
         }
         let x = self.inner.next_u64();
         self.fresh(Draw::U64(x));
