@@ -556,6 +556,14 @@ pub trait Family: Sized + Send + Sync + 'static {
         String::new()
     }
 
+    /// The display a quantity is looked at through, if any (W-Grey's 8-bit
+    /// image for Whitted's pixels): the reports count, per row, the
+    /// displayed values that differ from the reference's, so they say from
+    /// which budget on more work no longer changes what a person sees.
+    fn display(_quantity: Self::Quantity) -> Option<Display> {
+        None
+    }
+
     /// The family's audit of printed formulas, as Markdown, if it has one.
     fn audit() -> Option<String> {
         None
@@ -566,6 +574,19 @@ pub trait Family: Sized + Send + Sync + 'static {
     fn scene_audit(_scene: &Self::Scene) -> Option<String> {
         None
     }
+}
+
+/// A quantized display of a quantity's channels ([`Family::display`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Display {
+    /// Its name in the reports (`8-bit (W-Grey)`).
+    pub name: &'static str,
+    /// Half a display step, in the quantity's units: an error below it moves
+    /// a displayed value by at most one step (`1/510` for 8 bits over
+    /// `[0, 1]`).
+    pub half_step: f64,
+    /// The displayed value of one channel.
+    pub quantize: fn(f64) -> u8,
 }
 
 /// Serde for floats in results files that keeps the non-finite ones: JSON has

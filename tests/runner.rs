@@ -545,7 +545,7 @@ fn a_familys_value_flag_reaches_the_report_row() {
         resolution: Default::default(),
     }];
     let reference = exp.run_job((0, 64, 0)).quantities["I"].value.clone();
-    let table = rows(&rules, &jobs, "I", &reference);
+    let table = rows(&rules, &jobs, "I", &reference, None);
     assert_eq!(table.len(), 2, "{table:?}");
     for row in &table {
         let n = row
@@ -1638,7 +1638,7 @@ fn true_errors_near_the_top_of_the_range_do_not_overflow() {
         resolution: Default::default(),
     };
     let reference = [-1.7e308];
-    let rows = lightquad::experiment::report::rows(&[rule], &results, "I_E", &reference);
+    let rows = lightquad::experiment::report::rows(&[rule], &results, "I_E", &reference, None);
     let chord = 2.0 * (1.0f64 - 0.09).sqrt();
     let exact = 1.7e308 / 2.0 * (1.0 - (-2.0 * chord).exp());
     let want = exact / 1.7e308 + 1.0;
@@ -2316,4 +2316,55 @@ fn evaluations_above_the_budget_are_explained_in_the_report() {
     assert!(!md.contains(line) && !html.contains(line), "{md}");
     let _ = fs::remove_dir_all(&dir);
     let _ = fs::remove_dir_all(&dir2);
+}
+
+/// A row of an image-like quantity reports its worst channel and the
+/// channels whose 8-bit value (W-Grey) differs from the reference's, both
+/// counted here by hand: reference (0.2, 0.4), two repeats at (0.201, 0.41)
+/// and (0.2, 0.4 - 0.03). W-Grey: round(255 v); 0.2 -> 51, 0.201 -> 51
+/// (51.255), 0.4 -> 102, 0.41 -> 105 (104.55), 0.37 -> 94 (94.35).
+#[test]
+fn the_largest_channel_error_and_the_8_bit_values_off_are_counted() {
+    use lightquad::experiment::report::{RuleInfo, rows};
+    use lightquad::experiment::validate::parse_json;
+    use lightquad::family::Display;
+    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
+    let exp = lightquad::families::builtin()
+        .load(parse_json(&text).expect("parses"), "h")
+        .expect("valid");
+    let jobs: Vec<_> = [vec![0.201, 0.41], vec![0.2, 0.37]]
+        .into_iter()
+        .enumerate()
+        .map(|(repeat, value)| {
+            let mut job = exp.run_job((0, 16, repeat));
+            job.quantities.get_mut("I").expect("I").value = value;
+            job
+        })
+        .collect();
+    let rules = [RuleInfo {
+        label: "gauss-legendre".into(),
+        is_random: false,
+        min_budget: 1,
+        resolution: Default::default(),
+    }];
+    let display = Display {
+        name: "8-bit (W-Grey)",
+        half_step: 1.0 / 510.0,
+        quantize: lightquad::whitted::image::grey,
+    };
+    let reference = [0.2, 0.4];
+    let table = rows(&rules, &jobs, "I", &reference, Some(&display));
+    assert_eq!(table.len(), 1, "{table:?}");
+    let row = &table[0];
+    // Scale: rms(0.2, 0.4) = sqrt(0.1); worst channel 0.03 (second repeat).
+    let scale = 0.1f64.sqrt();
+    assert!((row.max_error - 0.03 / scale).abs() < 1e-12, "{row:?}");
+    // RMS over the four differences (0.001, 0.01, 0, -0.03).
+    let rms = ((0.001f64.powi(2) + 0.01f64.powi(2) + 0.03f64.powi(2)) / 4.0).sqrt();
+    assert!((row.rel_error - rms / scale).abs() < 1e-12, "{row:?}");
+    // One value off in each repeat.
+    assert_eq!(row.display_off, Some(1.0), "{row:?}");
+    // Without a display nothing is counted.
+    let plain = rows(&rules, &jobs, "I", &reference, None);
+    assert_eq!(plain[0].display_off, None);
 }

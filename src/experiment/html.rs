@@ -73,6 +73,7 @@ tr.warn td { background: var(--warn); }
 tr.floor td { color: var(--muted); }
 .sw { display: inline-block; width: .9em; height: .9em; border-radius: 2px; margin-right: .4em; vertical-align: -.1em; }
 td.rule { white-space: nowrap; }
+td.flags { min-width: 16rem; }
 figure { margin: 1rem 0; }
 figure svg { width: 100%; max-width: 1020px; height: auto; border: 1px solid var(--line); display: block; }
 figcaption { color: var(--muted); font-size: .9rem; }
@@ -453,9 +454,30 @@ fn section(page: &Page, s: &Section) -> String {
         escape(&s.slope_heading)
     );
     // Every row.
+    let display = page
+        .quantities
+        .iter()
+        .position(|&q| q == s.quantity)
+        .and_then(|i| page.displays.get(i).copied().flatten());
+    let (multi, display) = super::report::extra_columns(&s.rows, display.as_ref());
+    let mut extra = String::new();
+    if multi {
+        extra.push_str(&th(
+            "largest channel error",
+            "the largest error of any channel in any repeat, same scale (the worst pixel)",
+            true,
+        ));
+    }
+    if let Some(d) = display {
+        extra.push_str(&th(
+            &format!("{} values off", d.name),
+            "displayed values that differ from the reference's, mean over repeats",
+            true,
+        ));
+    }
     let _ = write!(
         b,
-        "<h3>Every rule and budget</h3>\n<div class=\"scroll\"><table class=\"sortable\"><thead><tr>{}{}{}{}{}{}{}{}</tr></thead><tbody>",
+        "<h3>Every rule and budget</h3>\n<div class=\"scroll\"><table class=\"sortable\"><thead><tr>{}{}{}{}{extra}{}{}{}{}</tr></thead><tbody>",
         th("rule", "rule or estimator", false),
         th("n", "budget", true),
         th("value", "value, mean over repeats", true),
@@ -478,7 +500,7 @@ fn section(page: &Page, s: &Section) -> String {
         th("flags", "see Flags below", false),
     );
     for r in &s.rows {
-        b.push_str(&row(page, r));
+        b.push_str(&row(page, r, multi, display.is_some()));
     }
     let _ = writeln!(
         b,
@@ -489,11 +511,16 @@ fn section(page: &Page, s: &Section) -> String {
     if let Some(line) = super::report::over_budget(page, &s.rows) {
         let _ = writeln!(b, "<p class=\"note\">{}</p>", escape(&line));
     }
+    if let (Some(d), Some(values)) = (display, page.reference.values.get(s.quantity)) {
+        let line = super::report::display_line(d, s.quantity, values, &s.rows, page);
+        let _ = writeln!(b, "<p class=\"note\">{}</p>", escape(&line));
+    }
     b
 }
 
-/// One table row of a quantity.
-fn row(page: &Page, r: &Row) -> String {
+/// One table row of a quantity, with the largest channel error (`multi`)
+/// and the displayed values off (`display`) where the table has them.
+fn row(page: &Page, r: &Row, multi: bool, display: bool) -> String {
     let class = if r.flags.iter().any(alarming) {
         " class=\"warn\""
     } else if r
@@ -511,8 +538,16 @@ fn row(page: &Page, r: &Row) -> String {
         [x] => *x,
         v => super::reference::rms(v.iter().copied()),
     };
+    let mut extra = String::new();
+    if multi {
+        extra.push_str(&num_cell(&cell(r.max_error), r.max_error));
+    }
+    if display {
+        let off = r.display_off.unwrap_or(f64::NAN);
+        extra.push_str(&num_cell(&super::report::off_cell(r.display_off), off));
+    }
     format!(
-        "<tr{class}>{}{}{}{}{}{}{}<td>{}</td></tr>",
+        "<tr{class}>{}{}{}{}{extra}{}{}{}<td class=\"flags\">{}</td></tr>",
         rule_cell(&label(page, r.rule_index)),
         num_cell(&r.budget.to_string(), r.budget as f64),
         num_cell(&show_value(&r.value), value),

@@ -57,6 +57,11 @@ pub struct Reference {
     pub note: String,
     /// Relative accuracy per quantity name (absent: unknown, taken as 0).
     pub accuracy: BTreeMap<String, f64>,
+    /// Absolute accuracy per quantity name and channel, where the reference
+    /// knows it channel by channel (a converged reference: each channel's
+    /// last change or its own error estimate, the larger; a background pixel
+    /// that every ray sees alike has 0).
+    pub channel_accuracy: BTreeMap<String, Vec<f64>>,
 }
 
 impl Reference {
@@ -348,6 +353,7 @@ pub fn reference<F: Family>(exp: &Experiment<F>) -> Reference {
             missing: names::<F>(exp, why),
             note: format!("none: {why}."),
             accuracy: BTreeMap::new(),
+            channel_accuracy: BTreeMap::new(),
         };
     };
     // Relative accuracy per quantity: the stated uncertainty against the
@@ -374,6 +380,7 @@ pub fn reference<F: Family>(exp: &Experiment<F>) -> Reference {
         missing: BTreeMap::new(),
         note: known.note.clone(),
         accuracy,
+        channel_accuracy: BTreeMap::new(),
     }
 }
 
@@ -419,6 +426,7 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
             missing: names::<F>(exp, &why),
             note: format!("none: {why}."),
             accuracy: BTreeMap::new(),
+            channel_accuracy: BTreeMap::new(),
         }
     };
     let mut coarse = match converged_measured(exp, n) {
@@ -426,7 +434,7 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
         Err(e) => return failed(e),
     };
     let mut m = n;
-    let (fine, changes) = loop {
+    let (fine, changes, per_channel) = loop {
         m *= 2;
         let fine = match converged_measured(exp, m) {
             Ok(b) => b,
@@ -454,7 +462,27 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
             .collect();
         let done = changes.values().all(|c| *c <= goal);
         if done || m >= n << MAX_DOUBLINGS {
-            break (fine, changes);
+            // Each channel's change or own error estimate, the larger.
+            let per_channel: BTreeMap<String, Vec<f64>> = exp
+                .spec
+                .quantities
+                .iter()
+                .filter_map(|q| {
+                    let (x, y) = (coarse.get(q)?, fine.get(q)?);
+                    let each = (0..y.value.len())
+                        .map(|c| {
+                            let change = match x.value.get(c) {
+                                Some(&a) => (a - y.value[c]).abs(),
+                                None => f64::NAN,
+                            };
+                            let own = y.error.get(c).copied().filter(|e| e.is_finite());
+                            own.map_or(change, |e| change.max(e.abs()))
+                        })
+                        .collect();
+                    Some((q.name().to_string(), each))
+                })
+                .collect();
+            break (fine, changes, per_channel);
         }
         coarse = fine;
     };
@@ -524,6 +552,7 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
             m / 2
         ),
         accuracy,
+        channel_accuracy: per_channel,
     }
 }
 

@@ -181,6 +181,7 @@ fn page<'a, F: Family>(
             .iter()
             .map(|&q| F::dimension(&exp.scene, q))
             .collect(),
+        displays: spec.quantities.iter().map(|&q| F::display(q)).collect(),
         rules,
         targets: &spec.targets,
         reference,

@@ -22,7 +22,7 @@
 //! let intervals: BTreeMap<usize, f64> = [8, 16, 32, 64, 128].map(|n| (n, Trapezoid.resolution(n, 1))).into();
 //! let rule = RuleInfo { label: "trapezoid".into(), is_random: false, min_budget: 2,
 //!     resolution: BTreeMap::from([(1, intervals.clone())]) };
-//! let table = rows(&[rule], &results, "exp", &[std::f64::consts::E - 1.0]);
+//! let table = rows(&[rule], &results, "exp", &[std::f64::consts::E - 1.0], None);
 //! assert_eq!(table.len(), 5);
 //! let against = Against::Resolution { dimension: 1, by_budget: Some(&intervals) };
 //! let slope = order(&table.iter().collect::<Vec<_>>(), against, 0.0).ok_or("no fit")?;
@@ -45,7 +45,7 @@ use super::fit::fitted_line;
 use super::plot;
 use super::reference::{Crosscheck, Reference, crosscheck_markdown, rms};
 use super::run::{JobResult, write_atomic};
-use crate::family::{Flag, Measured};
+use crate::family::{Display, Flag, Measured};
 
 /// What a report page shows of an experiment, whatever its family.
 #[derive(Debug, Clone)]
@@ -75,6 +75,8 @@ pub struct Page<'a> {
     pub quantities: Vec<&'static str>,
     /// Each quantity's dimension (a budget of n is n^(1/D) nodes per axis).
     pub dimensions: Vec<usize>,
+    /// Each quantity's display ([`Family::display`](crate::family::Family::display)).
+    pub displays: Vec<Option<Display>>,
     /// The rules and estimators, in the file's order.
     pub rules: Vec<RuleInfo>,
     /// Target relative errors.
@@ -174,6 +176,13 @@ pub struct Row {
     pub rel_error: f64,
     /// Mean over repeats of the root-mean-square estimated error, same scale.
     pub rel_estimate: f64,
+    /// The largest true error of any channel in any repeat, same scale (the
+    /// worst pixel of an image; `rel_error` itself for one channel).
+    pub max_error: f64,
+    /// Where the quantity has a display: mean over repeats of the channels
+    /// whose displayed value differs from the reference's (0: more work does
+    /// not change what a person sees, against this reference).
+    pub display_off: Option<f64>,
     /// Mean evaluations.
     pub evaluations: f64,
     /// Lower median wall time, seconds.
@@ -196,8 +205,16 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// Aggregates the jobs of quantity `q` into rows, with their flags.
-pub fn rows(rules: &[RuleInfo], results: &[JobResult], q: &str, reference: &[f64]) -> Vec<Row> {
+/// Aggregates the jobs of quantity `q` into rows, with their flags; with
+/// the quantity's display, each row counts the displayed values that differ
+/// from the reference's.
+pub fn rows(
+    rules: &[RuleInfo],
+    results: &[JobResult],
+    q: &str,
+    reference: &[f64],
+    display: Option<&Display>,
+) -> Vec<Row> {
     let mut groups: BTreeMap<(usize, usize), Vec<&JobResult>> = BTreeMap::new();
     for r in results {
         groups.entry((r.rule_index, r.budget)).or_default().push(r);
@@ -210,7 +227,13 @@ pub fn rows(rules: &[RuleInfo], results: &[JobResult], q: &str, reference: &[f64
         .into_iter()
         .map(|((rule_index, budget), jobs)| {
             let random = rules.get(rule_index).is_some_and(|r| r.is_random);
-            row(rule_index, budget, &jobs, q, reference, scale, random)
+            let mut row = row(rule_index, budget, &jobs, q, reference, scale, random);
+            if let Some(d) = display
+                && !row.value.is_empty()
+            {
+                row.display_off = Some(display_off(d, &jobs, q, reference));
+            }
+            row
         })
         .collect();
     // Convergence that stalls or reverses, above the rounding floor.
@@ -260,6 +283,8 @@ fn row(
             value: Vec::new(),
             rel_error: f64::NAN,
             rel_estimate: f64::NAN,
+            max_error: f64::NAN,
+            display_off: None,
             evaluations: 0.0,
             seconds,
             flags,
@@ -312,11 +337,22 @@ fn row(
             .flat_map(|m| &m.value)
             .any(|v| v.abs() > f64::MAX / 2.0);
     let (halve, double) = if huge { (0.5, 2.0) } else { (1.0, 1.0) };
-    let diffs = measured.iter().flat_map(|m| {
-        (0..channels.max(m.value.len()))
-            .map(move |c| channel(&m.value, c) * halve - channel(reference, c) * halve)
-    });
-    let rel_error = rms(diffs.collect::<Vec<_>>().into_iter()) / scale * double;
+    let diffs: Vec<f64> = measured
+        .iter()
+        .flat_map(|m| {
+            (0..channels.max(m.value.len()))
+                .map(move |c| channel(&m.value, c) * halve - channel(reference, c) * halve)
+        })
+        .collect();
+    let rel_error = rms(diffs.iter().copied()) / scale * double;
+    let max_error = diffs.iter().map(|d| d.abs()).fold(0.0, |m: f64, d| {
+        if d.is_nan() || m.is_nan() {
+            f64::NAN
+        } else {
+            m.max(d)
+        }
+    }) / scale
+        * double;
     let rel_estimate = measured
         .iter()
         .map(|m| rms(m.error.iter().copied()) / count)
@@ -332,10 +368,27 @@ fn row(
         value,
         rel_error,
         rel_estimate,
+        max_error,
+        display_off: None,
         evaluations,
         seconds,
         flags,
     }
+}
+
+/// Mean over the repeats of the channels whose displayed value differs from
+/// the reference's (a missing channel counts as differing).
+fn display_off(d: &Display, jobs: &[&JobResult], q: &str, reference: &[f64]) -> f64 {
+    let measured: Vec<&Measured> = jobs.iter().filter_map(|j| j.quantities.get(q)).collect();
+    let off = |m: &Measured| {
+        (0..reference.len().max(m.value.len()))
+            .filter(|&c| match (m.value.get(c), reference.get(c)) {
+                (Some(&v), Some(&r)) => (d.quantize)(v) != (d.quantize)(r),
+                _ => true,
+            })
+            .count() as f64
+    };
+    measured.iter().map(|m| off(m)).sum::<f64>() / measured.len().max(1) as f64
 }
 
 /// The rule's own error estimate against the truth: a random estimate more
@@ -537,7 +590,7 @@ pub struct Fit {
 /// Computes the sections of a page, one per quantity in the file's order.
 pub fn sections(page: &Page, results: &[JobResult]) -> Result<Vec<Section>, String> {
     let mut out = Vec::new();
-    for &q in &page.quantities {
+    for (i, &q) in page.quantities.iter().enumerate() {
         let Some(reference) = page.reference.values.get(q) else {
             let why = page
                 .reference
@@ -555,7 +608,8 @@ pub fn sections(page: &Page, results: &[JobResult]) -> Result<Vec<Section>, Stri
             });
             continue;
         };
-        let mut rows = rows(&page.rules, results, q, reference);
+        let display = page.displays.get(i).copied().flatten();
+        let mut rows = rows(&page.rules, results, q, reference, display.as_ref());
         let accuracy = page.reference.accuracy_of(q);
         for r in rows.iter_mut() {
             if accuracy > 0.0 && r.rel_error <= accuracy {
@@ -626,7 +680,7 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
         let _ = writeln!(md, "{audit}");
     }
     let mut summary = Summary::new();
-    for s in &sections {
+    for (i, s) in sections.iter().enumerate() {
         let q = s.quantity;
         let reference = match &s.reference {
             Ok(r) => r,
@@ -639,11 +693,18 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
                 continue;
             }
         };
+        let display = page.displays.get(i).copied().flatten();
         let _ = writeln!(
             md,
             "## {q} (reference {reference})\n\n{}",
-            table(page, &s.rows)
+            table(page, &s.rows, display.as_ref())
         );
+        if let (Some(d), Some(values)) = (
+            extra_columns(&s.rows, display.as_ref()).1,
+            page.reference.values.get(q),
+        ) {
+            let _ = writeln!(md, "{}\n", display_line(d, q, values, &s.rows, page));
+        }
         if let Some(line) = over_budget(page, &s.rows) {
             let _ = writeln!(md, "{line}");
         }
@@ -751,21 +812,48 @@ pub fn provenance(results: &[JobResult]) -> Option<String> {
     })
 }
 
-/// The table of one quantity: a row per (rule, budget).
-fn table(page: &Page, rows: &[Row]) -> String {
+/// The table of one quantity: a row per (rule, budget); with several
+/// channels the largest channel error, and with a display the displayed
+/// values off the reference's.
+fn table(page: &Page, rows: &[Row], display: Option<&Display>) -> String {
+    let (multi, display) = extra_columns(rows, display);
     let mut md = String::from(
-        "| rule | n | value (mean over repeats) | true error (root mean square over repeats; relative, absolute where the reference is 0) | estimated error (mean over repeats, same scale; a standard error for random rules) | evaluations (mean) | median time (s) | flags |\n\
-         |---|---:|---:|---:|---:|---:|---:|---|\n",
+        "| rule | n | value (mean over repeats) | true error (root mean square over repeats; relative, absolute where the reference is 0) |",
     );
+    if multi {
+        md.push_str(" largest channel error (same scale) |");
+    }
+    if let Some(d) = display {
+        let _ = write!(
+            md,
+            " {} values off the reference's (mean over repeats) |",
+            d.name
+        );
+    }
+    md.push_str(
+        " estimated error (mean over repeats, same scale; a standard error for random rules) | evaluations (mean) | median time (s) | flags |\n|---|---:|---:|---:|",
+    );
+    md.push_str(&"---:|".repeat(usize::from(multi) + usize::from(display.is_some())));
+    md.push_str("---:|---:|---:|---|\n");
     for r in rows {
         let flags: Vec<String> = r.flags.iter().map(ToString::to_string).collect();
-        let _ = writeln!(
+        let _ = write!(
             md,
-            "| {} | {} | {} | {} | {} | {:.0} | {:.2e} | {} |",
+            "| {} | {} | {} | {} |",
             label(page, r.rule_index),
             r.budget,
             show_value(&r.value),
             cell(r.rel_error),
+        );
+        if multi {
+            let _ = write!(md, " {} |", cell(r.max_error));
+        }
+        if display.is_some() {
+            let _ = write!(md, " {} |", off_cell(r.display_off));
+        }
+        let _ = writeln!(
+            md,
+            " {} | {:.0} | {:.2e} | {} |",
             cell(r.rel_estimate),
             r.evaluations,
             r.seconds,
@@ -773,6 +861,99 @@ fn table(page: &Page, rows: &[Row]) -> String {
         );
     }
     md
+}
+
+/// Whether a quantity's table has the largest-channel-error column (several
+/// channels) and the display column (a display and a row that counted).
+pub fn extra_columns<'a>(
+    rows: &[Row],
+    display: Option<&'a Display>,
+) -> (bool, Option<&'a Display>) {
+    let multi = rows.iter().any(|r| r.value.len() > 1);
+    let display = display.filter(|_| rows.iter().any(|r| r.display_off.is_some()));
+    (multi, display)
+}
+
+/// A count of displayed values off, as shown ("—" where none was counted).
+pub fn off_cell(off: Option<f64>) -> String {
+    match off {
+        None => "—".into(),
+        Some(x) if x.fract() == 0.0 => format!("{x:.0}"),
+        Some(x) => format!("{x:.1}"),
+    }
+}
+
+/// What the display column shows, in words: half a step against the
+/// table's scale, per rule the first budget from which every larger budget
+/// leaves every displayed value equal to the reference's, and how many of
+/// the reference's own displayed values its accuracy leaves in doubt.
+pub fn display_line(
+    display: &Display,
+    q: &str,
+    reference: &[f64],
+    rows: &[Row],
+    page: &Page,
+) -> String {
+    let scale = match rms(reference.iter().copied()) {
+        s if s > 0.0 => s,
+        _ => 1.0,
+    };
+    // A reference value within its accuracy of a step boundary may display
+    // either way.
+    let overall = page.reference.accuracy_of(q) * scale;
+    let each = page.reference.channel_accuracy.get(q);
+    let unsure = reference
+        .iter()
+        .enumerate()
+        .filter(|&(c, &r)| {
+            let a = each.and_then(|e| e.get(c)).copied().unwrap_or(overall);
+            (display.quantize)(r - a) != (display.quantize)(r + a)
+        })
+        .count();
+    let unsure = if overall > 0.0 || each.is_some() {
+        let how = if each.is_some() {
+            "Each channel's accuracy (its last change or own error estimate, the larger)"
+        } else {
+            "The reference's accuracy"
+        };
+        format!(
+            " {how} leaves {unsure} of the reference's own displayed values in doubt (within \
+             it of a step boundary): counts up to about {unsure} are not resolved."
+        )
+    } else {
+        String::new()
+    };
+    let mut settled = Vec::new();
+    for (i, rule) in page.rules.iter().enumerate() {
+        let mine: Vec<&Row> = rows.iter().filter(|r| r.rule_index == i).collect();
+        let from = (0..mine.len())
+            .find(|&k| mine[k..].iter().all(|r| r.display_off == Some(0.0)))
+            .map(|k| mine[k].budget);
+        let best = mine
+            .iter()
+            .filter_map(|r| r.display_off)
+            .fold(f64::INFINITY, f64::min);
+        settled.push(match from {
+            Some(n) => format!("{} from n = {n}", rule.label),
+            None if best.is_finite() => format!(
+                "{} never (at best {} off)",
+                rule.label,
+                off_cell(Some(best))
+            ),
+            None => format!("{} never", rule.label),
+        });
+    }
+    format!(
+        "{name}: a channel's displayed value; {total} in all. Half a display step, {h:.3e} absolute, \
+         is {rel:.2e} on this table's relative scale: a largest channel error below it moves no \
+         displayed value by more than one step. The displayed image equals the reference's \
+         (and more work leaves it unchanged, against this reference): {list}.{unsure}",
+        name = display.name,
+        total = reference.len(),
+        h = display.half_step,
+        rel = display.half_step / scale,
+        list = settled.join("; ")
+    )
 }
 
 /// A line saying why evaluations exceed the budget, where a row's do (its

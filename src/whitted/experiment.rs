@@ -542,6 +542,16 @@ impl Family for Whitted {
         build(spec)
     }
 
+    /// W-Grey's 8-bit image of pixels and images (not of coverage, which
+    /// is no intensity).
+    fn display(q: WhittedQuantity) -> Option<family::Display> {
+        (q != WhittedQuantity::Coverage).then_some(family::Display {
+            name: "8-bit (W-Grey)",
+            half_step: 1.0 / 510.0,
+            quantize: super::image::grey,
+        })
+    }
+
     /// The pixel square.
     fn dimension(_: &Built, _: WhittedQuantity) -> usize {
         2
