@@ -80,10 +80,13 @@ pub trait Estimator:
     /// Every estimator with default parameters (for listings and names).
     fn all() -> Vec<Self>;
     /// The resolution per axis that a budget of `n` buys in `dim`
-    /// dimensions, against which the reports fit the order per axis: `n`
-    /// for walks and samples, the points per axis for a grid.
-    fn resolution(&self, n: usize, _dim: usize) -> f64 {
-        n as f64
+    /// dimensions, against which the reports fit the order per axis, as
+    /// for the rules: the largest `m` with `m^dim <= n` (`n` itself in one
+    /// dimension; a sampler in two dimensions was fitted against `n`, and
+    /// its slope showed as half of Monte Carlo's beside it), the points per
+    /// axis for a grid.
+    fn resolution(&self, n: usize, dim: usize) -> f64 {
+        crate::quadrature::integer_root(n, dim) as f64
     }
 }
 

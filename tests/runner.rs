@@ -2368,3 +2368,58 @@ fn the_largest_channel_error_and_the_8_bit_values_off_are_counted() {
     let plain = rows(&rules, &jobs, "I", &reference, None);
     assert_eq!(plain[0].display_off, None);
 }
+
+/// r-coaxial-disk-1e-6: Gauss-Legendre returned pi for pi / (1 + 1e-12), a
+/// true error of 0.99982e-12 with an estimate of 2.2e-16, and the row went
+/// unflagged because the judge began at 1e-12 (the rows at 1.0001e-12 were
+/// flagged). An estimate more than 10x too small is judged from 1e-13.
+#[test]
+fn an_estimate_4500_times_too_small_at_an_error_of_1e_12_is_flagged() {
+    use lightquad::experiment::report::{RowFlag, RuleInfo, rows};
+    use lightquad::experiment::validate::parse_json;
+    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
+    let exp = lightquad::families::builtin()
+        .load(parse_json(&text).expect("parses"), "h")
+        .expect("valid");
+    let pi = std::f64::consts::PI;
+    let mut job = exp.run_job((0, 16, 0));
+    let m = job.quantities.get_mut("I").expect("I");
+    m.value = vec![pi];
+    m.error = vec![2.2e-16 * pi];
+    m.flags.clear();
+    let rules = [RuleInfo {
+        label: "gauss-legendre".into(),
+        is_random: false,
+        min_budget: 1,
+        resolution: Default::default(),
+    }];
+    let exact = pi / (1.0 + 1e-12);
+    let table = rows(&rules, &[job], "I", &[exact], None);
+    let row = &table[0];
+    assert!((row.rel_error - 1e-12).abs() < 1e-15, "{row:?}");
+    assert!(row.flags.contains(&RowFlag::EstimateOff), "{row:?}");
+}
+
+/// A sampler's budget in two dimensions buys sqrt(n) samples per axis, as
+/// for Monte Carlo: the MIS estimators were fitted against n, so their
+/// slopes (-0.57) showed as half of Monte Carlo's (-1.13 against sqrt n).
+#[test]
+fn a_samplers_resolution_per_axis_is_the_rules() {
+    use lightquad::family::Estimator;
+    use lightquad::quadrature::{MonteCarlo, Rule};
+    use lightquad::rendering::experiment::Mis;
+    for n in [2usize, 1024, 65536, 65537] {
+        for dim in [1usize, 2, 3] {
+            let mc = MonteCarlo.resolution(n, dim);
+            for mis in Mis::all() {
+                assert_eq!(
+                    mis.resolution(n, dim),
+                    mc,
+                    "{} n = {n}, dim = {dim}",
+                    mis.name()
+                );
+            }
+        }
+    }
+    assert_eq!(MonteCarlo.resolution(65536, 2), 256.0);
+}

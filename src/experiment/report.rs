@@ -423,9 +423,14 @@ fn judge_estimate(
         });
         outside.then_some(RowFlag::OutsideStandardErrors)
     } else {
-        let off = rel_error > 100.0 * FLOOR
-            && rel_estimate.is_finite()
-            && (rel_estimate > 10.0 * rel_error || rel_estimate < rel_error / 10.0);
+        // An estimate more than 10x too small is judged from an error of
+        // 1e-13 (ten times the floor): at a cut of 1e-12 an error of 1e-12
+        // with an estimate of 2.2e-16 went unflagged or flagged as rounding
+        // put it at 0.99997e-12 or 1.0001e-12. One more than 10x too large
+        // (the safe side) is judged from 1e-12.
+        let low = rel_error > 10.0 * FLOOR && rel_estimate < rel_error / 10.0;
+        let high = rel_error > 100.0 * FLOOR && rel_estimate > 10.0 * rel_error;
+        let off = rel_estimate.is_finite() && (low || high);
         off.then_some(RowFlag::EstimateOff)
     }
 }
