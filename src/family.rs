@@ -567,6 +567,14 @@ pub trait Family: Sized + Send + Sync + 'static {
         None
     }
 
+    /// `[width, height]` where the quantity's channels are an RGB image, in
+    /// rows from the top (R, G, B per pixel): the reports then show the
+    /// reference and each rule's image at its largest budget, with error
+    /// heat maps, as PNG (and PFM files beside them).
+    fn image(_scene: &Self::Scene, _quantity: Self::Quantity) -> Option<[usize; 2]> {
+        None
+    }
+
     /// The family's audit of printed formulas, as Markdown, if it has one.
     fn audit() -> Option<String> {
         None

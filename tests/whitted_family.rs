@@ -112,6 +112,12 @@ fn the_bundled_whitted_experiments_validate_run_and_cover_every_equation() {
             }
         }
         assert!(report.contains("## Terms and rays of this scene"), "{name}");
+        if spec["quantities"]
+            .as_array()
+            .is_some_and(|q| q.contains(&json!("image")))
+        {
+            images_are_the_results(&out.join(name), name);
+        }
         let description = spec["description"].as_str().expect("description");
         assert!(description.len() > 200, "{name}: say what the report shows");
         for id in spec["equations"].as_array().expect("equations") {
@@ -122,6 +128,112 @@ fn the_bundled_whitted_experiments_validate_run_and_cover_every_equation() {
         assert!(ids.contains(*id), "no bundled experiment for {id}");
     }
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// An image experiment's report shows each rule's mean image at its largest
+/// budget as PNG, with an error map: checked here against results.jsonl
+/// with W-Grey written out (`round(255 clamp(v, 0, 1))`) and the
+/// reference's PFM read back (f32, rows from the bottom): the PNG holds the
+/// mean's bytes, the map's white pixel is the one of the largest error, and
+/// the page shows every file.
+fn images_are_the_results(dir: &std::path::Path, name: &str) {
+    let decode = |path: &std::path::Path| -> (usize, Vec<u8>) {
+        let file = fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+            .read_info()
+            .expect("a PNG");
+        let mut buf = vec![0; reader.output_buffer_size().expect("size")];
+        let info = reader.next_frame(&mut buf).expect("a frame");
+        buf.truncate(info.buffer_size());
+        (info.width as usize, buf)
+    };
+    let grey = |v: f64| (255.0 * v.clamp(0.0, 1.0)).round() as u8;
+    let html = fs::read_to_string(dir.join("index.html")).expect("page");
+    let pfm = fs::read(dir.join(format!("{name}-image-reference.pfm"))).expect("reference PFM");
+    let header: Vec<&[u8]> = pfm.splitn(4, |&b| b == b'\n').collect();
+    let dims: Vec<usize> = std::str::from_utf8(header[1])
+        .expect("text")
+        .split(' ')
+        .map(|x| x.parse().expect("a size"))
+        .collect();
+    let (w, h) = (dims[0], dims[1]);
+    let floats: Vec<f64> = header[3]
+        .chunks_exact(4)
+        .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+        .collect();
+    // Rows from the top.
+    let reference: Vec<f64> = (0..h)
+        .rev()
+        .flat_map(|row| floats[row * 3 * w..(row + 1) * 3 * w].to_vec())
+        .collect();
+    let mut by_rule: std::collections::BTreeMap<(usize, usize), Vec<Vec<f64>>> = Default::default();
+    let mut labels = std::collections::BTreeMap::new();
+    for line in fs::read_to_string(dir.join("results.jsonl"))
+        .expect("results")
+        .lines()
+    {
+        let job: Value = serde_json::from_str(line).expect("a job");
+        let (i, n) = (
+            job["rule_index"].as_u64().expect("i") as usize,
+            job["budget"].as_u64().expect("n") as usize,
+        );
+        labels.insert(i, job["rule"].as_str().expect("rule").to_string());
+        let value: Vec<f64> = job["quantities"]["image"]["value"]
+            .as_array()
+            .expect("image values")
+            .iter()
+            .map(|v| v.as_f64().expect("a number"))
+            .collect();
+        by_rule.entry((i, n)).or_default().push(value);
+    }
+    for (i, rule) in &labels {
+        let (&(_, n), repeats) = by_rule
+            .range((*i, 0)..=(*i, usize::MAX))
+            .next_back()
+            .expect("a row");
+        let mean: Vec<f64> = (0..3 * w * h)
+            .map(|c| repeats.iter().map(|v| v[c]).sum::<f64>() / repeats.len() as f64)
+            .collect();
+        let label: String = rule
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+            .collect();
+        let stem = format!("{name}-image-{i}-{label}-n{n}");
+        let (width, bytes) = decode(&dir.join(format!("{stem}.png")));
+        assert_eq!(width, w);
+        let mine: Vec<u8> = mean.iter().map(|&v| grey(v)).collect();
+        let off = bytes.iter().zip(&mine).filter(|(a, b)| a != b).count();
+        assert_eq!(off, 0, "{stem}: {off} bytes differ from the mean's");
+        let (_, map) = decode(&dir.join(format!("{stem}-error.png")));
+        let errors: Vec<f64> = (0..w * h)
+            .map(|p| {
+                (0..3)
+                    .map(|c| (mean[3 * p + c] - reference[3 * p + c]).abs())
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        let largest = errors.iter().copied().fold(0.0, f64::max);
+        if largest > 1e-6 {
+            let white = (0..w * h)
+                .find(|&p| map[3 * p..3 * p + 3] == [255, 255, 255])
+                .unwrap_or_else(|| panic!("{stem}: no white pixel in the error map"));
+            assert!(
+                errors[white] >= 0.999 * largest,
+                "{stem}: white at {white}, error {} of {largest}",
+                errors[white]
+            );
+        }
+        for file in [
+            format!("{stem}.png"),
+            format!("{stem}-error.png"),
+            format!("{stem}.pfm"),
+        ] {
+            assert!(
+                html.contains(&format!("\"{file}\"")),
+                "{name}: the page does not show {file}"
+            );
+        }
+    }
 }
 
 // ------------------------------------------------------- (2) closed forms

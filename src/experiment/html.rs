@@ -74,6 +74,9 @@ tr.floor td { color: var(--muted); }
 .sw { display: inline-block; width: .9em; height: .9em; border-radius: 2px; margin-right: .4em; vertical-align: -.1em; }
 td.rule { white-space: nowrap; }
 td.flags { min-width: 16rem; }
+.images { display: flex; flex-wrap: wrap; gap: 1rem; }
+.images figure { margin: 0; max-width: 520px; }
+img.px { image-rendering: pixelated; margin-right: .3rem; border: 1px solid var(--line); }
 figure { margin: 1rem 0; }
 figure svg { width: 100%; max-width: 1020px; height: auto; border: 1px solid var(--line); display: block; }
 figcaption { color: var(--muted); font-size: .9rem; }
@@ -417,6 +420,33 @@ fn section(page: &Page, s: &Section) -> String {
         );
     }
     b.push_str("</div>\n");
+    // The images of an image-valued quantity, drawn large with square pixels.
+    if !s.pictures.is_empty() {
+        b.push_str("<h3>Images</h3>\n<div class=\"images\">");
+        for p in &s.pictures {
+            let shown = (240 / p.width.max(1)).max(1) * p.width;
+            let _ = write!(
+                b,
+                "<figure><img class=\"px\" src=\"{}\" width=\"{shown}\" alt=\"{}\">",
+                escape(&p.png),
+                escape(&p.caption)
+            );
+            if let Some(e) = &p.error_png {
+                let _ = write!(
+                    b,
+                    "<img class=\"px\" src=\"{}\" width=\"{shown}\" alt=\"error map\">",
+                    escape(e)
+                );
+            }
+            let _ = write!(
+                b,
+                "<figcaption>{} (<a href=\"{}\">PFM</a>)</figcaption></figure>",
+                escape(&p.caption),
+                escape(&p.pfm)
+            );
+        }
+        b.push_str("</div>\n");
+    }
     // Fitted slopes and times to the targets.
     let _ = write!(
         b,

@@ -182,6 +182,11 @@ fn page<'a, F: Family>(
             .map(|&q| F::dimension(&exp.scene, q))
             .collect(),
         displays: spec.quantities.iter().map(|&q| F::display(q)).collect(),
+        images: spec
+            .quantities
+            .iter()
+            .map(|&q| F::image(&exp.scene, q))
+            .collect(),
         rules,
         targets: &spec.targets,
         reference,

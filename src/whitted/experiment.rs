@@ -542,6 +542,12 @@ impl Family for Whitted {
         build(spec)
     }
 
+    /// The image quantity is the camera's image.
+    fn image(built: &Built, q: WhittedQuantity) -> Option<[usize; 2]> {
+        let cam = &built.scene.camera;
+        (q == WhittedQuantity::Image).then(|| [cam.width(), cam.height()])
+    }
+
     /// W-Grey's 8-bit image of pixels and images (not of coverage, which
     /// is no intensity).
     fn display(q: WhittedQuantity) -> Option<family::Display> {
