@@ -311,3 +311,100 @@ fn the_fov_minimum_is_stated_and_phong_zero_is_accepted() {
     });
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// The cost guard counts the work of one evaluation (issue 10, the hostile
+/// probe of session 21): a lookup in 2000 Gaussian blobs, a sample's shadow
+/// ray against 2000 occluders, a ray against 500 objects each passed as one
+/// evaluation, and jobs of days were accepted. Each is refused now, at
+/// `budgets`, with its estimate; without the factor each stays under 1e11.
+#[test]
+fn the_cost_guard_counts_blobs_occluders_and_objects() {
+    let blob = |i: usize| json!({"centre": [-5.0 + 0.005 * i as f64, 0.0, 0.0], "amplitude": 0.5, "width": 0.3});
+    let volume = json!({
+        "name": "blobs", "family": "volume",
+        "scene": {"depth_scheme": "nested", "ray": {"origin": [-6, 0, 0.05], "direction": [1, 0.02, 0]},
+                  "medium": {"type": "gaussian-blobs", "blobs": (0..2000).map(blob).collect::<Vec<_>>()},
+                  "lambda": 1.0, "emission": {"type": "constant", "c": 1.0}},
+        "quantities": ["I_E"], "rules": [{"rule": "gauss-legendre"}], "budgets": [27000],
+        "repeats": 1, "reference": {"type": "converged", "n": 16}
+    });
+    refused(
+        &check_text(&volume.to_string()),
+        "budgets",
+        &["gauss-legendre", "e14", "--no-cost-limit"],
+    );
+    let tri = |i: usize| {
+        let x = 10.0 + 0.001 * i as f64;
+        json!({"type": "triangle", "a": [x, 10, 1], "b": [x + 0.0005, 10, 1], "c": [x, 10.0005, 1]})
+    };
+    let rendering = json!({
+        "name": "occluders", "family": "rendering",
+        "scene": {"receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+                  "emitters": [{"type": "rectangle", "origin": [-1.0, -1.0, 2.0], "edge_u": [0.0, 2.0, 0.0],
+                                "edge_v": [2.0, 0.0, 0.0], "radiance": 1.0}],
+                  "occluders": (0..2000).map(tri).collect::<Vec<_>>()},
+        "quantities": ["E_area"], "rules": [{"rule": "monte-carlo"}], "budgets": [100000000],
+        "repeats": 1, "reference": {"type": "value", "values": {"E_area": 0.5}, "uncertainty": 0.001}
+    });
+    refused(
+        &check_text(&rendering.to_string()),
+        "budgets",
+        &["monte-carlo", "e11", "--no-cost-limit"],
+    );
+    let mut whitted: Value = serde_json::from_str(
+        &fs::read_to_string(root().join("experiments/w-grey-test-scene.json")).expect("read"),
+    )
+    .expect("json");
+    whitted["name"] = json!("objects");
+    let objects = whitted["scene"]["objects"].as_array_mut().expect("objects");
+    for i in 0..497 {
+        objects.push(
+            json!({"type": "sphere", "centre": [50.0 + i as f64, -50, -50], "radius": 0.001,
+                            "material": {"k_a": 0.2, "k_d": 0.3}}),
+        );
+    }
+    whitted["rules"] = json!([{"rule": "grid"}]);
+    whitted["budgets"] = json!([1000000]);
+    refused(
+        &check_text(&whitted.to_string()),
+        "budgets",
+        &["grid", "e12", "--no-cost-limit"],
+    );
+}
+
+/// The whole experiment is guarded too: 6 rules at 174 budgets, 1000
+/// repeats each (a million jobs), and a 16384 x 16384 image (116 GB of results) passed the
+/// per-job guard.
+#[test]
+fn the_cost_guard_bounds_the_jobs_and_the_results_of_an_experiment() {
+    let o = check_edited("calibration-exp.json", |v| {
+        v["rules"] = json!([{"rule": "monte-carlo"}, {"rule": "stratified"}, {"rule": "sobol"},
+                            {"rule": "trapezoid"}, {"rule": "simpson"}, {"rule": "gauss-legendre"}]);
+        v["budgets"] = json!({"from": 8, "to": 1000000, "factor": 1.07});
+        v["repeats"] = json!(1000);
+    });
+    refused(
+        &o,
+        "budgets",
+        &["jobs", "expected at most 1e6", "--no-cost-limit"],
+    );
+    let o = check_edited("w-grey-test-scene.json", |v| {
+        v["scene"]["camera"]["width"] = json!(16384);
+        v["scene"]["camera"]["height"] = json!(16384);
+        v["scene"]["lights"] = json!([]);
+        v["scene"]["objects"] = json!([{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0],
+                                        "material": {"k_a": 0.3, "colour": [0.8, 0.8, 0.7]}}]);
+        v["rules"] = json!([{"rule": "centre"}]);
+        v["budgets"] = json!([1]);
+        v["reference"] = json!({"type": "closed-form"});
+    });
+    refused(
+        &o,
+        "budgets",
+        &[
+            "GB of results",
+            "expected at most 2.0 GB",
+            "--no-cost-limit",
+        ],
+    );
+}

@@ -354,6 +354,20 @@ pub const MAX_JOB_EVALUATIONS: f64 = 1e11;
 /// GB). `--no-cost-limit` lifts it too.
 pub const MAX_JOB_BYTES: f64 = 4.0 * (1u64 << 30) as f64;
 
+/// The most work a whole experiment may cost by its family's estimates
+/// (every rule at every budget it runs, every repeat): 1e12 simple
+/// evaluations, hours on a few cores. 300 rules at 185 budgets and 1000
+/// repeats passed the per-job guard: 55 million jobs, 3e14 evaluations.
+pub const MAX_EXPERIMENT_EVALUATIONS: f64 = 1e12;
+
+/// The most jobs one experiment may have (rules x budgets x repeats).
+pub const MAX_JOBS: f64 = 1e6;
+
+/// The most bytes of results one experiment may write, estimated at 400
+/// bytes a job and 48 a channel (value and error): 2 GB. An image of
+/// 1024 x 1024 pixels wrote 106 MB of results.jsonl for a few jobs.
+pub const MAX_RESULTS_BYTES: f64 = 2e9;
+
 static COST_LIMIT_LIFTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// Lets experiments whose jobs cost more than [`MAX_JOB_EVALUATIONS`] through
@@ -443,6 +457,58 @@ fn check_cost<F: Family>(
                 ),
             ));
         }
+    }
+    // The whole experiment: every rule at each budget it runs, every repeat.
+    let repeats = spec.repeats as f64;
+    let (mut jobs, mut total) = (0.0, 0.0);
+    for m in &spec.rules {
+        let need = min_budget::<F>(scene, m, &spec.quantities);
+        for &b in budgets.iter().filter(|&&b| b >= need) {
+            jobs += repeats;
+            total += repeats
+                * spec
+                    .quantities
+                    .iter()
+                    .map(|&q| F::cost(scene, m, b, q))
+                    .sum::<f64>();
+        }
+    }
+    let channels: f64 = spec
+        .quantities
+        .iter()
+        .map(|&q| F::channels(scene, q) as f64)
+        .sum();
+    let written = jobs * (400.0 + 48.0 * channels);
+    let whole = "rules x budgets x repeats";
+    let lower =
+        "(fewer rules, budgets or repeats, or pass --no-cost-limit to check and run to go ahead)";
+    if total.is_nan() || total > MAX_EXPERIMENT_EVALUATIONS {
+        return Err(SpecError::at(
+            "budgets",
+            format!(
+                "the experiment's {jobs:.0} jobs ({whole}) cost about {total:.1e} integrand \
+                 evaluations in all: expected at most {MAX_EXPERIMENT_EVALUATIONS:.0e} {lower}"
+            ),
+        ));
+    }
+    if jobs > MAX_JOBS {
+        return Err(SpecError::at(
+            "budgets",
+            format!(
+                "the experiment has {jobs:.0} jobs ({whole}): expected at most {MAX_JOBS:.0e} {lower}"
+            ),
+        ));
+    }
+    if written > MAX_RESULTS_BYTES {
+        return Err(SpecError::at(
+            "budgets",
+            format!(
+                "the experiment's {jobs:.0} jobs of {channels:.0} channels each would write about \
+                 {:.1} GB of results: expected at most {:.1} GB {lower}",
+                written / 1e9,
+                MAX_RESULTS_BYTES / 1e9
+            ),
+        ));
     }
     Ok(())
 }

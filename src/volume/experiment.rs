@@ -578,8 +578,18 @@ impl Family for Volume {
         let (scene, _) = built.scene.anchored();
         let (_, depth) = scene.depth_bound();
         let n = budget as f64;
+        // Lookups, each as costly as the costliest field's.
+        let work = scene
+            .medium
+            .iter()
+            .map(|m| m.lookup_work())
+            .chain(match &scene.emission {
+                Some(EmissionMap::Field(f)) => Some(f.lookup_work()),
+                _ => None,
+            })
+            .fold(1.0, f64::max);
         let rule = match method {
-            Method::Estimator(_) => return n * (1.0 + depth),
+            Method::Estimator(_) => return n * (1.0 + depth) * work,
             Method::Rule(rule) => rule,
         };
         // A rule's evaluations at the budget, its error estimate's included
@@ -637,7 +647,7 @@ impl Family for Volume {
         } else {
             0.0
         };
-        match quantity {
+        work * match quantity {
             Tau | LnTau | Background => tau,
             Emission => tau + emission,
             Light => tau + light,

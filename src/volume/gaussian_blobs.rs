@@ -106,6 +106,11 @@ impl Medium for GaussianBlobs {
         "gaussian-blobs"
     }
 
+    /// One term per blob.
+    fn lookup_work(&self) -> f64 {
+        self.blobs.len().max(1) as f64
+    }
+
     fn density(&self, p: Vec3) -> f64 {
         self.blobs
             .iter()

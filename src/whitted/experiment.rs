@@ -691,13 +691,16 @@ impl WhittedQuantity {
     }
 }
 
-/// About how many rays one primary ray costs in `scene`: itself, a shadow
-/// ray per light per hit, and up to two secondary rays per level.
+/// About how much work one primary ray costs in `scene`, in ray-object
+/// tests: itself, a shadow ray per light per hit, and up to two secondary
+/// rays per level, each tested against every object.
 fn per_primary(scene: &Scene) -> f64 {
     let lights = scene.lights.len() as f64;
     let branches = f64::from(u8::from(scene.has_mirrors()) + u8::from(scene.has_transparency()));
     let hits: f64 = (0..=scene.max_depth).map(|d| branches.powi(d as i32)).sum();
-    hits * (1.0 + lights)
+    // Every ray tests every object (50 000 spheres made a ray 0.3 ms).
+    let objects = scene.objects.len().max(1) as f64;
+    hits * (1.0 + lights) * objects
 }
 
 /// The film region whose primary rays meet a shape, when it is a convex
