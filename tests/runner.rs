@@ -947,6 +947,73 @@ fn merge_prefers_a_finished_job_over_a_failed_copy() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// Shards that disagree on a finished job's values (an appended line with
+/// another value was merged without a word), and unreadable lines in a
+/// shard, make `merge` say so and fail; a merged folder holds its
+/// experiment file, so it can be merged again (it could not: no
+/// experiment.json).
+#[test]
+fn merge_says_where_shards_disagree_and_its_output_merges_again() {
+    let dir = scratch("mergeconflict");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let good = dir.join("a-good");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&good)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let merged = dir.join("merged");
+    let o = bin()
+        .args(["merge", "--out"])
+        .arg(&merged)
+        .arg(&good)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(merged.join("t/experiment.json").is_file());
+    let again = dir.join("again");
+    let o = bin()
+        .args(["merge", "--out"])
+        .arg(&again)
+        .arg(&merged)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    same(&results(&again, "t"), &results(&good, "t"));
+    // A copy with one value changed, and a line of garbage.
+    let other = dir.join("b-other");
+    fs::create_dir_all(other.join("t")).expect("folder");
+    fs::copy(
+        good.join("t/experiment.json"),
+        other.join("t/experiment.json"),
+    )
+    .expect("copy");
+    let text = fs::read_to_string(good.join("t/results.jsonl")).expect("results");
+    let first = text.lines().next().expect("a line");
+    let mut v: serde_json::Value = serde_json::from_str(first).expect("json");
+    v["quantities"]["tau"]["value"] = serde_json::json!([9.99]);
+    fs::write(other.join("t/results.jsonl"), format!("{v}\n{{garbage\n")).expect("write");
+    let conflict = dir.join("conflict");
+    let o = bin()
+        .args(["merge", "--out"])
+        .arg(&conflict)
+        .arg(&good)
+        .arg(&other)
+        .output()
+        .expect("runs");
+    let msg = stderr(&o);
+    assert!(!o.status.success(), "accepted: {msg}");
+    assert!(
+        msg.contains("1 job(s) with different values in two shards"),
+        "{msg}"
+    );
+    assert!(msg.contains("1 unreadable line(s)"), "{msg}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
 /// A job whose error estimate is infinite (Gauss–Legendre without its
 /// estimate) survives the results file: merge and resume read it back (JSON
 /// has no infinity; it used to be written as null and then dropped).

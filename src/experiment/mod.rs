@@ -51,7 +51,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 pub use registry::{FamilyEntry, Loaded, Registry};
-use run::{JobResult, RunOptions, file_hash, read_results, run_experiment, write_atomic};
+use run::{JobResult, RunOptions, file_hash, run_experiment, write_atomic};
 pub use source::Source;
 pub use validate::SpecError;
 
@@ -389,7 +389,7 @@ fn write_reports(
 /// Joins the shards' results under `inputs` (written by `run --shard k/n` into
 /// the same or copied folders) into one results file and report per experiment.
 pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
-    let mut by_name: BTreeMap<String, (Box<dyn Loaded>, Vec<JobResult>)> = BTreeMap::new();
+    let mut by_name: BTreeMap<String, Gathered> = BTreeMap::new();
     // Shards still writing into an input would be merged half done.
     let mut reading = Vec::new();
     for input in inputs {
@@ -453,12 +453,46 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
     let _lock = lock_output(out, None)?;
     let mut missing = Vec::new();
     let mut done = Vec::new();
-    for (name, (exp, mut results)) in by_name {
+    for (name, g) in by_name {
+        let Gathered {
+            exp,
+            mut results,
+            spec,
+            unread,
+        } = g;
         // One result per job of this experiment, a finished one before a
         // failed one where shards disagree.
         let expected: BTreeSet<_> = exp.jobs(None).into_iter().collect();
         results.retain(|r| expected.contains(&r.key()));
         results.sort_by_key(|r| (r.key(), r.failure.is_some()));
+        // Two finished results of one job must agree (a job is
+        // deterministic): values that differ mean an edited or foreign
+        // shard, said and not settled in silence (9.99 from an appended
+        // line was merged without a word).
+        let conflicts: Vec<String> = results
+            .windows(2)
+            .filter(|w| {
+                w[0].key() == w[1].key()
+                    && w[0].failure.is_none()
+                    && w[1].failure.is_none()
+                    && values_differ(&w[0], &w[1])
+            })
+            .map(|w| format!("{:?}", w[0].key()))
+            .collect();
+        if !conflicts.is_empty() {
+            missing.push(format!(
+                "{name}: {} job(s) with different values in two shards (rule, budget, repeat: {}): \
+                 which is right cannot be told: the first in the folders' order was kept",
+                conflicts.len(),
+                conflicts.join(", ")
+            ));
+        }
+        if unread.unreadable > 0 {
+            missing.push(format!(
+                "{name}: {} unreadable line(s) in the shards' results were passed over",
+                unread.unreadable
+            ));
+        }
         results.dedup_by_key(|r| r.key());
         if results.len() < expected.len() {
             missing.push(format!(
@@ -469,6 +503,9 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
         }
         let dir = out.join(&name);
         fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
+        // The experiment file beside its results, so the merged folder is
+        // one `merge` and the report's link can read again.
+        write_atomic(&dir.join("experiment.json"), &spec).map_err(|e| io(&dir, e))?;
         let mut text = String::new();
         for r in &results {
             text.push_str(&serde_json::to_string(r).map_err(|e| io(&dir, e))?);
@@ -480,17 +517,50 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
     write_reports(registry, out, &done, missing)
 }
 
+/// One experiment's shards as `merge` gathers them: the experiment, its
+/// results, the experiment file's bytes and the lines not read.
+struct Gathered {
+    exp: Box<dyn Loaded>,
+    results: Vec<JobResult>,
+    spec: Vec<u8>,
+    unread: run::Unread,
+}
+
+/// Whether two results of one job hold different values or errors (bit for
+/// bit: a job is deterministic).
+fn values_differ(a: &JobResult, b: &JobResult) -> bool {
+    let bits = |r: &JobResult| -> Vec<(String, Vec<u64>, Vec<u64>)> {
+        r.quantities
+            .iter()
+            .map(|(q, m)| {
+                (
+                    q.clone(),
+                    m.value.iter().map(|v| v.to_bits()).collect(),
+                    m.error.iter().map(|v| v.to_bits()).collect(),
+                )
+            })
+            .collect()
+    };
+    bits(a) != bits(b)
+}
+
 /// Adds one shard folder's experiment and results to `by_name`.
 fn gather(
     registry: &Registry,
     spec_file: &Path,
-    by_name: &mut BTreeMap<String, (Box<dyn Loaded>, Vec<JobResult>)>,
+    by_name: &mut BTreeMap<String, Gathered>,
 ) -> Result<(), RunError> {
     let exp = load(registry, spec_file)?;
+    let spec = fs::read(spec_file).map_err(|e| io(spec_file, e))?;
     let hash = exp.hash().to_string();
     let name = exp.name().to_string();
-    let slot = by_name.entry(name).or_insert_with(|| (exp, Vec::new()));
-    if slot.0.hash() != hash {
+    let slot = by_name.entry(name).or_insert_with(|| Gathered {
+        exp,
+        results: Vec::new(),
+        spec,
+        unread: run::Unread::default(),
+    });
+    if slot.exp.hash() != hash {
         return Err(io(
             spec_file,
             "a different version of this experiment than the other shards (hash differs)",
@@ -510,8 +580,9 @@ fn gather(
     files.sort();
     for f in files {
         // Lines of this lightquad version only, as `--resume` keeps.
-        let lines = read_results(&f, Some(&hash));
-        slot.1.extend(
+        let (lines, unread) = run::read_results_counted(&f, Some(&hash));
+        slot.unread.unreadable += unread.unreadable;
+        slot.results.extend(
             lines
                 .into_iter()
                 .filter(|r| r.version == env!("CARGO_PKG_VERSION")),
