@@ -187,8 +187,24 @@ fn run(command: Command) -> Result<(), Failure> {
             if no_cost_limit {
                 experiment::validate::lift_cost_limit();
             }
+            // Names shared between files are refused as `run` refuses them.
+            let mut names = std::collections::BTreeMap::new();
             for f in sources(files)? {
                 let exp = experiment::load_source(&registry, &f)?;
+                if let Some(other) = names.insert(exp.name().to_string(), f.display()) {
+                    return Err(experiment::RunError::Spec {
+                        file: f.display(),
+                        source: lightquad::error::SpecError::at(
+                            "name",
+                            format!(
+                                "{:?} is also the name of {other}: one run (one output folder) \
+                                 cannot hold both; rename one",
+                                exp.name()
+                            ),
+                        ),
+                    }
+                    .into());
+                }
                 for w in exp.warnings() {
                     eprintln!(
                         "warning: {}: {}",

@@ -408,3 +408,37 @@ fn the_cost_guard_bounds_the_jobs_and_the_results_of_an_experiment() {
         ],
     );
 }
+
+/// `check` refuses two files of one name as `run` does (it said ok to both,
+/// and `run` then refused them).
+#[test]
+fn check_refuses_two_files_of_one_name() {
+    let dir = scratch("dupname");
+    let a = root().join("experiments/calibration-exp.json");
+    let b = dir.join("copy.json");
+    fs::copy(&a, &b).expect("copy");
+    let o = bin().arg("check").arg(&a).arg(&b).output().expect("runs");
+    refused(
+        &o,
+        "name",
+        &["\"calibration-exp\" is also the name of", "rename one"],
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A Mitsuba reference naming a file that is not there is refused naming
+/// that file first (the message spoke only of the bundled values being
+/// stale).
+#[test]
+fn a_missing_values_file_is_named() {
+    let o = check_edited("mitsuba-tau-constant-sphere.json", |v| {
+        // Its own name, so the bundled (now stale) values are found.
+        v["name"] = json!("mitsuba-tau-constant-sphere");
+        v["reference"] = json!({"type": "mitsuba", "file": "nonexist.json"});
+    });
+    refused(
+        &o,
+        "reference.file",
+        &["nonexist.json", "could not be read", "stale"],
+    );
+}

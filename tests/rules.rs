@@ -800,3 +800,34 @@ fn stratified_intervals_cover_where_one_cell_carries_the_variance() {
     let singular = cover(64, &|x| x.powf(-0.25), 4.0 / 3.0);
     assert!(singular >= 0.87, "x^-1/4 at n = 64: {singular}");
 }
+
+/// A budget whose working memory cannot fit is refused at once, naming `n`
+/// and the memory: G7-K15 and Genz-Malik at n = 2^40 (accepted by the
+/// budget limit) grew to gigabytes until the machine ran out.
+#[test]
+fn a_budget_whose_working_memory_cannot_fit_is_refused_at_once() {
+    use rand::SeedableRng;
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+    let n = 1usize << 40;
+    let started = std::time::Instant::now();
+    let gk = GaussKronrod::default().integrate(n, &mut rng, |u: [f64; 1]| (1e3 * u[0]).sin());
+    let gm = lightquad::quadrature::GenzMalik::default()
+        .integrate(n, &mut rng, |u: [f64; 2]| (1e3 * u[0] * u[1]).sin());
+    let gl = GaussLegendre::default().integrate(n, &mut rng, |u: [f64; 1]| u[0]);
+    for (name, r) in [
+        ("gauss-kronrod", gk),
+        ("genz-malik", gm),
+        ("gauss-legendre", gl),
+    ] {
+        let msg = r.expect_err(name).to_string();
+        assert!(
+            msg.contains("invalid n = 1099511627776") && msg.contains("GB"),
+            "{name}: {msg}"
+        );
+    }
+    // Refused, not run: far below the time a single pass would take.
+    assert!(started.elapsed().as_secs() < 60);
+    // A budget that fits still runs.
+    let ok = GaussKronrod::default().integrate(1000, &mut rng, |u: [f64; 1]| u[0]);
+    assert!((ok.expect("fits").value - 0.5).abs() < 1e-14);
+}

@@ -123,7 +123,18 @@ pub fn known_values<F: Family>(
                 Values::Stale {
                     location,
                     made_from,
-                } => return Err(stale_values(&location, &made_from, hash)),
+                    named_missing,
+                } => {
+                    let stale = stale_values(&location, &made_from, hash);
+                    return Err(match named_missing {
+                        // The named file is the fault: say so first.
+                        Some(missing) => SpecError::at(
+                            at,
+                            format!("{missing} could not be read; and {}", stale.message),
+                        ),
+                        None => stale,
+                    });
+                }
                 Values::NotValues { location, why } => {
                     return Err(SpecError::at(at, not_values(&location, &why)));
                 }
@@ -590,6 +601,7 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
         Values::Stale {
             location,
             made_from,
+            ..
         } => (
             serde_json::Value::Null,
             Some(format!(

@@ -145,6 +145,9 @@ pub enum Values {
         location: String,
         /// The hash they were made from.
         made_from: String,
+        /// The file the reference names, where it could not be read, and
+        /// why (the stale values were found elsewhere).
+        named_missing: Option<String>,
     },
     /// The file the reference names exists but is not a values file (another
     /// JSON file, not JSON, a folder): said as such, not reported stale
@@ -171,6 +174,7 @@ pub enum Values {
 pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>) -> Values {
     // Each place with its values, or why it has none (said when none is found).
     let mut places: Vec<(String, Result<serde_json::Value, String>)> = Vec::new();
+    let mut named_missing = None;
     if let Origin::Folder(dir) = origin {
         if let Some(file) = named {
             let path = resolve(dir, file);
@@ -184,6 +188,9 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
                     location: path.display().to_string(),
                     why: why.clone(),
                 };
+            }
+            if let Err(why) = &json {
+                named_missing = Some(format!("{} ({why})", path.display()));
             }
             places.push((path.display().to_string(), json));
         }
@@ -218,6 +225,7 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
         stale.get_or_insert(Values::Stale {
             location: location.clone(),
             made_from,
+            named_missing: named_missing.clone(),
         });
     }
     if let Some(s) = stale {

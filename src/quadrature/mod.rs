@@ -207,6 +207,23 @@ pub trait Rule {
                 format!("a budget of at most 2^40 = {MAX_BUDGET} evaluations"),
             ));
         }
+        // Working memory that grows with n (an adaptive rule's intervals, a
+        // node table): G7-K15 at n = 2^40 grew to gigabytes until the machine
+        // ran out.
+        let bytes = self.memory(n, D);
+        if bytes > MAX_RULE_BYTES {
+            return Err(QuadError::invalid(
+                "n",
+                n,
+                format!(
+                    "a budget whose working memory fits: {} needs about {:.0} GB at this n, at \
+                     most {:.0} GB is accepted",
+                    self.name(),
+                    bytes / 1e9,
+                    MAX_RULE_BYTES / 1e9
+                ),
+            ));
+        }
         let promise = (n as u64).max(self.evaluations(n, D) as u64);
         let mut points = replay::Log::<([f64; D], V)>::new();
         let mut draws = replay::Log::<replay::Draw>::new();
@@ -427,6 +444,12 @@ pub(crate) fn check_tolerances(abs_tol: f64, rel_tol: f64) -> Result<(), QuadErr
 /// from an unchecked computation) is refused at once instead of looping for
 /// centuries.
 pub const MAX_BUDGET: usize = 1 << 40;
+
+/// The most working memory one integral may need by its rule's own
+/// estimate ([`Rule::memory`]): 32 GiB, more than the machines this runs on
+/// hold; a larger `n` is refused at once instead of growing until the
+/// machine runs out.
+pub const MAX_RULE_BYTES: f64 = 32.0 * (1u64 << 30) as f64;
 
 /// `x 2^e` exactly (while representable), in two steps so that each power
 /// of two is a normal number for every `e` in `-1074..=1023`.
