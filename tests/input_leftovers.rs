@@ -442,3 +442,32 @@ fn a_missing_values_file_is_named() {
         &["nonexist.json", "could not be read", "stale"],
     );
 }
+
+/// A radiance whose integrands overflow is refused at its path (1e308 was
+/// accepted, and 10 of 14 jobs then failed with "integrand returned inf");
+/// 1e290, the largest accepted, runs every job.
+#[test]
+fn a_radiance_that_overflows_the_integrands_is_refused() {
+    let o = check_edited("r-shadow-boundary.json", |v| {
+        v["scene"]["emitters"][0]["radiance"] = json!(1e308);
+    });
+    refused(&o, "scene.emitters[0].radiance", &["1e308", "[0, 1e290]"]);
+    let dir = scratch("radiance");
+    let mut v: Value = serde_json::from_str(
+        &fs::read_to_string(root().join("experiments/r-shadow-boundary.json")).expect("read"),
+    )
+    .expect("json");
+    v["name"] = json!("bright");
+    v["scene"]["emitters"][0]["radiance"] = json!(1e290);
+    v["budgets"] = json!([4, 16, 64]);
+    let f = dir.join("bright.json");
+    fs::write(&f, v.to_string()).expect("write");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(dir.join("out"))
+        .arg(&f)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
+}
