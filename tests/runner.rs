@@ -2490,3 +2490,17 @@ fn a_samplers_resolution_per_axis_is_the_rules() {
     }
     assert_eq!(MonteCarlo.resolution(65536, 2), 256.0);
 }
+
+/// The runner runs no more jobs at once than the memory available holds
+/// (four jobs of 4 GB on four threads aborted a run): 80% of it over the
+/// largest job's estimate, at least one, no cap where memory is unknown.
+#[test]
+fn jobs_at_once_fit_the_memory_available() {
+    use lightquad::experiment::jobs_that_fit;
+    assert_eq!(jobs_that_fit(4e9, Some(8e9)), 1);
+    assert_eq!(jobs_that_fit(5.6e9, Some(24e9)), 3);
+    assert_eq!(jobs_that_fit(1e9, Some(8e9)), 6);
+    assert_eq!(jobs_that_fit(9e9, Some(8e9)), 1);
+    assert_eq!(jobs_that_fit(0.0, Some(8e9)), usize::MAX);
+    assert_eq!(jobs_that_fit(4e9, None), usize::MAX);
+}

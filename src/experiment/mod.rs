@@ -304,7 +304,26 @@ pub fn run_sources(
         }
         bar.set_message(exp.name().to_string());
         let started = std::time::Instant::now();
-        let results = run_experiment(exp.as_ref(), opts, &bar).map_err(|e| io(&dir, e))?;
+        // No more jobs at once than the machine's memory holds (four jobs of
+        // 4 GB each on four threads aborted the run).
+        let threads = rayon::current_num_threads();
+        let fit = jobs_that_fit(exp.max_job_bytes(), available_memory()).min(threads);
+        let results = if fit < threads {
+            eprintln!(
+                "{}: its largest jobs hold about {:.1} GB each: {fit} at a time instead of \
+                 {threads}, to fit in the memory available",
+                exp.name(),
+                exp.max_job_bytes() / 1e9
+            );
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(fit)
+                .build()
+                .map_err(|e| io(&dir, e))?
+                .install(|| run_experiment(exp.as_ref(), opts, &bar))
+        } else {
+            run_experiment(exp.as_ref(), opts, &bar)
+        }
+        .map_err(|e| io(&dir, e))?;
         progress::finished(opts.progress, &bar, exp.name(), &results, started.elapsed());
         done.push((exp, results));
     }
@@ -321,6 +340,25 @@ pub fn run_sources(
         };
     }
     write_reports(registry, &opts.out, &done, Vec::new())
+}
+
+/// How many jobs of `bytes` each fit at once in `available` bytes (at
+/// least one: a single job was checked against the per-job limit; unknown
+/// memory caps nothing).
+pub fn jobs_that_fit(bytes: f64, available: Option<f64>) -> usize {
+    match available {
+        Some(a) if bytes > 0.0 => ((0.8 * a / bytes).floor() as usize).max(1),
+        _ => usize::MAX,
+    }
+}
+
+/// The memory available to new work (`MemAvailable` of /proc/meminfo), in
+/// bytes; `None` where the system does not say.
+fn available_memory() -> Option<f64> {
+    let text = fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
 }
 
 /// Failed and total jobs.

@@ -65,6 +65,11 @@ pub trait Loaded: Send + Sync {
     /// Doubts about its scene that do not stop it ([`Family::warnings`]),
     /// each at its JSON path.
     fn warnings(&self) -> Vec<SpecError>;
+    /// The memory its costliest job holds by the family's estimate
+    /// ([`Family::memory`]: every rule at the largest budget, every
+    /// quantity), in bytes: the runner runs fewer jobs at once where the
+    /// machine cannot hold one per thread.
+    fn max_job_bytes(&self) -> f64;
 }
 
 impl<F: Family> Loaded for Experiment<F> {
@@ -91,6 +96,21 @@ impl<F: Family> Loaded for Experiment<F> {
     }
     fn warnings(&self) -> Vec<SpecError> {
         F::warnings(&self.scene)
+    }
+    fn max_job_bytes(&self) -> f64 {
+        let Some(&largest) = self.budgets.last() else {
+            return 0.0;
+        };
+        self.spec
+            .rules
+            .iter()
+            .flat_map(|m| {
+                self.spec
+                    .quantities
+                    .iter()
+                    .map(move |&q| F::memory(&self.scene, m, largest, q))
+            })
+            .fold(0.0, f64::max)
     }
     fn converged_reference(&self) -> Option<usize> {
         match &self.spec.reference {
