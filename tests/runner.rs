@@ -2504,3 +2504,37 @@ fn jobs_at_once_fit_the_memory_available() {
     assert_eq!(jobs_that_fit(0.0, Some(8e9)), usize::MAX);
     assert_eq!(jobs_that_fit(4e9, None), usize::MAX);
 }
+
+/// A finite value against a finite reference too small to divide by (a
+/// literal 5e-324) has a relative error beyond the f64 range: the row says
+/// so (it showed "inf" with no flag); against 0.5 it does not.
+#[test]
+fn a_relative_error_beyond_the_f64_range_is_flagged() {
+    use lightquad::experiment::report::{RowFlag, RuleInfo, rows};
+    use lightquad::experiment::validate::parse_json;
+    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
+    let exp = lightquad::families::builtin()
+        .load(parse_json(&text).expect("parses"), "h")
+        .expect("valid");
+    let mut job = exp.run_job((0, 16, 0));
+    let m = job.quantities.get_mut("I").expect("I");
+    m.value = vec![1.75];
+    m.error = vec![1e-3];
+    m.flags.clear();
+    let rules = [RuleInfo {
+        label: "gauss-legendre".into(),
+        is_random: false,
+        min_budget: 1,
+        resolution: Default::default(),
+    }];
+    let tiny = rows(&rules, std::slice::from_ref(&job), "I", &[5e-324], None);
+    assert!(tiny[0].rel_error.is_infinite(), "{:?}", tiny[0]);
+    assert!(
+        tiny[0].flags.contains(&RowFlag::ErrorBeyondRange),
+        "{:?}",
+        tiny[0]
+    );
+    let plain = rows(&rules, &[job], "I", &[0.5], None);
+    assert!((plain[0].rel_error - 2.5).abs() < 1e-15, "{:?}", plain[0]);
+    assert!(!plain[0].flags.contains(&RowFlag::ErrorBeyondRange));
+}

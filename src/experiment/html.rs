@@ -381,6 +381,7 @@ fn alarming(f: &RowFlag) -> bool {
             | RowFlag::OutsideStandardErrors
             | RowFlag::EstimateOff
             | RowFlag::ErrorGrew
+            | RowFlag::ErrorBeyondRange
     )
 }
 

@@ -127,6 +127,10 @@ pub enum RowFlag {
     /// The method's error estimate is infinite: it had no information to
     /// estimate the error (stratified sampling on two cells).
     NoEstimate,
+    /// The true relative error is beyond the f64 range though value and
+    /// reference are finite: the reference is too small to divide by (a
+    /// literal reference of 5e-324 showed an error of inf, unflagged).
+    ErrorBeyondRange,
 }
 
 impl std::fmt::Display for RowFlag {
@@ -143,6 +147,10 @@ impl std::fmt::Display for RowFlag {
                 f,
                 "no error estimate (infinite: too little to estimate from)"
             ),
+            RowFlag::ErrorBeyondRange => write!(
+                f,
+                "relative error beyond the f64 range (the reference is too small to divide by)"
+            ),
         }
     }
 }
@@ -158,7 +166,8 @@ per axis), whose differences do not shrink the way its order says, or whose sum 
 carries; or a random one whose \
 samples were all alike, a constant integrand included, since nothing was seen to vary, or whose \
 sample variance is carried by a few samples); `error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
-parts); `underflows` (the value is below the smallest f64 and reads 0; its logarithm is exact: ask for `ln_tau`, \
+parts); `relative error beyond the f64 range` (a finite value against a finite reference too small to \
+divide by); `underflows` (the value is below the smallest f64 and reads 0; its logarithm is exact: ask for `ln_tau`, \
 and `ln I_B = ln B + ln tau`); `no error estimate` (the method had too little to estimate from: \
 stratified sampling on two cells); `at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
 scored alike` (a tracking estimate with zero sample variance: its error is a Wilson half-width \
@@ -347,6 +356,12 @@ fn row(
         })
         .collect();
     let rel_error = rms(diffs.iter().copied()) / scale * double;
+    if rel_error.is_infinite()
+        && value.iter().all(|v| v.is_finite())
+        && reference.iter().all(|r| r.is_finite())
+    {
+        flags.push(RowFlag::ErrorBeyondRange);
+    }
     let max_error = diffs.iter().map(|d| d.abs()).fold(0.0, |m: f64, d| {
         if d.is_nan() || m.is_nan() {
             f64::NAN
