@@ -471,3 +471,19 @@ fn a_radiance_that_overflows_the_integrands_is_refused() {
     assert!(o.status.success(), "{}", stderr(&o));
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A converged reference's `n` beyond its range is refused with the range,
+/// not first with the cost (which sent the user to --no-cost-limit, and
+/// then to the range).
+#[test]
+fn a_converged_n_beyond_its_range_names_the_range_first() {
+    let o = check_edited("v-e-constant-sphere.json", |v| {
+        v["reference"] = json!({"type": "converged", "n": 100000000});
+    });
+    refused(
+        &o,
+        "reference.n",
+        &["100000000 is not an integer in 2..=100000"],
+    );
+    assert!(!stderr(&o).contains("--no-cost-limit"), "{}", stderr(&o));
+}

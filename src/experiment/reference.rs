@@ -155,12 +155,7 @@ pub fn known_values<F: Family>(
             }
         }
         ReferenceSpec::Converged(ConvergedReference { n }) => {
-            if !(2..=100_000).contains(n) {
-                return Err(SpecError::at(
-                    "reference.n",
-                    format!("{n} is not an integer in 2..=100000"),
-                ));
-            }
+            check_converged_n(*n)?;
             return Ok(None);
         }
     }))
@@ -202,6 +197,21 @@ fn closed_forms<F: Family>(
         uncertainty: 0.0,
         note: format!("closed forms of the {} family.", F::NAME),
     })
+}
+
+/// The largest `n` of a converged reference.
+pub const MAX_CONVERGED_N: usize = 100_000;
+
+/// Checks a converged reference's `n`: an integer in `2..=MAX_CONVERGED_N`.
+pub fn check_converged_n(n: usize) -> Result<(), SpecError> {
+    if (2..=MAX_CONVERGED_N).contains(&n) {
+        Ok(())
+    } else {
+        Err(SpecError::at(
+            "reference.n",
+            format!("{n} is not an integer in 2..={MAX_CONVERGED_N}"),
+        ))
+    }
 }
 
 /// Reads a Mitsuba values file for an experiment whose file hashes to `hash`:
