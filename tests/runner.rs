@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 mod common;
-use common::{bin, scratch, stderr};
+use common::{bin, root, scratch, stderr};
 use std::time::{Duration, Instant};
 
 /// Writes `text` to a scratch folder and runs it into `<folder>/out`.
@@ -2537,4 +2537,36 @@ fn a_relative_error_beyond_the_f64_range_is_flagged() {
     let plain = rows(&rules, &[job], "I", &[0.5], None);
     assert!((plain[0].rel_error - 2.5).abs() < 1e-15, "{:?}", plain[0]);
     assert!(!plain[0].flags.contains(&RowFlag::ErrorBeyondRange));
+}
+
+/// Runs of other files into one output folder: the index says which
+/// experiment folders it holds from earlier runs and links them (it listed
+/// only the last run's, leaving the others unlinked).
+#[test]
+fn an_index_links_the_experiments_of_earlier_runs_in_its_folder() {
+    let dir = scratch("earlier");
+    let out = dir.join("out");
+    for file in ["calibration-exp.json", "calibration-disk.json"] {
+        let o = bin()
+            .args(["run", "--out"])
+            .arg(&out)
+            .arg(root().join("experiments").join(file))
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let md = fs::read_to_string(out.join("index.md")).expect("index");
+    assert!(
+        md.contains("from earlier runs")
+            && md.contains("[calibration-exp](calibration-exp/report.md)"),
+        "{md}"
+    );
+    assert!(
+        !md.contains("[calibration-disk](calibration-disk/report.md)."),
+        "{md}"
+    );
+    let html = fs::read_to_string(out.join("index.html")).expect("index");
+    assert!(html.contains("<a href=\"calibration-exp/index.html\">calibration-exp</a>"));
+    assert!(out.join("calibration-exp/index.html").is_file());
+    let _ = fs::remove_dir_all(&dir);
 }

@@ -19,7 +19,7 @@
 //! std::fs::create_dir_all(&out)?;
 //! let ranked = Ranked { label: "gauss-legendre".into(), seconds: Some(2e-6), exact_from_start: false };
 //! let entries = [("exp".to_string(), "e^u <b>& friends</b>".to_string(), vec![("exp", vec![ranked])])];
-//! write_index(&out, &entries, &[], &[], &[])?;
+//! write_index(&out, &entries, &[], &[], &[], &[])?;
 //! let page = std::fs::read_to_string(out.join("index.html"))?;
 //! assert!(page.contains("e^u &lt;b&gt;&amp; friends&lt;/b&gt;") && !page.contains("<b>&"));
 //! assert!(page.contains(&rule_css("gauss-legendre"))); // the rule's colour
@@ -590,6 +590,11 @@ fn row(page: &Page, r: &Row, multi: bool, display: bool) -> String {
     )
 }
 
+/// Said of the experiment folders in the output folder that this run did
+/// not write (a run of other files into the same folder listed only its
+/// own, leaving the earlier pages unlinked).
+pub const EARLIER: &str = "Also in this folder, from earlier runs and not part of this one (their pages are as those runs left them)";
+
 /// SVG text without an XML declaration, to sit inside HTML.
 fn strip_xml_declaration(svg: &str) -> &str {
     match svg.trim_start().strip_prefix("<?xml") {
@@ -607,6 +612,7 @@ pub fn write_index(
     crosscheck: &[Crosscheck],
     audits: &[String],
     problems: &[String],
+    earlier: &[String],
 ) -> Result<(), String> {
     let mut b = String::from("<h1>lightquad report</h1>\n");
     if !problems.is_empty() {
@@ -666,6 +672,13 @@ pub fn write_index(
         );
     }
     b.push_str("</tbody></table></div>\n");
+    if !earlier.is_empty() {
+        let links: Vec<String> = earlier
+            .iter()
+            .map(|name| format!("<a href=\"{}\">{}</a>", page_link(out, name), escape(name)))
+            .collect();
+        let _ = writeln!(b, "<p class=\"note\">{EARLIER}: {}.</p>", links.join(", "));
+    }
     // The time scale shared by every chart, so bars compare across experiments.
     let times: Vec<f64> = entries
         .iter()

@@ -406,7 +406,21 @@ fn write_reports(
         .filter(|e| families.contains(e.name))
         .filter_map(FamilyEntry::audit)
         .collect();
-    report::write_index(out, &entries, &checks, &audits, &problems).map_err(|e| io(out, e))?;
+    // Experiment folders of earlier runs into this folder, said and linked.
+    let ours: BTreeSet<&str> = done.iter().map(|(e, _)| e.name()).collect();
+    let mut earlier: Vec<String> = fs::read_dir(out)
+        .map(|d| {
+            d.flatten()
+                .map(|e| e.path())
+                .filter(|p| p.join("experiment.json").is_file() && p.join("report.md").is_file())
+                .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+                .filter(|n| !ours.contains(n.as_str()))
+                .collect()
+        })
+        .unwrap_or_default();
+    earlier.sort();
+    report::write_index(out, &entries, &checks, &audits, &problems, &earlier)
+        .map_err(|e| io(out, e))?;
     let index = out.join("index.md");
     if !problems.is_empty() {
         return Err(RunError::Incomplete {

@@ -1344,6 +1344,7 @@ pub fn write_index(
     crosscheck: &[Crosscheck],
     audits: &[String],
     problems: &[String],
+    earlier: &[String],
 ) -> Result<(), String> {
     let mut md = String::from("# lightquad report\n\n");
     if !problems.is_empty() {
@@ -1390,6 +1391,13 @@ pub fn write_index(
         }
         md.push('\n');
     }
+    if !earlier.is_empty() {
+        let links: Vec<String> = earlier
+            .iter()
+            .map(|name| format!("[{name}]({name}/report.md)"))
+            .collect();
+        let _ = writeln!(md, "{}: {}.\n", super::html::EARLIER, links.join(", "));
+    }
     if !crosscheck.is_empty() {
         let _ = writeln!(
             md,
@@ -1404,7 +1412,7 @@ pub fn write_index(
         let _ = writeln!(md, "{audit}");
     }
     write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())?;
-    super::html::write_index(out, entries, crosscheck, audits, problems)
+    super::html::write_index(out, entries, crosscheck, audits, problems, earlier)
 }
 
 #[cfg(test)]
