@@ -2570,3 +2570,46 @@ fn an_index_links_the_experiments_of_earlier_runs_in_its_folder() {
     assert!(out.join("calibration-exp/index.html").is_file());
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A write that fails leaves no temporary file, and a whole run removes the
+/// temporary files a killed run left (ENOSPC and kill -9 during report
+/// writing left `.name.pid.n.tmp` files that `--resume` kept).
+#[test]
+fn failed_writes_and_killed_runs_leave_no_temporary_files() {
+    use lightquad::experiment::run::write_atomic;
+    let dir = scratch("temporaries");
+    // Renaming onto a non-empty folder fails.
+    let target = dir.join("taken");
+    fs::create_dir_all(target.join("inside")).expect("folder");
+    assert!(write_atomic(&target, b"text").is_err());
+    let left: Vec<String> = fs::read_dir(&dir)
+        .expect("list")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    // A killed run's leftovers, and a dot file that is not one.
+    let out = dir.join("out");
+    fs::create_dir_all(out.join("t")).expect("folder");
+    for stale in [
+        out.join(".index.md.4242.3.tmp"),
+        out.join("t/.report.md.4242.7.tmp"),
+    ] {
+        fs::write(&stale, "half").expect("write");
+    }
+    fs::write(out.join(".keep"), "").expect("write");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let o = bin()
+        .args(["run", "--resume", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.join(".index.md.4242.3.tmp").exists());
+    assert!(!out.join("t/.report.md.4242.7.tmp").exists());
+    assert!(out.join(".keep").exists());
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -287,6 +287,11 @@ pub fn run_sources(
     }
     writable(&opts.out)?;
     let _lock = lock_output(&opts.out, opts.shard)?;
+    // Alone in the folder (a whole run's lock), the temporary files of a
+    // killed run can go; shards share the folder and leave them.
+    if opts.shard.is_none() {
+        run::remove_stale_temporaries(&opts.out);
+    }
     let total: usize = loaded
         .iter()
         .map(|(e, _, _)| e.jobs(opts.shard).len())
@@ -503,6 +508,7 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
     // The inputs have been read; `out` may be one of them.
     drop(reading);
     let _lock = lock_output(out, None)?;
+    run::remove_stale_temporaries(out);
     let mut missing = Vec::new();
     let mut done = Vec::new();
     for (name, g) in by_name {

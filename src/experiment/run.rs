@@ -364,12 +364,44 @@ pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
         .file_name()
         .map_or("out".into(), |n| n.to_string_lossy().to_string());
     let tmp = path.with_file_name(format!(".{name}.{}.{unique}.tmp", std::process::id()));
-    {
-        let mut f = File::create(&tmp)?;
-        f.write_all(text)?;
-        f.sync_all()?;
+    let written = File::create(&tmp)
+        .and_then(|mut f| {
+            f.write_all(text)?;
+            f.sync_all()
+        })
+        .and_then(|()| fs::rename(&tmp, path));
+    // A write that failed (a full disk) leaves no temporary file behind.
+    if written.is_err() {
+        let _ = fs::remove_file(&tmp);
     }
-    fs::rename(&tmp, path)
+    written
+}
+
+/// Whether `name` is one of [`write_atomic`]'s temporary files
+/// (`.<name>.<pid>.<n>.tmp`).
+fn is_temporary(name: &str) -> bool {
+    name.starts_with('.') && name.ends_with(".tmp") && name.split('.').count() >= 5
+}
+
+/// Removes the temporary files that runs killed while writing left in `out`
+/// and its experiment folders; for a caller that holds the folder's lock
+/// alone (no other run writes there).
+pub fn remove_stale_temporaries(out: &Path) {
+    let Ok(top) = fs::read_dir(out) else {
+        return;
+    };
+    let mut dirs = vec![out.to_path_buf()];
+    dirs.extend(top.flatten().map(|e| e.path()).filter(|p| p.is_dir()));
+    for dir in dirs {
+        let Ok(entries) = fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            if e.file_name().to_str().is_some_and(is_temporary) && e.path().is_file() {
+                let _ = fs::remove_file(e.path());
+            }
+        }
+    }
 }
 
 /// Runs one experiment's pending jobs, appending to `<out>/<name>/results.jsonl`;
