@@ -487,3 +487,33 @@ fn a_converged_n_beyond_its_range_names_the_range_first() {
     );
     assert!(!stderr(&o).contains("--no-cost-limit"), "{}", stderr(&o));
 }
+
+/// `render` refuses an image whose memory would not fit, before it renders
+/// (16384 x 16384 ran out of memory; 8192 x 8192 peaked at 3.2 GB).
+#[test]
+fn render_refuses_an_image_that_would_not_fit_in_memory() {
+    let dir = scratch("bigrender");
+    let png = dir.join("big.png");
+    let o = bin()
+        .args([
+            "render",
+            "--width",
+            "16384",
+            "--height",
+            "16384",
+            "--samples",
+            "1",
+            "--png",
+        ])
+        .arg(&png)
+        .arg(root().join("experiments/w-grey-test-scene.json"))
+        .output()
+        .expect("runs");
+    refused(
+        &o,
+        "width",
+        &["16384 x 16384 pixels", "GB while rendering", "--width"],
+    );
+    assert!(!png.exists());
+    let _ = fs::remove_dir_all(&dir);
+}
