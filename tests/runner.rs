@@ -26,6 +26,38 @@ fn run_text(tag: &str, text: &str) -> (PathBuf, PathBuf, Output) {
     (dir, out, o)
 }
 
+/// VALID's scene with the quantity `I` alone, loaded (its jobs run with
+/// `run_job`), and the one rule `rows` is told of (Gauss–Legendre).
+fn i_experiment() -> (
+    Box<dyn lightquad::experiment::registry::Loaded>,
+    [lightquad::experiment::report::RuleInfo; 1],
+) {
+    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
+    let exp = lightquad::families::builtin()
+        .load(
+            lightquad::experiment::validate::parse_json(&text).expect("parses"),
+            "h",
+        )
+        .expect("valid");
+    let rules = [lightquad::experiment::report::RuleInfo {
+        label: "gauss-legendre".into(),
+        is_random: false,
+        min_budget: 1,
+        resolution: Default::default(),
+    }];
+    (exp, rules)
+}
+
+/// `lightquad merge --out <out> <inputs...>`.
+fn merge(out: &Path, inputs: &[&Path]) -> Output {
+    bin()
+        .args(["merge", "--out"])
+        .arg(out)
+        .args(inputs)
+        .output()
+        .expect("runs")
+}
+
 const VALID: &str = r#"{
   "name": "t",
   "family": "volume",
@@ -520,13 +552,9 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
 /// negative emission is refused, so the flag is set on the jobs' values here.)
 #[test]
 fn a_familys_value_flag_reaches_the_report_row() {
-    use lightquad::experiment::report::{RowFlag, RuleInfo, rows};
-    use lightquad::experiment::validate::parse_json;
+    use lightquad::experiment::report::{RowFlag, rows};
     use lightquad::family::Flag;
-    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
-    let exp = lightquad::families::builtin()
-        .load(parse_json(&text).expect("parses"), "h")
-        .expect("valid");
+    let (exp, rules) = i_experiment();
     let jobs: Vec<_> = [4usize, 16]
         .iter()
         .map(|&n| {
@@ -538,12 +566,6 @@ fn a_familys_value_flag_reaches_the_report_row() {
             job
         })
         .collect();
-    let rules = [RuleInfo {
-        label: "gauss-legendre".into(),
-        is_random: false,
-        min_budget: 1,
-        resolution: Default::default(),
-    }];
     let reference = exp.run_job((0, 64, 0)).quantities["I"].value.clone();
     let table = rows(&rules, &jobs, "I", &reference, None);
     assert_eq!(table.len(), 2, "{table:?}");
@@ -954,33 +976,14 @@ fn merge_prefers_a_finished_job_over_a_failed_copy() {
 /// experiment.json).
 #[test]
 fn merge_says_where_shards_disagree_and_its_output_merges_again() {
-    let dir = scratch("mergeconflict");
-    let file = dir.join("e.json");
-    fs::write(&file, VALID).expect("write");
-    let good = dir.join("a-good");
-    let o = bin()
-        .args(["run", "--out"])
-        .arg(&good)
-        .arg(&file)
-        .output()
-        .expect("runs");
+    let (dir, good, o) = run_text("mergeconflict", VALID);
     assert!(o.status.success(), "{}", stderr(&o));
     let merged = dir.join("merged");
-    let o = bin()
-        .args(["merge", "--out"])
-        .arg(&merged)
-        .arg(&good)
-        .output()
-        .expect("runs");
+    let o = merge(&merged, &[&good]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(merged.join("t/experiment.json").is_file());
     let again = dir.join("again");
-    let o = bin()
-        .args(["merge", "--out"])
-        .arg(&again)
-        .arg(&merged)
-        .output()
-        .expect("runs");
+    let o = merge(&again, &[&merged]);
     assert!(o.status.success(), "{}", stderr(&o));
     same(&results(&again, "t"), &results(&good, "t"));
     // A copy with one value changed, and a line of garbage.
@@ -997,13 +1000,7 @@ fn merge_says_where_shards_disagree_and_its_output_merges_again() {
     v["quantities"]["tau"]["value"] = serde_json::json!([9.99]);
     fs::write(other.join("t/results.jsonl"), format!("{v}\n{{garbage\n")).expect("write");
     let conflict = dir.join("conflict");
-    let o = bin()
-        .args(["merge", "--out"])
-        .arg(&conflict)
-        .arg(&good)
-        .arg(&other)
-        .output()
-        .expect("runs");
+    let o = merge(&conflict, &[&good, &other]);
     let msg = stderr(&o);
     assert!(!o.status.success(), "accepted: {msg}");
     assert!(
@@ -2392,13 +2389,9 @@ fn evaluations_above_the_budget_are_explained_in_the_report() {
 /// (51.255), 0.4 -> 102, 0.41 -> 105 (104.55), 0.37 -> 94 (94.35).
 #[test]
 fn the_largest_channel_error_and_the_8_bit_values_off_are_counted() {
-    use lightquad::experiment::report::{RuleInfo, rows};
-    use lightquad::experiment::validate::parse_json;
+    use lightquad::experiment::report::rows;
     use lightquad::family::Display;
-    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
-    let exp = lightquad::families::builtin()
-        .load(parse_json(&text).expect("parses"), "h")
-        .expect("valid");
+    let (exp, rules) = i_experiment();
     let jobs: Vec<_> = [vec![0.201, 0.41], vec![0.2, 0.37]]
         .into_iter()
         .enumerate()
@@ -2408,12 +2401,6 @@ fn the_largest_channel_error_and_the_8_bit_values_off_are_counted() {
             job
         })
         .collect();
-    let rules = [RuleInfo {
-        label: "gauss-legendre".into(),
-        is_random: false,
-        min_budget: 1,
-        resolution: Default::default(),
-    }];
     let display = Display {
         name: "8-bit (W-Grey)",
         half_step: 1.0 / 510.0,
@@ -2442,24 +2429,14 @@ fn the_largest_channel_error_and_the_8_bit_values_off_are_counted() {
 /// flagged). An estimate more than 10x too small is judged from 1e-13.
 #[test]
 fn an_estimate_4500_times_too_small_at_an_error_of_1e_12_is_flagged() {
-    use lightquad::experiment::report::{RowFlag, RuleInfo, rows};
-    use lightquad::experiment::validate::parse_json;
-    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
-    let exp = lightquad::families::builtin()
-        .load(parse_json(&text).expect("parses"), "h")
-        .expect("valid");
+    use lightquad::experiment::report::{RowFlag, rows};
+    let (exp, rules) = i_experiment();
     let pi = std::f64::consts::PI;
     let mut job = exp.run_job((0, 16, 0));
     let m = job.quantities.get_mut("I").expect("I");
     m.value = vec![pi];
     m.error = vec![2.2e-16 * pi];
     m.flags.clear();
-    let rules = [RuleInfo {
-        label: "gauss-legendre".into(),
-        is_random: false,
-        min_budget: 1,
-        resolution: Default::default(),
-    }];
     let exact = pi / (1.0 + 1e-12);
     let table = rows(&rules, &[job], "I", &[exact], None);
     let row = &table[0];
@@ -2510,23 +2487,13 @@ fn jobs_at_once_fit_the_memory_available() {
 /// so (it showed "inf" with no flag); against 0.5 it does not.
 #[test]
 fn a_relative_error_beyond_the_f64_range_is_flagged() {
-    use lightquad::experiment::report::{RowFlag, RuleInfo, rows};
-    use lightquad::experiment::validate::parse_json;
-    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"I\"]");
-    let exp = lightquad::families::builtin()
-        .load(parse_json(&text).expect("parses"), "h")
-        .expect("valid");
+    use lightquad::experiment::report::{RowFlag, rows};
+    let (exp, rules) = i_experiment();
     let mut job = exp.run_job((0, 16, 0));
     let m = job.quantities.get_mut("I").expect("I");
     m.value = vec![1.75];
     m.error = vec![1e-3];
     m.flags.clear();
-    let rules = [RuleInfo {
-        label: "gauss-legendre".into(),
-        is_random: false,
-        min_budget: 1,
-        resolution: Default::default(),
-    }];
     let tiny = rows(&rules, std::slice::from_ref(&job), "I", &[5e-324], None);
     assert!(tiny[0].rel_error.is_infinite(), "{:?}", tiny[0]);
     assert!(

@@ -587,19 +587,16 @@ struct Gathered {
 /// Whether two results of one job hold different values or errors (bit for
 /// bit: a job is deterministic).
 fn values_differ(a: &JobResult, b: &JobResult) -> bool {
-    let bits = |r: &JobResult| -> Vec<(String, Vec<u64>, Vec<u64>)> {
-        r.quantities
-            .iter()
-            .map(|(q, m)| {
-                (
-                    q.clone(),
-                    m.value.iter().map(|v| v.to_bits()).collect(),
-                    m.error.iter().map(|v| v.to_bits()).collect(),
-                )
-            })
-            .collect()
+    let same = |x: &[f64], y: &[f64]| {
+        x.len() == y.len() && x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())
     };
-    bits(a) != bits(b)
+    a.quantities.len() != b.quantities.len()
+        || a.quantities
+            .iter()
+            .zip(&b.quantities)
+            .any(|((p, m), (q, n))| {
+                p != q || !same(&m.value, &n.value) || !same(&m.error, &n.error)
+            })
 }
 
 /// Adds one shard folder's experiment and results to `by_name`.

@@ -230,10 +230,7 @@ pub fn rows(
     for r in results {
         groups.entry((r.rule_index, r.budget)).or_default().push(r);
     }
-    let scale = match rms(reference.iter().copied()) {
-        s if s > 0.0 => s,
-        _ => 1.0,
-    };
+    let scale = scale_of(reference);
     let mut out: Vec<Row> = groups
         .into_iter()
         .map(|((rule_index, budget), jobs)| {
@@ -257,6 +254,15 @@ pub fn rows(
         }
     }
     out
+}
+
+/// The scale of a quantity's relative errors: the reference's root mean
+/// square, or 1 (absolute errors) where that is 0.
+fn scale_of(reference: &[f64]) -> f64 {
+    match rms(reference.iter().copied()) {
+        s if s > 0.0 => s,
+        _ => 1.0,
+    }
 }
 
 /// One row from the repeats of one (rule, budget).
@@ -1055,10 +1061,7 @@ pub fn display_line(
     rows: &[Row],
     page: &Page,
 ) -> String {
-    let scale = match rms(reference.iter().copied()) {
-        s if s > 0.0 => s,
-        _ => 1.0,
-    };
+    let scale = scale_of(reference);
     // A reference value within its accuracy of a step boundary may display
     // either way.
     let overall = page.reference.accuracy_of(q) * scale;

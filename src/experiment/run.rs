@@ -380,7 +380,15 @@ pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
 /// Whether `name` is one of [`write_atomic`]'s temporary files
 /// (`.<name>.<pid>.<n>.tmp`).
 fn is_temporary(name: &str) -> bool {
-    name.starts_with('.') && name.ends_with(".tmp") && name.split('.').count() >= 5
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let Some(inner) = name.strip_prefix('.').and_then(|n| n.strip_suffix(".tmp")) else {
+        return false;
+    };
+    let mut parts = inner.rsplitn(3, '.');
+    matches!(
+        (parts.next(), parts.next(), parts.next()),
+        (Some(n), Some(pid), Some(file)) if digits(n) && digits(pid) && !file.is_empty()
+    )
 }
 
 /// Removes the temporary files that runs killed while writing left in `out`

@@ -161,6 +161,21 @@ pub struct LoggedRng<'a, R: ?Sized> {
 }
 
 impl<R: rand::Rng + ?Sized> LoggedRng<'_, R> {
+    /// The next word of the kind `same` accepts: the logged one while
+    /// replaying and the log agrees, else a fresh one drawn by `fresh` and
+    /// logged.
+    #[inline(always)]
+    fn draw(&mut self, same: fn(&Draw) -> bool, fresh: impl FnOnce(&mut R) -> Draw) -> Draw {
+        if self.replaying
+            && let Some(d) = self.log.replay(same)
+        {
+            return d;
+        }
+        let d = fresh(self.inner);
+        self.fresh(d);
+        d
+    }
+
     /// A fresh draw, logged: in a first pass at the end of the log, else at
     /// the cursor where the replay ended.
     #[inline(always)]
@@ -179,25 +194,19 @@ impl<R: rand::Rng + ?Sized> rand::TryRng for LoggedRng<'_, R> {
     type Error = Infallible;
 
     fn try_next_u32(&mut self) -> Result<u32, Infallible> {
-        if self.replaying
-            && let Some(Draw::U32(x)) = self.log.replay(|d| matches!(d, Draw::U32(_)))
-        {
-            return Ok(x);
-        }
-        let x = self.inner.next_u32();
-        self.fresh(Draw::U32(x));
-        Ok(x)
+        let word = self.draw(|d| matches!(d, Draw::U32(_)), |r| Draw::U32(r.next_u32()));
+        Ok(match word {
+            Draw::U32(x) => x,
+            Draw::U64(x) => x as u32,
+        })
     }
 
     fn try_next_u64(&mut self) -> Result<u64, Infallible> {
-        if self.replaying
-            && let Some(Draw::U64(x)) = self.log.replay(|d| matches!(d, Draw::U64(_)))
-        {
-            return Ok(x);
-        }
-        let x = self.inner.next_u64();
-        self.fresh(Draw::U64(x));
-        Ok(x)
+        let word = self.draw(|d| matches!(d, Draw::U64(_)), |r| Draw::U64(r.next_u64()));
+        Ok(match word {
+            Draw::U64(x) => x,
+            Draw::U32(x) => u64::from(x),
+        })
     }
 
     fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Infallible> {
