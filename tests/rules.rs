@@ -580,6 +580,29 @@ fn integrands_near_the_top_of_the_f64_range_give_finite_estimates() {
     }
 }
 
+/// Values of `+-f64::MAX` at three Monte Carlo samples: the standard error,
+/// about 2.2 f64::MAX, lies beyond the f64 range, and came back infinite and
+/// trusted (the hostile review of issue 10). An infinite error is no bound a
+/// report can show: the estimate is doubted, whichever rule took it.
+#[test]
+fn an_error_beyond_the_f64_range_is_doubted() {
+    let mut rng = rng(7);
+    for rule in every_rule() {
+        let name = rule.label();
+        let mut k = 0usize;
+        let result = rule.integrate::<1, f64, _, _>(3, &mut rng, |_| {
+            k += 1;
+            if k % 2 == 0 { f64::MAX } else { -f64::MAX }
+        });
+        if let Ok(e) = result {
+            assert!(
+                e.error.is_finite() || !e.reliable,
+                "{name}: infinite error trusted: {e:?}"
+            );
+        }
+    }
+}
+
 /// A channel's scale is its own: beside a channel near 1.7e308, a channel of
 /// 2.2e-308 was scaled by the large one's 2^-e to 0 and came back as 0 with
 /// an error of 0 (Monte Carlo, stratified, Sobol', Gauss–Kronrod); and an

@@ -176,7 +176,9 @@ pub trait Rule {
     /// a channel whose values all lie below `2^-500` and whose error came out
     /// 0 is taken again of `f 2^-e` too: exact scalings, undone on the
     /// estimate. An estimate that is still not finite is an error
-    /// ([`QuadError::Overflow`]), never a silent NaN.
+    /// ([`QuadError::Overflow`]), never a silent NaN; an error estimate
+    /// that is finite at its scale and beyond the f64 range once scaled
+    /// back is infinite and doubted.
     ///
     /// Passes after the first keep the budget: they replay the draws and
     /// values logged so far (module `replay`, at most 1 MiB each) and
@@ -405,8 +407,18 @@ pub trait Rule {
                 underflowed = Some(estimate);
                 continue;
             }
+            // An error finite at the pass's scale and beyond the f64 range
+            // once scaled back (values near +-f64::MAX spread wider than
+            // f64): infinite, no bound a report can show, so doubted.
+            let beyond_range = (0..V::CHANNELS).any(|c| {
+                estimate.error.channel(c).is_infinite() && pass.error.channel(c).is_finite()
+            });
             return if sound(&estimate) {
-                Ok(estimate)
+                Ok(if beyond_range {
+                    estimate.doubted()
+                } else {
+                    estimate
+                })
             } else {
                 Err(QuadError::Overflow {
                     rule: self.name(),
