@@ -517,3 +517,25 @@ fn render_refuses_an_image_that_would_not_fit_in_memory() {
     assert!(!png.exists());
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// An empty file, a file cut short and a key that is not a string: each is
+/// named where it is (the hostile probe of issue 10 saw `.` for an empty file
+/// and `scene.?` for a key it could not read).
+#[test]
+fn empty_cut_short_and_unreadable_keys_are_named_where_they_are() {
+    refused(&check_text(""), ".", &["the file is empty"]);
+    refused(&check_text(" \n\t"), ".", &["the file is empty"]);
+    let text =
+        fs::read_to_string(root().join("experiments").join("calibration-exp.json")).expect("read");
+    let cut = &text[..text.find("\"rules\"").expect("rules") + "\"rules\": ".len()];
+    refused(
+        &check_text(cut),
+        "rules",
+        &["the file ends inside", "cut short"],
+    );
+    refused(
+        &check_text(&text.replacen("\"scene\": {}", "\"scene\": {\"a\": 1, 2: 3}", 1)),
+        "scene",
+        &["key must be a string"],
+    );
+}

@@ -187,6 +187,16 @@ pub fn plain_words(message: &str) -> String {
         .replace("invalid type: map,", "invalid type: an object,")
         .replace("invalid type: sequence,", "invalid type: a list,")
         .replace("expected a sequence", "expected a list");
+    // A file cut short (a truncated copy, a write that was killed).
+    if let Some(rest) = m.strip_prefix("EOF while parsing ") {
+        let (what, at) = rest.split_once(" at line").unwrap_or((rest, ""));
+        let at = if at.is_empty() {
+            String::new()
+        } else {
+            format!(" at line{at}")
+        };
+        m = format!("the file ends inside {what}{at}: is it cut short?");
+    }
     if let Some(rest) = m.strip_prefix("number out of range") {
         m = format!(
             "a number beyond the f64 range (its magnitude is above 1.8e308){rest}: expected a \

@@ -60,14 +60,34 @@ pub struct Experiment<F: Family> {
 /// format is checked by [`deserialize`]); a syntax error names the JSON path
 /// it is in, and its line and column.
 pub fn parse_json(text: &str) -> Result<serde_json::Value, SpecError> {
+    if text.trim().is_empty() {
+        return Err(empty_file());
+    }
     parse_raw(text).map_err(|(path, e)| error_at(&path, &e))
+}
+
+/// The message for a file with nothing but white space in it (serde says
+/// "EOF while parsing a value at line 1 column 0").
+fn empty_file() -> SpecError {
+    SpecError::at(
+        ".",
+        "the file is empty: an experiment file is one JSON object (`lightquad schema` prints its format)",
+    )
 }
 
 /// [`parse_json`] with the JSON path and serde's error as they are.
 fn parse_raw(text: &str) -> Result<serde_json::Value, (String, serde_json::Error)> {
     let de = &mut serde_json::Deserializer::from_str(text);
-    let Strict(json) = serde_path_to_error::deserialize(&mut *de)
-        .map_err(|e| (e.path().to_string(), e.into_inner()))?;
+    // serde_path_to_error names a key it could not read (not a string) `?`:
+    // the fault is then placed at the object that holds it.
+    let Strict(json) = serde_path_to_error::deserialize(&mut *de).map_err(|e| {
+        let path = e.path().to_string();
+        let path = match path.strip_suffix('?') {
+            Some(parent) => parent.trim_end_matches('.').to_string(),
+            None => path,
+        };
+        (path, e.into_inner())
+    })?;
     de.end().map_err(|e| (".".to_string(), e))?;
     Ok(json)
 }
@@ -87,6 +107,9 @@ pub fn parse_and_load<T>(
     text: &str,
     load: impl FnOnce(serde_json::Value) -> Result<T, SpecError>,
 ) -> Result<T, SpecError> {
+    if text.trim().is_empty() {
+        return Err(empty_file());
+    }
     let mut text = std::borrow::Cow::Borrowed(text);
     // The first number beyond the range, as the reader reported it.
     let mut first: Option<(SpecError, String, String)> = None;
@@ -229,9 +252,10 @@ impl<'de> serde::de::Visitor<'de> for StrictVisitor {
         let mut object = serde_json::Map::new();
         while let Some(key) = map.next_key::<String>()? {
             if object.contains_key(&key) {
-                return Err(serde::de::Error::custom(format!(
-                    "duplicate key `{key}`: give each key once"
-                )));
+                return Err(super::tagged::below(
+                    &key,
+                    &format!("the key `{key}` appears twice in its object: give each key once"),
+                ));
             }
             let Strict(v) = map.next_value()?;
             object.insert(key, v);
