@@ -107,7 +107,7 @@ fn rejected(text: &str, path: &str, what: &str) {
 
 #[test]
 fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
-    rejected("{ \"name\": ", "name", "EOF while parsing");
+    rejected("{ \"name\": ", "name", "the file ends inside a value");
     rejected(
         &VALID.replace("\"seed\": 7", "\"seed\": 7, \"colour\": 1"),
         "colour",
@@ -2579,5 +2579,57 @@ fn failed_writes_and_killed_runs_leave_no_temporary_files() {
     assert!(!out.join(".index.md.4242.3.tmp").exists());
     assert!(!out.join("t/.report.md.4242.7.tmp").exists());
     assert!(out.join(".keep").exists());
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// Shards of an experiment whose Mitsuba values file is named by a path
+/// relative to the experiment file: `run` found it, `merge` of the shards'
+/// folders did not (the hostile probe of issue 10). A run keeps a copy
+/// beside `experiment.json`, and the merged report compares with it.
+#[test]
+fn shards_with_a_relative_mitsuba_values_file_merge() {
+    let dir = scratch("mitsuba-shards");
+    fs::create_dir_all(dir.join("experiments")).expect("mkdir");
+    fs::create_dir_all(dir.join("values")).expect("mkdir");
+    let text = VALID.replace("[\"tau\", \"I_E\"]", "[\"tau\"]").replace(
+        "\"reference\": { \"type\": \"closed-form\" }",
+        "\"reference\": { \"type\": \"mitsuba\", \"file\": \"../values/t.json\" }",
+    );
+    assert!(text.contains("../values/t.json"), "{text}");
+    let file = dir.join("experiments").join("t.json");
+    fs::write(&file, &text).expect("write");
+    // tau along the chord y = 0.3 of the unit sphere with kappa 2: exp(-2 L).
+    let chord = 2.0 * (1.0f64 - 0.09).sqrt();
+    let values = serde_json::json!({
+        "experiment": "t",
+        "experiment_hash": lightquad::experiment::run::file_hash(text.as_bytes()),
+        "mitsuba_variant": "scalar_rgb",
+        "mitsuba_version": "test",
+        "quantities": {"tau": {"value": (-2.0 * chord).exp(), "std_error": 1e-7, "samples": 1}}
+    });
+    fs::write(dir.join("values").join("t.json"), values.to_string()).expect("write");
+    let shards: Vec<PathBuf> = (1..=2).map(|k| dir.join(format!("s{k}"))).collect();
+    for (k, out) in shards.iter().enumerate() {
+        let o = bin()
+            .args([
+                "run",
+                "--threads",
+                "1",
+                "--shard",
+                &format!("{}/2", k + 1),
+                "--out",
+            ])
+            .arg(out)
+            .arg(&file)
+            .output()
+            .expect("runs");
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let merged = dir.join("merged");
+    let o = merge(&merged, &[&shards[0], &shards[1]]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = fs::read_to_string(merged.join("t").join("report.md")).expect("report");
+    assert!(report.contains("lightquad vs Mitsuba 3"), "{report}");
+    assert!(merged.join("t").join("mitsuba-values.json").is_file());
     let _ = fs::remove_dir_all(&dir);
 }

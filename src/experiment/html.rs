@@ -463,7 +463,10 @@ fn section(page: &Page, s: &Section) -> String {
     for t in page.targets {
         b.push_str(&th(
             &format!("time to {t:.0e} (s)"),
-            &format!("least median time among rows whose error is at most {t:.0e}"),
+            &format!(
+                "least median time among the rows from the budget on which the error stays at \
+                 most {t:.0e} at every larger budget"
+            ),
             true,
         ));
     }

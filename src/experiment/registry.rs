@@ -70,6 +70,11 @@ pub trait Loaded: Send + Sync {
     /// quantity), in bytes: the runner runs fewer jobs at once where the
     /// machine cannot hold one per thread.
     fn max_job_bytes(&self) -> f64;
+    /// The Mitsuba values file made from this experiment's bytes, where one
+    /// was found ([`find_values`](super::source::find_values)): the run keeps
+    /// a copy beside its results, so that `merge` of its folder finds it
+    /// wherever the reference's relative path pointed.
+    fn mitsuba_values(&self) -> Option<serde_json::Value>;
 }
 
 impl<F: Family> Loaded for Experiment<F> {
@@ -111,6 +116,16 @@ impl<F: Family> Loaded for Experiment<F> {
                     .map(move |&q| F::memory(&self.scene, m, largest, q))
             })
             .fold(0.0, f64::max)
+    }
+    fn mitsuba_values(&self) -> Option<serde_json::Value> {
+        let named = match &self.spec.reference {
+            super::spec::ReferenceSpec::Mitsuba(m) => Some(m.file.as_str()),
+            _ => None,
+        };
+        match super::source::find_values(&self.origin, &self.spec.name, &self.hash, named) {
+            super::source::Values::Found { json, .. } => Some(json),
+            _ => None,
+        }
     }
     fn converged_reference(&self) -> Option<usize> {
         match &self.spec.reference {

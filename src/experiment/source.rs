@@ -166,10 +166,15 @@ pub enum Values {
     },
 }
 
+/// The copy of its Mitsuba values a run writes beside `experiment.json` in
+/// the experiment's output folder.
+pub const VALUES_COPY: &str = "mitsuba-values.json";
+
 /// Looks for the Mitsuba values of experiment `name` whose file hashes to
 /// `hash`: `named` (the file its reference names, relative to the experiment
-/// file's folder), then `<folder>/../reference/values/<name>.json`, then the
-/// bundled values. The first made from these bytes wins; otherwise the first
+/// file's folder), then the copy a run kept in that folder ([`VALUES_COPY`],
+/// where it is: a run's output folder read again by `merge`), then
+/// `<folder>/../reference/values/<name>.json`, then the bundled values. The first made from these bytes wins; otherwise the first
 /// found is stale.
 pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>) -> Values {
     // Each place with its values, or why it has none (said when none is found).
@@ -193,6 +198,13 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
                 named_missing = Some(format!("{} ({why})", path.display()));
             }
             places.push((path.display().to_string(), json));
+        }
+        let copy = dir.join(VALUES_COPY);
+        if copy.is_file() {
+            places.push((
+                copy.display().to_string(),
+                read_text(&copy).and_then(|t| values_json(&t)),
+            ));
         }
         let path = dir
             .join("..")
