@@ -243,6 +243,11 @@ fn run(command: Command) -> Result<(), Failure> {
                         .into(),
                 );
             }
+            for (flag, given) in [("--width", width), ("--height", height)] {
+                if given == Some(0) {
+                    return Err(format!("invalid {flag} = 0: expected at least 1 pixel").into());
+                }
+            }
             if let Some(p) = &pfm
                 && same_file(&png, p)
             {
@@ -252,6 +257,28 @@ fn run(command: Command) -> Result<(), Failure> {
                     png.display()
                 )
                 .into());
+            }
+            // Where the files go, checked before rendering (a render can take
+            // minutes, and an unwritable --pfm was found only after it).
+            for (flag, path) in
+                std::iter::once(("--png", &png)).chain(pfm.as_ref().map(|p| ("--pfm", p)))
+            {
+                let folder = match path.parent() {
+                    Some(f) if !f.as_os_str().is_empty() => f,
+                    _ => std::path::Path::new("."),
+                };
+                if path.is_dir() || !folder.is_dir() {
+                    return Err(format!(
+                        "invalid {flag} = {}: expected a file in an existing folder ({})",
+                        path.display(),
+                        if path.is_dir() {
+                            "it is a folder"
+                        } else {
+                            "its folder does not exist"
+                        }
+                    )
+                    .into());
+                }
             }
             let source = match file {
                 Some(f) => Source::File(f),
@@ -275,10 +302,12 @@ fn run(command: Command) -> Result<(), Failure> {
             image
                 .write_png(&png)
                 .map_err(|e| format!("cannot write the PNG: {e}"))?;
-            if let Some(p) = &pfm {
-                image
-                    .write_pfm(p)
-                    .map_err(|e| format!("cannot write the PFM: {e}"))?;
+            if let Some(p) = &pfm
+                && let Err(e) = image.write_pfm(p)
+            {
+                // No PNG left without its PFM.
+                let _ = std::fs::remove_file(&png);
+                return Err(format!("cannot write the PFM: {e} (the PNG was removed)").into());
             }
             writeln!(
                 out,

@@ -826,3 +826,55 @@ fn gauss_legendre_estimate_is_honest_at_either_endpoint_singularity() {
         }
     }
 }
+
+/// Stratified sampling of a peak narrower than a cell that no sample hit:
+/// the samples saw its flanks only (a Gaussian of width 1e-3 read as 1e-300
+/// +- 1e-299) and the estimate lied unflagged (the independent check of
+/// issue 9: 697 of 13936 battery cases, 588 of them peaks and Gaussians).
+/// Over 40 interior centres, widths 1e-3 and 1e-4 and 16 budgets from 5 to
+/// 1025 cells, counted against the closed forms `int exp(-((x - c) /
+/// w)^2) = w sqrt(pi) / 2 (erf((1 - c) / w) + erf(c / w))` and the
+/// Lorentzian's arctangents.
+#[test]
+fn stratified_estimates_of_peaks_between_samples_are_doubted() {
+    use lightquad::quadrature::AnyRule;
+    use rand::{RngExt, SeedableRng};
+    let rule = AnyRule::by_name("stratified").expect("a rule");
+    let mut pick = rand_pcg::Pcg64::seed_from_u64(11);
+    let centres: Vec<f64> = (0..40).map(|_| pick.random_range(0.05..0.95)).collect();
+    let budgets = [
+        5usize, 7, 9, 13, 16, 24, 33, 48, 64, 100, 128, 200, 256, 513, 777, 1025,
+    ];
+    let (mut lies, mut total) = (0usize, 0usize);
+    for &w in &[1e-3f64, 1e-4] {
+        for (i, &c) in centres.iter().enumerate() {
+            let gauss = w * std::f64::consts::PI.sqrt() / 2.0
+                * (statrs::function::erf::erf((1.0 - c) / w) + statrs::function::erf::erf(c / w));
+            let lorentz = (((1.0 - c) / w).atan() + (c / w).atan()) / w;
+            for &n in &budgets {
+                let seed = (i * 100 + n) as u64;
+                let g = rule
+                    .integrate::<1, f64, _, _>(n, &mut rng(seed), |p: [f64; 1]| {
+                        (-((p[0] - c) / w).powi(2)).exp()
+                    })
+                    .expect("finite");
+                let l = rule
+                    .integrate::<1, f64, _, _>(n, &mut rng(seed), |p: [f64; 1]| {
+                        1.0 / (w * w + (p[0] - c).powi(2))
+                    })
+                    .expect("finite");
+                let (a, b) = tally([(g, gauss), (l, lorentz)].into_iter());
+                lies += a;
+                total += b;
+            }
+        }
+    }
+    eprintln!("stratified interior peaks: {lies} of {total} lie unflagged");
+    // Measured: 961 of 2560 before the tail check, 132 now (Lorentzian
+    // flanks, which look like a resolved 1/x^2, and budgets of 5 to 9 cells,
+    // where one dominant sample of k is not yet beyond the threshold).
+    assert!(
+        lies * 16 <= total,
+        "{lies} of {total} peak estimates lie unflagged"
+    );
+}

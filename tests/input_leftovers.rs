@@ -539,3 +539,59 @@ fn empty_cut_short_and_unreadable_keys_are_named_where_they_are() {
         &["key must be a string"],
     );
 }
+
+/// `render` counts the whole ray tree, as `run` does: a scene at depth 16
+/// with a mirror and a glass sphere at 1000 x 1000 and 9 rays a pixel passed
+/// the primary-ray count and would have run for hours. And it checks its
+/// flags and output folders before rendering: `--width 0` was named as the
+/// file's `scene.camera.width`, and an unwritable `--pfm` was found after
+/// the render, leaving the PNG behind (the hostile probe of issue 10).
+#[test]
+fn render_counts_the_ray_tree_and_checks_its_outputs_first() {
+    let dir = scratch("render-tree");
+    let mut v: Value = serde_json::from_str(
+        &fs::read_to_string(root().join("experiments/w-grey-test-scene.json")).expect("read"),
+    )
+    .expect("json");
+    v["scene"]["max_depth"] = json!(16);
+    let file = dir.join("deep.json");
+    fs::write(&file, v.to_string()).expect("write");
+    let png = dir.join("r.png");
+    let render = |args: &[&str]| {
+        bin()
+            .arg("render")
+            .args(args)
+            .arg("--png")
+            .arg(&png)
+            .arg(&file)
+            .output()
+            .expect("runs")
+    };
+    let o = render(&["--width", "1000", "--height", "1000", "--samples", "9"]);
+    refused(
+        &o,
+        "samples",
+        &["depth 16", "ray-object tests", "max_depth"],
+    );
+    assert!(!png.exists());
+    let o = render(&["--width", "0"]);
+    assert!(!o.status.success(), "accepted");
+    assert!(stderr(&o).contains("--width = 0"), "{}", stderr(&o));
+    let pfm = dir.join("no").join("r.pfm");
+    let o = render(&[
+        "--width",
+        "4",
+        "--height",
+        "3",
+        "--pfm",
+        pfm.to_str().expect("utf-8"),
+    ]);
+    assert!(!o.status.success(), "accepted");
+    assert!(
+        stderr(&o).contains("--pfm") && stderr(&o).contains("folder does not exist"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!png.exists(), "a PNG was left behind");
+    let _ = fs::remove_dir_all(&dir);
+}

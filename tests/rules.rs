@@ -592,7 +592,7 @@ fn an_error_beyond_the_f64_range_is_doubted() {
         let mut k = 0usize;
         let result = rule.integrate::<1, f64, _, _>(3, &mut rng, |_| {
             k += 1;
-            if k % 2 == 0 { f64::MAX } else { -f64::MAX }
+            if k.is_multiple_of(2) { f64::MAX } else { -f64::MAX }
         });
         if let Ok(e) = result {
             assert!(

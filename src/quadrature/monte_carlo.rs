@@ -97,7 +97,7 @@ impl<V: Value> Default for Welford<V> {
 }
 
 /// The smallest power of two `>= x` for finite `x > 0` (`2^1023` beyond it).
-fn power_of_two_above(x: f64) -> f64 {
+pub(crate) fn power_of_two_above(x: f64) -> f64 {
     let e = x.log2().ceil().clamp(-1074.0, 1023.0) as i32;
     let p = 2f64.powi(e);
     if p < x && e < 1023 { p * 2.0 } else { p }

@@ -983,6 +983,26 @@ pub fn render_spec(
             ),
         ));
     }
+    // And the whole ray tree: each primary ray's shadow rays and secondary
+    // generations, each tested against every object, as `run` counts it (12
+    // glass spheres at depth 16 passed the primary-ray count, about 5e10
+    // rays, hours).
+    let work = primary * per_primary(&built.scene);
+    if work > crate::experiment::validate::MAX_JOB_EVALUATIONS {
+        return Err(SpecError::at(
+            "samples",
+            format!(
+                "{spec_width} x {spec_height} pixels at {side} x {side} rays a pixel, with the rays \
+                 each primary ray can spawn in this scene (depth {}, lights: {}, objects: {}), are \
+                 about {work:.1e} ray-object tests: expected at most {:.0e} (fewer --samples, a \
+                 smaller --width, --height, or a lower max_depth in the file)",
+                built.scene.max_depth,
+                built.scene.lights.len(),
+                built.scene.objects.len(),
+                crate::experiment::validate::MAX_JOB_EVALUATIONS
+            ),
+        ));
+    }
     // And what would not fit: the values, their errors, the image and its
     // files hold about RENDER_BYTES_PER_PIXEL a pixel (8192 x 8192 peaked at
     // 3.2 GB; 16384 x 16384 ran out of memory).
