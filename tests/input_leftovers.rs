@@ -595,3 +595,13 @@ fn render_counts_the_ray_tree_and_checks_its_outputs_first() {
     assert!(!png.exists(), "a PNG was left behind");
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// An equation ID in a family that has none said so with an empty list
+/// ("expected one of" and nothing; the hostile probe of issue 10).
+#[test]
+fn an_equation_id_in_a_family_without_equations_says_there_are_none() {
+    let o = check_edited("calibration-exp.json", |v| {
+        v["equations"] = json!(["ZZZ"]);
+    });
+    refused(&o, "equations[0]", &["\"ZZZ\"", "instantiates no equation"]);
+}

@@ -375,6 +375,22 @@ fn bad_input_is_a_clear_error_never_a_panic() {
         );
         assert!(e.to_string().contains("NaN"), "{e}");
     }
+    // A product rule names the point in the square (it named the inner
+    // rule's 1-D point, the hostile probe of issue 10); stratified sampling
+    // of a 0-dimensional integral says it needs a dimension.
+    let e = AnyRule::by_name("product(gauss-legendre,trapezoid)")
+        .expect("a rule")
+        .integrate(16, &mut rng(0), |_: [f64; 2]| f64::NAN)
+        .expect_err("NaN");
+    match e {
+        QuadError::NonFiniteIntegrand { ref point, .. } => assert_eq!(point.len(), 2, "{e}"),
+        _ => panic!("{e}"),
+    }
+    let e = AnyRule::by_name("stratified")
+        .expect("a rule")
+        .integrate(2, &mut rng(0), |_: [f64; 0]| 1.0)
+        .expect_err("0-D");
+    assert!(e.to_string().contains("dimension 0"), "{e}");
     let e = AnyRule::by_name("simpsons").expect_err("unknown");
     assert!(e.to_string().contains("unknown rule `simpsons`"), "{e}");
     assert!(e.to_string().contains("gauss-legendre"), "{e}");
@@ -589,16 +605,22 @@ fn an_error_beyond_the_f64_range_is_doubted() {
     let mut rng = rng(7);
     for rule in every_rule() {
         let name = rule.label();
-        let mut k = 0usize;
-        let result = rule.integrate::<1, f64, _, _>(3, &mut rng, |_| {
-            k += 1;
-            if k.is_multiple_of(2) { f64::MAX } else { -f64::MAX }
-        });
-        if let Ok(e) = result {
-            assert!(
-                e.error.is_finite() || !e.reliable,
-                "{name}: infinite error trusted: {e:?}"
-            );
+        for n in [3, 16, 1000] {
+            let mut k = 0usize;
+            let result = rule.integrate::<1, f64, _, _>(n, &mut rng, |_| {
+                k += 1;
+                if k.is_multiple_of(2) {
+                    f64::MAX
+                } else {
+                    -f64::MAX
+                }
+            });
+            if let Ok(e) = result {
+                assert!(
+                    e.error.is_finite() || !e.reliable,
+                    "{name} n = {n}: infinite error trusted: {e:?}"
+                );
+            }
         }
     }
 }

@@ -573,11 +573,19 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
         if !F::EQUATIONS.contains(&id.as_str()) {
             return Err(SpecError::at(
                 format!("equations[{i}]"),
-                format!(
-                    "unknown equation ID {id:?} for family {}: expected one of {}",
-                    F::NAME,
-                    F::EQUATIONS.join(", ")
-                ),
+                if F::EQUATIONS.is_empty() {
+                    format!(
+                        "unknown equation ID {id:?}: the family {} instantiates no equation of \
+                         the documents; expected no `equations` (or an empty list)",
+                        F::NAME
+                    )
+                } else {
+                    format!(
+                        "unknown equation ID {id:?} for family {}: expected one of {}",
+                        F::NAME,
+                        F::EQUATIONS.join(", ")
+                    )
+                },
             ));
         }
     }

@@ -187,7 +187,14 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
                 let mut p = [0.0; D];
                 p[0] = u[0];
                 p[1] = v[0];
-                f(p)
+                // A value that is not finite is named at its point in the
+                // square, not at the inner rule's point on its line.
+                let y = f(p)?;
+                if y.all_finite() {
+                    Ok(y)
+                } else {
+                    Err(super::nodes::non_finite(&p, &y))
+                }
             })?;
             inner_evaluations += inner.evaluations;
             inner_random |= inner.kind == ErrorKind::StandardError;

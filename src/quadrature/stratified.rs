@@ -126,6 +126,13 @@ impl Rule for Stratified {
         rng: &mut R,
         mut f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        if D == 0 {
+            return Err(QuadError::UnsupportedDimension {
+                rule: "stratified",
+                dim: D,
+                supported: "1 or more (cells to stratify)",
+            });
+        }
         let m = per_axis::<D>(n, 1, "n")?;
         let cells = m.pow(D as u32);
         if cells < 2 {
