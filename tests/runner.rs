@@ -1659,9 +1659,8 @@ fn resume_reads_past_a_bad_line_and_says_what_it_does_not_reuse() {
     assert!(o.status.success(), "{}", stderr(&o));
     let msg = stderr(&o);
     assert!(
-        msg.contains(
-            "--resume does not reuse 1 unreadable line(s), 0 result(s) of another version"
-        ),
+        msg.contains("--resume does not reuse 1 unreadable line(s)")
+            && msg.contains("0 result(s) of another version"),
         "{msg}"
     );
     // Every job's line is back, none run twice: the lines after the bad
@@ -2631,5 +2630,64 @@ fn shards_with_a_relative_mitsuba_values_file_merge() {
     let report = fs::read_to_string(merged.join("t").join("report.md")).expect("report");
     assert!(report.contains("lightquad vs Mitsuba 3"), "{report}");
     assert!(merged.join("t").join("mitsuba-values.json").is_file());
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// `--resume` and `merge` reuse only results of the file's own jobs, shaped
+/// as this version writes them: a line copied with `"rule_index": 99` was
+/// kept as a fifth job of a four-job file and shown as a row "rule #99", and
+/// a value of two channels for a scalar was shown with no true error (the
+/// hostile probe of issue 10).
+#[test]
+fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
+    let (dir, out, o) = run_text("misfits", VALID);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let path = out.join("t/results.jsonl");
+    let text = fs::read_to_string(&path).expect("results");
+    let total = text.lines().count();
+    let mut lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a result"))
+        .collect();
+    let mut foreign = lines[0].clone();
+    foreign["rule_index"] = serde_json::json!(99);
+    let q = lines[1]["quantities"]
+        .as_object()
+        .and_then(|m| m.keys().next().cloned())
+        .expect("a quantity");
+    lines[1]["quantities"][&q]["value"] = serde_json::json!([1.0, 2.0]);
+    lines.push(foreign);
+    let edited: String = lines.iter().map(|l| format!("{l}\n")).collect();
+    fs::write(&path, &edited).expect("write");
+    // merge of the edited folder passes both over, says so, and calls the
+    // merge incomplete (the edited job is missing).
+    let merged = dir.join("merged");
+    let o = merge(&merged, &[&out]);
+    assert!(!o.status.success(), "an incomplete merge succeeded");
+    assert!(
+        stderr(&o).contains("2 unreadable line(s)"),
+        "{}",
+        stderr(&o)
+    );
+    let report = fs::read_to_string(merged.join("t/report.md")).expect("report");
+    assert!(!report.contains("rule #99"), "{report}");
+    // --resume runs the edited job again and drops the foreign one.
+    let o = bin()
+        .args(["run", "--resume", "--out"])
+        .arg(&out)
+        .arg(dir.join("e.json"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("does not reuse 2 unreadable line(s)"),
+        "{}",
+        stderr(&o)
+    );
+    let after = fs::read_to_string(&path).expect("results");
+    assert_eq!(after.lines().count(), total, "{after}");
+    assert!(!after.contains("\"rule_index\":99"), "{after}");
+    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+    assert!(!report.contains("rule #99"), "{report}");
     let _ = fs::remove_dir_all(&dir);
 }

@@ -557,7 +557,8 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
         }
         if unread.unreadable > 0 {
             missing.push(format!(
-                "{name}: {} unreadable line(s) in the shards' results were passed over",
+                "{name}: {} unreadable line(s) in the shards' results (torn, edited, or not a \
+                 result of this file's jobs) were passed over",
                 unread.unreadable
             ));
         }
@@ -650,7 +651,8 @@ fn gather(
     for f in files {
         // Lines of this lightquad version only, as `--resume` keeps.
         let (lines, unread) = run::read_results_counted(&f, Some(&hash));
-        slot.unread.unreadable += unread.unreadable;
+        let (lines, misfits) = slot.exp.reusable(lines);
+        slot.unread.unreadable += unread.unreadable + misfits;
         slot.results.extend(
             lines
                 .into_iter()

@@ -75,6 +75,9 @@ pub trait Loaded: Send + Sync {
     /// a copy beside its results, so that `merge` of its folder finds it
     /// wherever the reference's relative path pointed.
     fn mitsuba_values(&self) -> Option<serde_json::Value>;
+    /// The results read back that are results of its jobs, and how many
+    /// were not ([`super::run::reusable`]).
+    fn reusable(&self, results: Vec<JobResult>) -> (Vec<JobResult>, usize);
 }
 
 impl<F: Family> Loaded for Experiment<F> {
@@ -116,6 +119,9 @@ impl<F: Family> Loaded for Experiment<F> {
                     .map(move |&q| F::memory(&self.scene, m, largest, q))
             })
             .fold(0.0, f64::max)
+    }
+    fn reusable(&self, results: Vec<JobResult>) -> (Vec<JobResult>, usize) {
+        super::run::reusable(self, results)
     }
     fn mitsuba_values(&self) -> Option<serde_json::Value> {
         let named = match &self.spec.reference {

@@ -1029,7 +1029,16 @@ fn table(page: &Page, rows: &[Row], display: Option<&Display>) -> String {
     md.push_str(&"---:|".repeat(usize::from(multi) + usize::from(display.is_some())));
     md.push_str("---:|---:|---:|---|\n");
     for r in rows {
-        let flags: Vec<String> = r.flags.iter().map(ToString::to_string).collect();
+        // A job's failure text may carry a user's strings (a results line
+        // edited by hand): escaped, so that it cannot break the table.
+        let flags: Vec<String> = r
+            .flags
+            .iter()
+            .map(|f| match f {
+                RowFlag::Failed(why) => format!("failed: {}", super::markdown::plain(why)),
+                f => f.to_string(),
+            })
+            .collect();
         let _ = write!(
             md,
             "| {} | {} | {} | {} |",

@@ -290,6 +290,45 @@ fn shaped<F: Family>(
     Ok(out)
 }
 
+/// The results read back from a file (`--resume`, `merge`) that are results
+/// of `exp`'s jobs as this version runs them: a job of its list, by the rule
+/// its index names, with exactly its quantities, each with its channel count
+/// of finite values and of errors (or a failure). Returns them and how many
+/// were not: a hand-edited line with `"rule_index": 99` was reused as a job
+/// of a rule the file does not have, and one with two channels of a scalar
+/// shown as a value with no error (the hostile probe of issue 10).
+pub fn reusable<F: Family>(
+    exp: &Experiment<F>,
+    results: Vec<JobResult>,
+) -> (Vec<JobResult>, usize) {
+    let jobs: BTreeSet<JobKey> = jobs(exp, None).into_iter().collect();
+    let fits = |r: &JobResult| {
+        let job = r.experiment == exp.spec.name
+            && r.family == F::NAME
+            && jobs.contains(&r.key())
+            && exp
+                .spec
+                .rules
+                .get(r.rule_index)
+                .is_some_and(|m| m.label() == r.rule);
+        let shaped = r.failure.is_some()
+            || (r.quantities.len() == exp.spec.quantities.len()
+                && exp.spec.quantities.iter().all(|q| {
+                    let want = F::channels(&exp.scene, *q);
+                    r.quantities.get(q.name()).is_some_and(|m| {
+                        m.value.len() == want
+                            && m.error.len() == want
+                            && m.value.iter().all(|x| x.is_finite())
+                    })
+                }));
+        job && shaped && r.seconds.is_finite()
+    };
+    let before = results.len();
+    let kept: Vec<JobResult> = results.into_iter().filter(fits).collect();
+    let dropped = before - kept.len();
+    (kept, dropped)
+}
+
 /// Every job of an experiment in a fixed order, restricted to a shard; a
 /// rule's budgets below its minimum are left out.
 pub fn jobs<F: Family>(exp: &Experiment<F>, shard: Option<(usize, usize)>) -> Vec<JobKey> {
@@ -431,7 +470,9 @@ pub fn run_experiment(
         // Lines of this experiment file and this lightquad version only, one per
         // job (the last wins).
         let mut by_key = BTreeMap::new();
-        let (read, unread) = read_results_counted(&path, Some(exp.hash()));
+        let (read, mut unread) = read_results_counted(&path, Some(exp.hash()));
+        let (read, misfits) = exp.reusable(read);
+        unread.unreadable += misfits;
         let mut other_release = 0;
         for r in read {
             if r.version == env!("CARGO_PKG_VERSION") {
@@ -444,7 +485,8 @@ pub fn run_experiment(
         // again).
         if unread != Unread::default() || other_release > 0 {
             eprintln!(
-                "{}: --resume does not reuse {} unreadable line(s), {} result(s) of another \
+                "{}: --resume does not reuse {} unreadable line(s) (torn, edited, or not a \
+                 result of this file's jobs), {} result(s) of another \
                  version of the experiment file and {} of another lightquad release in {}: \
                  their jobs run again",
                 exp.name(),
