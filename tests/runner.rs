@@ -1493,6 +1493,38 @@ fn jobs_that_would_take_hours_are_refused_with_their_estimate() {
     // 1e6 outer nodes times 1e6 inner ones, per graded piece.
     rejected(&nested, "budgets", "costs about");
     rejected(&nested, "budgets", "--no-cost-limit");
+    // 20000 voxels along the ray under the nested scheme at 4 nodes a piece:
+    // accepted as 6.8e10 evaluations, about 25 minutes a job (2000 voxels
+    // took 15 s): each piece's call and each trilinear lookup now count.
+    let voxels = |k: usize| {
+        let data: Vec<String> = (0..k)
+            .map(|i| format!("{}", 0.1 + (i % 7) as f64 * 0.1))
+            .collect();
+        VALID
+            .replace("\"scene\": {", "\"scene\": { \"depth_scheme\": \"nested\",")
+            .replace(
+                "{ \"type\": \"constant-sphere\", \"centre\": [0.0, 0.0, 0.0], \"radius\": 1.0, \"kappa\": 2.0 }",
+                &format!(
+                    "{{ \"type\": \"voxel-grid\", \"min\": [-1, -1, -1], \"max\": [1, 1, 1], \"resolution\": [{k}, 1, 1], \"data\": [{}] }}",
+                    data.join(", ")
+                ),
+            )
+            .replace("[4, 16, 64]", "[4]")
+            .replace(
+                "{ \"type\": \"closed-form\" }",
+                "{ \"type\": \"value\", \"values\": { \"tau\": 0.5, \"I_E\": 0.5 } }",
+            )
+    };
+    let slow = voxels(20000);
+    assert!(slow.contains("voxel-grid"), "{slow}");
+    rejected(&slow, "budgets", "costs about");
+    // 2000 voxels (15 s a job) pass.
+    let dir = scratch("voxels-2000");
+    let file = dir.join("e.json");
+    fs::write(&file, voxels(2000)).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
     let help = bin().args(["run", "--help"]).output().expect("runs");
     assert!(String::from_utf8_lossy(&help.stdout).contains("--no-cost-limit"));
     // The bundled suite is well inside the limit.

@@ -627,16 +627,22 @@ impl Family for Volume {
             crate::quadrature::Rule::name(rule),
             "gauss-kronrod" | "monte-carlo" | "sobol"
         );
+        // Each piece's integral costs its evaluations and the call around
+        // them (the rule's setup and bookkeeping, about PIECE_OVERHEAD
+        // lookups): with thousands of voxels along a ray and a few nodes a
+        // piece the calls cost more than the lookups (2000 voxels at n = 4,
+        // nested: 93 ns an evaluation against about 20 on one piece).
+        let pieces = |e: f64| (e + PIECE_OVERHEAD) * smooth;
         let inner = if nested {
-            e * smooth
+            pieces(e)
         } else if in_order {
             12.0
         } else {
             6.0 * (2.0 + n.max(1.0).log2())
         };
-        let shadow = if shadow { e * smooth } else { 1.0 };
+        let shadow = if shadow { pieces(e) } else { 1.0 };
         // V-tau is always evaluated; a term the scene lacks costs nothing.
-        let tau = smooth * e;
+        let tau = pieces(e);
         let emission = if scene.emission.is_some() {
             (graded + knots) * e * (1.0 + inner)
         } else {
@@ -1630,3 +1636,10 @@ fn scene(s: &SceneSpec) -> Result<VolumeScene, SpecError> {
     }
     Ok(scene)
 }
+
+/// The cost of one call of a rule on a piece of the ray, beside its
+/// evaluations, in density lookups of a simple field: Gauss–Legendre at n =
+/// 4 takes about 300 ns a call on a cheap integrand, 9 evaluations of about
+/// 10 ns and some 200 ns around them (measured with criterion-like loops on
+/// the 2-core machine), about ten lookups of a voxel grid.
+const PIECE_OVERHEAD: f64 = 10.0;

@@ -230,6 +230,15 @@ impl Medium for VoxelGrid {
         "voxel-grid"
     }
 
+    /// A trilinear lookup reads eight voxels and weighs them: about four
+    /// lookups of a simple field (the nested scheme at 2000 voxels along the
+    /// ray ran at 93 ns an evaluation, a constant sphere at 21 to 43; 20000
+    /// voxels at 12 repeats passed the guard as 8e11 evaluations and would
+    /// have run for about five hours).
+    fn lookup_work(&self) -> f64 {
+        4.0
+    }
+
     /// The trilinear reconstruction with edge clamping inside the box (faces
     /// included), 0 outside.
     /// Inside the box, the interpolation at `p` moved onto the box: beyond a
