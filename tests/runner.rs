@@ -2723,3 +2723,60 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     assert!(!report.contains("rule #99"), "{report}");
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// What is in the way of an experiment's files is named before any job runs
+/// (a file where its folder goes said "already exists", and a folder named
+/// results.jsonl was named as the experiment's folder); and a run without
+/// `--resume` says it replaces the earlier results of the same file (a rerun
+/// killed at once had turned 360 results into 80 without a word; the
+/// hostile probe of issue 10).
+#[test]
+fn what_is_in_the_way_is_named_and_replaced_results_are_said() {
+    let dir = scratch("in-the-way");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let run = |out: &Path| {
+        bin()
+            .args(["run", "--threads", "1", "--out"])
+            .arg(out)
+            .arg(&file)
+            .output()
+            .expect("runs")
+    };
+    let blocked = dir.join("blocked");
+    fs::create_dir_all(&blocked).expect("mkdir");
+    fs::write(blocked.join("t"), "not a folder").expect("write");
+    let o = run(&blocked);
+    assert!(!o.status.success(), "accepted");
+    assert!(
+        stderr(&o).contains("is in the way") && stderr(&o).contains("blocked/t"),
+        "{}",
+        stderr(&o)
+    );
+    let folder = dir.join("folder");
+    fs::create_dir_all(folder.join("t").join("results.jsonl")).expect("mkdir");
+    let o = run(&folder);
+    assert!(!o.status.success(), "accepted");
+    assert!(
+        stderr(&o).contains("t/results.jsonl") && stderr(&o).contains("is a folder"),
+        "{}",
+        stderr(&o)
+    );
+    let out = dir.join("out");
+    let o = run(&out);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("replacing"), "{}", stderr(&o));
+    let jobs = fs::read_to_string(out.join("t/results.jsonl"))
+        .expect("results")
+        .lines()
+        .count();
+    let o = run(&out);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!("replacing {jobs} earlier result(s)"))
+            && stderr(&o).contains("--resume"),
+        "{}",
+        stderr(&o)
+    );
+    let _ = fs::remove_dir_all(&dir);
+}

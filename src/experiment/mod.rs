@@ -223,6 +223,35 @@ fn lock_output(out: &Path, shard: Option<(usize, usize)>) -> Result<Vec<fs::File
     }
 }
 
+/// Makes an experiment's folder under `--out` (or finds it there), with no
+/// folder where its files go; what is in the way is named.
+fn experiment_folder(dir: &Path) -> Result<(), RunError> {
+    if fs::symlink_metadata(dir).is_ok() && !dir.is_dir() {
+        return Err(io(
+            dir,
+            "is in the way: a file (or a broken link) where this experiment's results folder \
+             goes; expected a folder or nothing (remove it, or choose another --out)",
+        ));
+    }
+    fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    for file in [
+        "experiment.json",
+        "results.jsonl",
+        "report.md",
+        "index.html",
+    ] {
+        let path = dir.join(file);
+        if path.is_dir() {
+            return Err(io(
+                &path,
+                "is a folder where the run writes a file: expected a file or nothing (remove it, \
+                 or choose another --out)",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Checks that `dir` exists (or can be made) and is writable.
 fn writable(dir: &Path) -> Result<(), RunError> {
     if let Ok(meta) = fs::metadata(dir)
@@ -291,6 +320,12 @@ pub fn run_sources(
     // killed run can go; shards share the folder and leave them.
     if opts.shard.is_none() {
         run::remove_stale_temporaries(&opts.out);
+    }
+    // Every experiment's folder and files, before any job runs: a file where
+    // a folder goes (or a folder where a file goes) stopped the run after
+    // the experiments before it had run, with "already exists".
+    for (exp, _, _) in &loaded {
+        experiment_folder(&opts.out.join(exp.name()))?;
     }
     let total: usize = loaded
         .iter()
