@@ -521,6 +521,36 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
         })
         .collect();
     assert_eq!(families, ["calibration", "volume", "rendering", "whitted"]);
+    // Every object the schema describes is closed, as `check` refuses
+    // unknown fields: `{"rule": "trapezoid", "foo": 1}` passed the schema
+    // (the hostile probe of issue 10); and `name` says what `check` accepts.
+    fn open_objects(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
+        match v {
+            serde_json::Value::Object(m) => {
+                if m.contains_key("properties")
+                    && m.get("additionalProperties") != Some(&false.into())
+                {
+                    out.push(path.to_string());
+                }
+                m.iter()
+                    .for_each(|(k, c)| open_objects(c, &format!("{path}/{k}"), out));
+            }
+            serde_json::Value::Array(a) => a
+                .iter()
+                .enumerate()
+                .for_each(|(i, c)| open_objects(c, &format!("{path}[{i}]"), out)),
+            _ => {}
+        }
+    }
+    let mut open = Vec::new();
+    open_objects(&schema, "", &mut open);
+    assert!(open.is_empty(), "open objects: {open:?}");
+    for branch in schema["oneOf"].as_array().expect("oneOf") {
+        assert_eq!(
+            branch["properties"]["name"]["pattern"], "^[A-Za-z0-9_-]{1,100}$",
+            "{branch}"
+        );
+    }
     let volume = &schema["oneOf"][1];
     assert!(
         volume["properties"]["scene"]["$ref"].is_string(),

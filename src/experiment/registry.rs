@@ -389,7 +389,12 @@ impl Registry {
             object.insert("title".into(), format!("{} experiment", e.name).into());
             branch["properties"]["family"] =
                 serde_json::json!({ "const": e.name, "description": e.about });
+            branch["properties"]["name"]["pattern"] =
+                format!("^[A-Za-z0-9_-]{{1,{}}}$", super::validate::MAX_NAME).into();
             branches.push(branch);
+        }
+        for v in defs.values_mut().chain(branches.iter_mut()) {
+            closed_objects(v);
         }
         serde_json::json!({
             "$schema": "https://json-schema.org/draft/2020-12/schema",
@@ -412,6 +417,25 @@ impl Registry {
             }
         }
         out
+    }
+}
+
+/// Marks every object schema below `v` that lists its properties as closed
+/// (`"additionalProperties": false`), as `check` reads every object (unknown
+/// fields are refused): a variant without fields of its own (`{"rule":
+/// "trapezoid"}`) was open, so the schema accepted `{"rule": "trapezoid",
+/// "foo": 1}`, which `check` refuses. The schema composes no object from
+/// parts (no `allOf`), so closing each is exact.
+fn closed_objects(v: &mut serde_json::Value) {
+    match v {
+        serde_json::Value::Object(map) => {
+            if map.contains_key("properties") && !map.contains_key("additionalProperties") {
+                map.insert("additionalProperties".into(), false.into());
+            }
+            map.values_mut().for_each(closed_objects);
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(closed_objects),
+        _ => {}
     }
 }
 
