@@ -614,9 +614,11 @@ fn rectangle_rejects_bad_input() {
     assert_names(Rectangle::new(o, Vec3::zeros(), y), "edge_u");
     assert_names(Rectangle::new(o, x, Vec3::zeros()), "edge_v");
     assert_names(Rectangle::new(o, x, x * -3.0), "edge_v");
-    // Finite components, but the length (and the area) overflow.
-    assert_names(Rectangle::new(o, x * 1e200, y), "edge_u");
+    // Finite components and a finite area: built (the length is taken
+    // scaled); an area beyond f64 is refused.
+    assert!(Rectangle::new(o, x * 1e200, y).is_ok());
     assert_names(Rectangle::new(o, x * 1e150, y * 1e160), "edge_v");
+    assert_names(Rectangle::new(o, x * f64::MAX, y * 2.0), "edge_v");
     assert!(Rectangle::new(o, x, x + y * 1e-6).is_ok());
 }
 
@@ -744,4 +746,51 @@ fn projected_hemisphere_lets_every_rule_integrate_cosine_weighted_integrands() {
             .expect("finite");
         assert!((s2.value - PI / 2.0).abs() < 1e-12, "{name}: {}", s2.value);
     }
+}
+
+/// A domain whose measure overflows f64 is refused by its constructor, with
+/// the reason: a disk of radius 1e200 and the segment [-f64::MAX, f64::MAX]
+/// were built, and every integral over them then blamed an integrand that
+/// returned 1.0 (the hostile probe of issue 10); a rectangle of edges 1e200
+/// was called "not of finite length", a triangle with a vertex at f64::MAX
+/// "not distinct from a".
+#[test]
+fn domains_whose_measure_overflows_are_refused_with_the_reason() {
+    let says = |r: Result<(), QuadError>, field: &str, what: &str| {
+        let e = r.expect_err("refused").to_string();
+        assert!(e.contains(field) && e.contains(what), "{e}");
+    };
+    says(
+        Disk::new(Vec3::zeros(), Vec3::z(), 1e200).map(|_| ()),
+        "radius",
+        "area pi R^2 is finite",
+    );
+    says(
+        Segment::new(-f64::MAX, f64::MAX).map(|_| ()),
+        "b",
+        "length b - a is finite",
+    );
+    says(
+        Rectangle::new(
+            Vec3::zeros(),
+            Vec3::new(1e200, 0.0, 0.0),
+            Vec3::new(0.0, 1e200, 0.0),
+        )
+        .map(|_| ()),
+        "edge_v",
+        "area |edge_u x edge_v| is finite",
+    );
+    says(
+        Triangle::new(
+            Vec3::zeros(),
+            Vec3::new(f64::MAX, 0.0, 0.0),
+            Vec3::new(0.0, 4.0, 0.0),
+        )
+        .map(|_| ()),
+        "c",
+        "edges and area are finite",
+    );
+    // Large but representable domains are still built.
+    assert!(Disk::new(Vec3::zeros(), Vec3::z(), 1e150).is_ok());
+    assert!(Segment::new(-1e307, 1e307).is_ok());
 }

@@ -62,6 +62,14 @@ impl Disk {
         require_finite_vec3("centre", centre)?;
         let frame = frame_around("normal", normal)?;
         require_positive("radius", radius)?;
+        // Its area is a factor of every integral over it.
+        if !(std::f64::consts::PI * radius * radius).is_finite() {
+            return Err(QuadError::invalid(
+                "radius",
+                radius,
+                "a radius whose area pi R^2 is finite in f64 (R below about 7.5e153)",
+            ));
+        }
         Ok(Disk {
             centre,
             frame,

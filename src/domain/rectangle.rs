@@ -47,24 +47,43 @@ impl Rectangle {
         require_finite_vec3("origin", origin)?;
         require_finite_vec3("edge_u", edge_u)?;
         require_finite_vec3("edge_v", edge_v)?;
-        let (len_u, len_v) = (edge_u.norm(), edge_v.norm());
+        // Lengths scaled first: nalgebra's norm of [1e200, 0, 0] overflows.
+        let norm = crate::geometry::norm;
+        let (len_u, len_v) = (norm(edge_u), norm(edge_v));
         if !(len_u > 0.0 && len_u.is_finite()) {
             return Err(QuadError::invalid(
                 "edge_u",
                 format!("{:?}", edge_u.as_slice()),
-                "a non-zero vector of finite length",
+                if len_u > 0.0 {
+                    "a vector whose length is finite in f64 (below about 1.8e308)"
+                } else {
+                    "a non-zero vector"
+                },
             ));
         }
         if !(len_v > 0.0 && len_v.is_finite()) {
             return Err(QuadError::invalid(
                 "edge_v",
                 format!("{:?}", edge_v.as_slice()),
-                "a non-zero vector of finite length",
+                if len_v > 0.0 {
+                    "a vector whose length is finite in f64 (below about 1.8e308)"
+                } else {
+                    "a non-zero vector"
+                },
             ));
         }
         let cross = edge_u.cross(&edge_v);
-        let area = cross.norm();
-        if !(area > DEGENERATE_SIN * len_u * len_v && area.is_finite()) {
+        let area = norm(cross);
+        if !area.is_finite() {
+            return Err(QuadError::invalid(
+                "edge_v",
+                format!("{:?}", edge_v.as_slice()),
+                "edges whose area |edge_u x edge_v| is finite in f64 (below about 1.8e308)",
+            ));
+        }
+        // The sine of the angle between the edges, divided in turn (the
+        // product of two lengths near 1e300 overflows).
+        if area / len_u / len_v <= DEGENERATE_SIN {
             return Err(QuadError::invalid(
                 "edge_v",
                 format!("{:?}", edge_v.as_slice()),

@@ -51,6 +51,16 @@ impl Segment {
                 format!("b >= a = {a} (a ray segment runs forward)"),
             ));
         }
+        // Its length is a factor of every integral over it.
+        if !(b - a).is_finite() {
+            return Err(QuadError::invalid(
+                "b",
+                b,
+                format!(
+                    "a segment from a = {a} whose length b - a is finite in f64 (below about 1.8e308)"
+                ),
+            ));
+        }
         for (i, &t) in breaks.iter().enumerate() {
             if !(t.is_finite() && a < t && t < b) {
                 return Err(QuadError::invalid(

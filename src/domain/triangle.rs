@@ -58,8 +58,24 @@ impl Triangle {
         require_finite_vec3("b", b)?;
         require_finite_vec3("c", c)?;
         let (ab, bc) = (b - a, c - b);
-        let (len_ab, len_bc) = (ab.norm(), bc.norm());
-        if !(len_ab > 0.0 && len_ab.is_finite()) {
+        // Lengths scaled first: nalgebra's norm of [1e200, 0, 0] overflows.
+        let norm = crate::geometry::norm;
+        let (len_ab, len_bc) = (norm(ab), norm(bc));
+        let cross = ab.cross(&bc);
+        let double_area = norm(cross);
+        if !(len_ab.is_finite() && len_bc.is_finite() && double_area.is_finite()) {
+            return Err(QuadError::invalid(
+                "c",
+                format!("{:?}", c.as_slice()),
+                format!(
+                    "vertices whose edges and area are finite in f64 (below about 1.8e308) with \
+                     a = {:?} and b = {:?}",
+                    a.as_slice(),
+                    b.as_slice()
+                ),
+            ));
+        }
+        if len_ab == 0.0 {
             return Err(QuadError::invalid(
                 "b",
                 format!("{:?}", b.as_slice()),
@@ -69,9 +85,9 @@ impl Triangle {
                 ),
             ));
         }
-        let cross = ab.cross(&bc);
-        let double_area = cross.norm();
-        if !(double_area > DEGENERATE_SIN * len_ab * len_bc && double_area.is_finite()) {
+        // The sine of the angle at b, divided in turn (the product of two
+        // lengths near 1e300 overflows).
+        if double_area / len_ab / len_bc <= DEGENERATE_SIN {
             return Err(QuadError::invalid(
                 "c",
                 format!("{:?}", c.as_slice()),
