@@ -87,7 +87,7 @@ impl Triangle {
         }
         // The sine of the angle at b, divided in turn (the product of two
         // lengths near 1e300 overflows).
-        if double_area / len_ab / len_bc <= DEGENERATE_SIN {
+        if len_bc == 0.0 || double_area / len_ab / len_bc <= DEGENERATE_SIN {
             return Err(QuadError::invalid(
                 "c",
                 format!("{:?}", c.as_slice()),
