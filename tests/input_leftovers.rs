@@ -365,6 +365,8 @@ fn the_cost_guard_counts_blobs_occluders_and_objects() {
     }
     whitted["rules"] = json!([{"rule": "grid"}]);
     whitted["budgets"] = json!([1000000]);
+    // A cheap reference, so that the job's own cost is what is refused.
+    whitted["reference"] = json!({"type": "converged", "n": 100});
     refused(
         &check_text(&whitted.to_string()),
         "budgets",
