@@ -870,11 +870,10 @@ fn stratified_estimates_of_peaks_between_samples_are_doubted() {
         }
     }
     eprintln!("stratified interior peaks: {lies} of {total} lie unflagged");
-    // Measured: 961 of 2560 before the tail check, 132 now (Lorentzian
-    // flanks, which look like a resolved 1/x^2, and budgets of 5 to 9 cells,
-    // where one dominant sample of k is not yet beyond the threshold).
+    // Measured: 961 of 2560 before the check, 77 now (Lorentzian flanks,
+    // which look like a resolved 1/x^2, and budgets of a few cells).
     assert!(
-        lies * 16 <= total,
+        lies * 25 <= total,
         "{lies} of {total} peak estimates lie unflagged"
     );
 }
