@@ -2810,3 +2810,18 @@ fn what_is_in_the_way_is_named_and_replaced_results_are_said() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A report file that cannot be written is named with the reason in words
+/// (a full disk during the report said only "No space left on device"; the
+/// hostile probe of issue 10).
+#[test]
+fn a_report_file_that_cannot_be_written_is_named() {
+    let dir = scratch("unwritable");
+    let path = dir.join("no-such-folder").join("report.md");
+    let e = lightquad::experiment::run::write_report_file(&path, b"x").expect_err("no folder");
+    assert!(
+        e.contains(&path.display().to_string()) && e.contains("not found"),
+        "{e}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -38,7 +38,7 @@ use super::report::{
     EXACT_FROM_START, FLAG_LEGEND, Page, Row, RowFlag, SHARED, Section, Summary, TIED, cell, label,
     provenance, ranked, ranks, show_value, skipped,
 };
-use super::run::{JobResult, write_atomic};
+use super::run::{JobResult, write_report_file};
 
 /// The page's styles.
 const CSS: &str = r#"
@@ -235,7 +235,7 @@ pub fn write_experiment(
     sections: &[Section],
 ) -> Result<(), String> {
     let html = experiment_page(dir, page, results, sections);
-    write_atomic(&dir.join("index.html"), html.as_bytes()).map_err(|e| e.to_string())
+    write_report_file(&dir.join("index.html"), html.as_bytes())
 }
 
 /// The HTML of one experiment's page; links only to files present in `dir`
@@ -764,7 +764,7 @@ pub fn write_index(
         b.push_str(&to_html(audit, 0));
     }
     let html = document("lightquad report", &b);
-    write_atomic(&out.join("index.html"), html.as_bytes()).map_err(|e| e.to_string())
+    write_report_file(&out.join("index.html"), html.as_bytes())
 }
 
 /// The link to an experiment's page: its HTML page where it was written,

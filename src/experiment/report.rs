@@ -44,7 +44,7 @@ use std::path::Path;
 use super::fit::fitted_line;
 use super::plot;
 use super::reference::{Crosscheck, Reference, crosscheck_markdown, rms};
-use super::run::{JobResult, write_atomic};
+use super::run::{JobResult, write_report_file};
 use crate::family::{Display, Flag, Measured};
 
 /// What a report page shows of an experiment, whatever its family.
@@ -911,7 +911,7 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
         );
         md.push('\n');
         for (what, file, text) in &s.plots {
-            write_atomic(&dir.join(file), text.as_bytes()).map_err(|e| e.to_string())?;
+            write_report_file(&dir.join(file), text.as_bytes())?;
             let _ = writeln!(md, "![error against {what}]({file})");
         }
         md.push('\n');
@@ -920,7 +920,7 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
         }
         for p in &s.pictures {
             for (file, bytes) in &p.files {
-                write_atomic(&dir.join(file), bytes).map_err(|e| e.to_string())?;
+                write_report_file(&dir.join(file), bytes)?;
             }
             let _ = write!(md, "![{}]({})", p.caption, p.png);
             if let Some(e) = &p.error_png {
@@ -938,8 +938,8 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
         );
     }
     let _ = writeln!(md, "{FLAG_LEGEND}");
-    write_atomic(&dir.join("report.md"), md.as_bytes()).map_err(|e| e.to_string())?;
-    write_atomic(&dir.join("results.csv"), csv(results).as_bytes()).map_err(|e| e.to_string())?;
+    write_report_file(&dir.join("report.md"), md.as_bytes())?;
+    write_report_file(&dir.join("results.csv"), csv(results).as_bytes())?;
     super::html::write_experiment(dir, page, results, &sections)?;
     Ok(summary)
 }
@@ -1451,7 +1451,7 @@ pub fn write_index(
     for audit in audits {
         let _ = writeln!(md, "{audit}");
     }
-    write_atomic(&out.join("index.md"), md.as_bytes()).map_err(|e| e.to_string())?;
+    write_report_file(&out.join("index.md"), md.as_bytes())?;
     super::html::write_index(out, entries, crosscheck, audits, problems, earlier)
 }
 

@@ -416,6 +416,18 @@ pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
     written
 }
 
+/// [`write_atomic`] for a report's files, its failure in words with the
+/// file named (a full disk said only "No space left on device").
+pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    write_atomic(path, bytes).map_err(|e| {
+        format!(
+            "cannot write {}: {}",
+            path.display(),
+            super::source::describe(&e)
+        )
+    })
+}
+
 /// Whether `name` is one of [`write_atomic`]'s temporary files
 /// (`.<name>.<pid>.<n>.tmp`).
 fn is_temporary(name: &str) -> bool {
