@@ -48,6 +48,16 @@ fn i_experiment() -> (
     (exp, rules)
 }
 
+/// `lightquad run --resume --out <out> <file>`.
+fn resume(out: &Path, file: &Path) -> Output {
+    bin()
+        .args(["run", "--resume", "--out"])
+        .arg(out)
+        .arg(file)
+        .output()
+        .expect("runs")
+}
+
 /// `lightquad merge --out <out> <inputs...>`.
 fn merge(out: &Path, inputs: &[&Path]) -> Output {
     bin()
@@ -316,12 +326,7 @@ fn a_killed_run_resumes_to_the_results_of_an_uninterrupted_one() {
         "killed after {before} of 36 jobs"
     );
 
-    let o = bin()
-        .args(["run", "--resume", "--out"])
-        .arg(&part)
-        .arg(&file)
-        .output()
-        .expect("runs");
+    let o = resume(&part, &file);
     assert!(o.status.success(), "{}", stderr(&o));
     same(&results(&part, "t"), &results(&full, "t"));
     let _ = fs::remove_dir_all(&dir);
@@ -1712,12 +1717,7 @@ fn resume_reads_past_a_bad_line_and_says_what_it_does_not_reuse() {
         }
     }
     fs::write(&path, &broken).expect("write");
-    let o = bin()
-        .args(["run", "--resume", "--out"])
-        .arg(&out)
-        .arg(dir.join("e.json"))
-        .output()
-        .expect("runs");
+    let o = resume(&out, &dir.join("e.json"));
     assert!(o.status.success(), "{}", stderr(&o));
     let msg = stderr(&o);
     assert!(
@@ -2630,12 +2630,7 @@ fn failed_writes_and_killed_runs_leave_no_temporary_files() {
     fs::write(out.join(".keep"), "").expect("write");
     let file = dir.join("e.json");
     fs::write(&file, VALID).expect("write");
-    let o = bin()
-        .args(["run", "--resume", "--out"])
-        .arg(&out)
-        .arg(&file)
-        .output()
-        .expect("runs");
+    let o = resume(&out, &file);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!out.join(".index.md.4242.3.tmp").exists());
     assert!(!out.join("t/.report.md.4242.7.tmp").exists());
@@ -2734,12 +2729,7 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     let report = fs::read_to_string(merged.join("t/report.md")).expect("report");
     assert!(!report.contains("rule #99"), "{report}");
     // --resume runs the edited job again and drops the foreign one.
-    let o = bin()
-        .args(["run", "--resume", "--out"])
-        .arg(&out)
-        .arg(dir.join("e.json"))
-        .output()
-        .expect("runs");
+    let o = resume(&out, &dir.join("e.json"));
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
         stderr(&o).contains("does not reuse 2 unreadable line(s)"),

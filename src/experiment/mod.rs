@@ -223,6 +223,23 @@ fn lock_output(out: &Path, shard: Option<(usize, usize)>) -> Result<Vec<fs::File
     }
 }
 
+/// Writes the experiment's Mitsuba values, where it has some, beside its
+/// `experiment.json` in `dir` ([`source::VALUES_COPY`]), unless the same
+/// bytes are there (shards sharing the folder do not race on it): a
+/// reference named by a path relative to the experiment file is not found
+/// from the output folder, and `merge` of shards failed on it.
+fn keep_values(exp: &dyn Loaded, dir: &Path) -> Result<(), RunError> {
+    let Some(values) = exp.mitsuba_values() else {
+        return Ok(());
+    };
+    let copy = dir.join(source::VALUES_COPY);
+    let text = serde_json::to_vec_pretty(&values).map_err(|e| io(dir, e))?;
+    if fs::read(&copy).ok().as_deref() != Some(text.as_slice()) {
+        write_atomic(&copy, &text).map_err(|e| io(&copy, e))?;
+    }
+    Ok(())
+}
+
 /// Makes an experiment's folder under `--out` (or finds it there), with no
 /// folder where its files go; what is in the way is named.
 fn experiment_folder(dir: &Path) -> Result<(), RunError> {
@@ -342,16 +359,7 @@ pub fn run_sources(
         if fs::read(&spec_path).ok().as_deref() != Some(bytes.as_slice()) {
             write_atomic(&spec_path, &bytes).map_err(|e| io(&dir, e))?;
         }
-        // Its Mitsuba values beside it: a reference named by a path relative
-        // to the experiment file is not found from this folder, and `merge`
-        // of shards failed on it.
-        if let Some(values) = exp.mitsuba_values() {
-            let copy = dir.join(source::VALUES_COPY);
-            let text = serde_json::to_vec_pretty(&values).map_err(|e| io(&dir, e))?;
-            if fs::read(&copy).ok().as_deref() != Some(text.as_slice()) {
-                write_atomic(&copy, &text).map_err(|e| io(&dir, e))?;
-            }
-        }
+        keep_values(exp.as_ref(), &dir)?;
         bar.set_message(exp.name().to_string());
         let started = std::time::Instant::now();
         // No more jobs at once than the machine's memory holds (four jobs of
@@ -610,10 +618,7 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
         // The experiment file beside its results, so the merged folder is
         // one `merge` and the report's link can read again.
         write_atomic(&dir.join("experiment.json"), &spec).map_err(|e| io(&dir, e))?;
-        if let Some(values) = exp.mitsuba_values() {
-            let text = serde_json::to_vec_pretty(&values).map_err(|e| io(&dir, e))?;
-            write_atomic(&dir.join(source::VALUES_COPY), &text).map_err(|e| io(&dir, e))?;
-        }
+        keep_values(exp.as_ref(), &dir)?;
         let mut text = String::new();
         for r in &results {
             text.push_str(&serde_json::to_string(r).map_err(|e| io(&dir, e))?);

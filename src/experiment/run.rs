@@ -392,6 +392,26 @@ pub fn read_results_counted(path: &Path, hash: Option<&str>) -> (Vec<JobResult>,
     (out, unread)
 }
 
+/// How many lines of a results file are results of the experiment file
+/// hashing to `hash`: each line is read for its hash alone (an image's
+/// results run to a hundred megabytes, and only the count is said).
+fn results_of(path: &Path, hash: &str) -> usize {
+    #[derive(Deserialize)]
+    struct HashOnly {
+        experiment_hash: String,
+    }
+    let Ok(file) = File::open(path) else {
+        return 0;
+    };
+    BufReader::new(file)
+        .split(b'\n')
+        .map_while(Result::ok)
+        .filter(|line| {
+            serde_json::from_slice::<HashOnly>(line).is_ok_and(|h| h.experiment_hash == hash)
+        })
+        .count()
+}
+
 /// Writes `text` to `path` atomically (a temporary file, then a rename), so a
 /// reader never sees a half-written file.
 pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
@@ -513,13 +533,12 @@ pub fn run_experiment(
         // A run without --resume starts afresh: earlier results of this very
         // file are said to be replaced, not dropped in silence (a rerun
         // killed at once had turned 360 results into 80).
-        let (earlier, _) = read_results_counted(&path, Some(exp.hash()));
-        if !earlier.is_empty() {
+        let earlier = results_of(&path, exp.hash());
+        if earlier > 0 {
             eprintln!(
-                "{}: replacing {} earlier result(s) of this file in {} (pass --resume to keep \
-                 them and run only the rest)",
+                "{}: replacing {earlier} earlier result(s) of this file in {} (pass --resume to \
+                 keep them and run only the rest)",
                 exp.name(),
-                earlier.len(),
                 path.display()
             );
         }

@@ -60,23 +60,22 @@ pub struct Experiment<F: Family> {
 /// format is checked by [`deserialize`]); a syntax error names the JSON path
 /// it is in, and its line and column.
 pub fn parse_json(text: &str) -> Result<serde_json::Value, SpecError> {
-    if text.trim().is_empty() {
-        return Err(empty_file());
-    }
     parse_raw(text).map_err(|(path, e)| error_at(&path, &e))
-}
-
-/// The message for a file with nothing but white space in it (serde says
-/// "EOF while parsing a value at line 1 column 0").
-fn empty_file() -> SpecError {
-    SpecError::at(
-        ".",
-        "the file is empty: an experiment file is one JSON object (`lightquad schema` prints its format)",
-    )
 }
 
 /// [`parse_json`] with the JSON path and serde's error as they are.
 fn parse_raw(text: &str) -> Result<serde_json::Value, (String, serde_json::Error)> {
+    // Nothing but white space: said in words (serde says "EOF while parsing a
+    // value at line 1 column 0").
+    if text.trim().is_empty() {
+        return Err((
+            ".".into(),
+            serde::de::Error::custom(
+                "the file is empty: an experiment file is one JSON object (`lightquad schema` \
+                 prints its format)",
+            ),
+        ));
+    }
     let de = &mut serde_json::Deserializer::from_str(text);
     // serde_path_to_error names a key it could not read (not a string) `?`:
     // the fault is then placed at the object that holds it.
@@ -107,9 +106,6 @@ pub fn parse_and_load<T>(
     text: &str,
     load: impl FnOnce(serde_json::Value) -> Result<T, SpecError>,
 ) -> Result<T, SpecError> {
-    if text.trim().is_empty() {
-        return Err(empty_file());
-    }
     let mut text = std::borrow::Cow::Borrowed(text);
     // The first number beyond the range, as the reader reported it.
     let mut first: Option<(SpecError, String, String)> = None;
