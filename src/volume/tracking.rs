@@ -68,11 +68,11 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 use super::medium::Medium;
-use super::scene::{EmissionMap, VolumeScene};
+use super::scene::{DirectionalLight, EmissionMap, VolumeScene};
 use super::terms::ShadowMethod;
 use crate::error::QuadError;
 use crate::geometry::Ray;
-use crate::quadrature::monte_carlo::Welford;
+use crate::quadrature::monte_carlo::{Welford, power_of_two_above};
 
 /// One span of a smooth piece with its majorant `bar >= sigma`, the control
 /// extinction (residual ratio tracking) and the rate tentative collisions are
@@ -552,21 +552,41 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
             1.0 / (span.b - span.a)
         }
     };
+    let largest_c = |span: &Span, map: &EmissionMap| match map {
+        EmissionMap::Table(table) => table.points().iter().map(|p| p.1.abs()).fold(0.0, f64::max),
+        _ => map.at(span.v_bar).abs(),
+    };
+    let largest_s =
+        |span: &Span, l: &DirectionalLight| l.albedo.map_or(1.0, |a| a * span.bar / (4.0 * PI));
+    // Scores are summed in units: a power of two no smaller than the largest
+    // |c| (V-E) or I_p s (V-L), so that one collision's `c / mu` stays finite
+    // where `mu` is small (c = 8e306 and sigma = 2.6e-3 overflowed to inf
+    // although I_E is 4e304) and scaling back is exact.
+    let unit_of = |largest: f64| {
+        if largest > 0.0 && largest.is_finite() {
+            power_of_two_above(largest)
+        } else {
+            1.0
+        }
+    };
+    let em_unit = unit_of(emission.map_or(0.0, |map| {
+        spans.iter().map(|s| largest_c(s, map)).fold(0.0, f64::max)
+    }));
+    let li_unit = unit_of(light.map_or(0.0, |l| {
+        spans
+            .iter()
+            .map(|s| l.intensity * largest_s(s, &l))
+            .fold(0.0, f64::max)
+    }));
+    let total_unit = em_unit.max(li_unit).max(unit_of(background.abs()));
     let mut one_emission: f64 = 0.0;
     let mut one_light: f64 = 0.0;
     for span in &spans {
         if let Some(map) = emission {
-            let c = match map {
-                EmissionMap::Table(table) => {
-                    table.points().iter().map(|p| p.1.abs()).fold(0.0, f64::max)
-                }
-                _ => map.at(span.v_bar).abs(),
-            };
-            one_emission = one_emission.max(c / rate(span));
+            one_emission = one_emission.max(largest_c(span, map) / em_unit / rate(span));
         }
         if let Some(l) = light {
-            let s = l.albedo.map_or(1.0, |a| a * span.bar / (4.0 * PI));
-            one_light = one_light.max(l.intensity * s / rate(span));
+            one_light = one_light.max(l.intensity / li_unit * largest_s(span, &l) / rate(span));
         }
     }
 
@@ -603,7 +623,7 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
                 let v = medium.density(p);
                 let sigma_t = lambda * v;
                 if let Some(map) = emission {
-                    em += map.at(v) / mu;
+                    em += map.at(v) / em_unit / mu;
                 }
                 if let Some(l) = light {
                     let shadow_ray = Ray {
@@ -628,7 +648,7 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
                         }
                     };
                     let s = l.albedo.map_or(1.0, |a| a * sigma_t / (4.0 * PI));
-                    li += l.intensity * shadow_tau * s / mu;
+                    li += l.intensity / li_unit * shadow_tau * s / mu;
                 }
                 if rng.random::<f64>() < sigma_t / mu {
                     alive = false;
@@ -641,7 +661,11 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
         bg_s.add(background * tau);
         em_s.add(em);
         li_s.add(li);
-        tot_s.add(em + background * tau + li);
+        tot_s.add(
+            em * (em_unit / total_unit)
+                + background / total_unit * tau
+                + li * (li_unit / total_unit),
+        );
     }
     let tau = tau_s.binary(evaluations);
     let scaled = |t: Tracked, s: f64| Tracked {
@@ -653,10 +677,11 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
     // of its own size and one tentative collision's largest score (plus I_b
     // for the escape or not of V-I).
     let unseen = |one: f64| move |x: f64| x.abs().max(one);
-    // A term the scene lacks (or that was not asked for) is exactly 0.
-    let term = |present: bool, scores: &Scores, one: f64| {
+    // A term the scene lacks (or that was not asked for) is exactly 0; the
+    // others are scaled back from their units.
+    let term = |present: bool, scores: &Scores, one: f64, unit: f64| {
         if present {
-            scores.tracked(evaluations, unseen(one))
+            scaled(scores.tracked(evaluations, unseen(one)), unit)
         } else {
             Tracked {
                 value: 0.0,
@@ -667,12 +692,15 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
             }
         }
     };
+    let one_total = one_emission * (em_unit / total_unit)
+        + one_light * (li_unit / total_unit)
+        + background.abs() / total_unit;
     Ok(Radiance {
         tau,
         background: scaled(tau, background),
-        emission: term(emission.is_some(), &em_s, one_emission),
-        light: term(light.is_some(), &li_s, one_light),
-        total: tot_s.tracked(evaluations, unseen(one_emission + one_light + background)),
+        emission: term(emission.is_some(), &em_s, one_emission, em_unit),
+        light: term(light.is_some(), &li_s, one_light, li_unit),
+        total: scaled(tot_s.tracked(evaluations, unseen(one_total)), total_unit),
     })
 }
 
