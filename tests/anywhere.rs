@@ -104,6 +104,29 @@ fn values_are_found_beside_the_experiment_then_among_the_bundled_ones() {
         &dir.join(format!("edited/{NAME}.json")),
     );
     assert!(row.contains("stale") && !row.contains(" +- "), "{row}");
+
+    // A renamed copy: no values are found by its name, and the row names the
+    // bundled experiment whose scene it has (the section was dropped).
+    let renamed = String::from_utf8(fs::read(&file).expect("read"))
+        .expect("utf-8")
+        .replace(&format!("\"name\": \"{NAME}\""), "\"name\": \"my-tau\"");
+    fs::create_dir_all(dir.join("renamed")).expect("mkdir");
+    fs::write(dir.join("renamed/my-tau.json"), renamed).expect("write");
+    let o = bin(&dir.join("elsewhere"))
+        .args(["run", "--out", "out-renamed"])
+        .arg(dir.join("renamed/my-tau.json"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", text(&o));
+    let index = fs::read_to_string(dir.join("elsewhere/out-renamed/index.md")).expect("index");
+    let row = index
+        .lines()
+        .find(|l| l.starts_with("| my-tau | tau | "))
+        .unwrap_or_else(|| panic!("no Mitsuba row in {index}"));
+    assert!(
+        row.contains(&format!("scene is that of the bundled `{NAME}`")) && !row.contains(" +- "),
+        "{row}"
+    );
     let _ = fs::remove_dir_all(&dir);
 }
 

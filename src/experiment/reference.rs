@@ -594,6 +594,23 @@ pub struct Crosscheck {
     pub note: String,
 }
 
+/// The bundled experiment with Mitsuba values whose scene `exp` has, under
+/// another name.
+fn copy_of_bundled<F: Family>(exp: &Experiment<F>) -> Option<String> {
+    super::source::bundled_experiments()
+        .iter()
+        .find_map(|(file, text)| {
+            let name = file.strip_suffix(".json")?;
+            if name == exp.spec.name || super::source::bundled_values(name).is_none() {
+                return None;
+            }
+            let spec =
+                super::validate::deserialize::<F>(super::validate::parse_json(text).ok()?).ok()?;
+            (spec.family == exp.spec.family && spec.scene == exp.spec.scene)
+                .then(|| name.to_string())
+        })
+}
+
 /// The comparison rows of an experiment with Mitsuba values (found as
 /// [`find_values`] says: relative to the experiment file, or built into the
 /// binary); none when it has none and none is expected. Values that are
@@ -606,7 +623,22 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
         _ => None,
     };
     let (json, note) = match find_values(&exp.origin, &exp.spec.name, &exp.hash, named) {
-        Values::NotExpected => return Vec::new(),
+        Values::NotExpected => match copy_of_bundled(exp) {
+            // A renamed copy of a bundled Mitsuba experiment lost its values
+            // (they are found by name and hash): said, not dropped.
+            Some(bundled) => (
+                serde_json::Value::Null,
+                Some(format!(
+                    "no Mitsuba values for `{}`: its scene is that of the bundled `{bundled}`, \
+                     whose values belong to that file alone (values are found by the \
+                     experiment's name and the hash of its file); make this file's with \
+                     `cd reference && .venv/bin/python -m lqref --out DIR FILE`, DIR being \
+                     `reference/values` beside the experiment's folder",
+                    exp.spec.name
+                )),
+            ),
+            None => return Vec::new(),
+        },
         Values::Found { json, .. } => (json, None),
         Values::Stale {
             location,
