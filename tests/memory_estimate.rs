@@ -108,3 +108,38 @@ fn a_job_that_would_exhaust_memory_is_refused_with_its_estimate() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Under an address-space limit (`ulimit -v`, as prlimit sets it) a job
+/// larger than the room left aborted the process when an allocation failed;
+/// it is refused before anything is written, with the limit named, and runs
+/// once the limit allows it.
+#[test]
+fn a_job_past_a_process_memory_limit_is_refused_with_the_limit() {
+    let dir = scratch("rlimit");
+    let file = dir.join("e.json");
+    std::fs::write(&file, experiment("gauss-legendre", 10_000_000)).expect("write");
+    let run = |kib: u64| {
+        Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "ulimit -v {kib} && exec \"$0\" run --out \"$1\" \"$2\""
+            ))
+            .arg(env!("CARGO_BIN_EXE_lightquad"))
+            .arg(dir.join("out"))
+            .arg(&file)
+            .output()
+            .expect("runs")
+    };
+    // Gauss–Legendre at 1e7 nodes holds about 0.56 GB (the estimate tested
+    // above against the measured peak).
+    let o = run(400_000);
+    let msg = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!o.status.success(), "ran under 0.4 GB: {msg}");
+    for want in ["at `budgets`", "0.56 GB", "address-space limit"] {
+        assert!(msg.contains(want), "no `{want}` in {msg}");
+    }
+    assert!(!dir.join("out").exists(), "output left behind");
+    let o = run(4_000_000);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}

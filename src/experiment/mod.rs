@@ -35,6 +35,7 @@ pub mod expected;
 pub mod fit;
 pub mod html;
 pub mod markdown;
+pub mod memory;
 pub mod plot;
 mod progress;
 pub mod reference;
@@ -331,6 +332,27 @@ pub fn run_sources(
             }
         }
     }
+    // A job past a hard cap on this process (prlimit, a cgroup) aborts the
+    // whole run when an allocation fails: refused before any job runs.
+    if let Some(cap) = memory::hard_cap()
+        && !validate::cost_limit_lifted()
+        && let Some((exp, source, _)) = loaded.iter().find(|(e, _, _)| e.max_job_bytes() > cap.room)
+    {
+        return Err(RunError::Spec {
+            file: source.display(),
+            source: crate::error::SpecError::at(
+                "budgets",
+                format!(
+                    "its largest job needs about {:.2} GB of memory, but this process may \
+                     allocate only {:.2} GB more under {} (lower the budgets or raise the \
+                     limit; --no-cost-limit runs it anyway)",
+                    exp.max_job_bytes() / 1e9,
+                    cap.room / 1e9,
+                    cap.what
+                ),
+            ),
+        });
+    }
     writable(&opts.out)?;
     let _lock = lock_output(&opts.out, opts.shard)?;
     // Alone in the folder (a whole run's lock), the temporary files of a
@@ -365,7 +387,7 @@ pub fn run_sources(
         // No more jobs at once than the machine's memory holds (four jobs of
         // 4 GB each on four threads aborted the run).
         let threads = rayon::current_num_threads();
-        let fit = jobs_that_fit(exp.max_job_bytes(), available_memory()).min(threads);
+        let fit = jobs_that_fit(exp.max_job_bytes(), memory::available()).min(threads);
         let results = if fit < threads {
             eprintln!(
                 "{}: its largest jobs hold about {:.1} GB each: {fit} at a time instead of \
@@ -408,15 +430,6 @@ pub fn jobs_that_fit(bytes: f64, available: Option<f64>) -> usize {
         Some(a) if bytes > 0.0 => ((0.8 * a / bytes).floor() as usize).max(1),
         _ => usize::MAX,
     }
-}
-
-/// The memory available to new work (`MemAvailable` of /proc/meminfo), in
-/// bytes; `None` where the system does not say.
-fn available_memory() -> Option<f64> {
-    let text = fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024.0)
 }
 
 /// Failed and total jobs.

@@ -396,6 +396,11 @@ pub fn lift_cost_limit() {
     COST_LIMIT_LIFTED.store(true, std::sync::atomic::Ordering::Relaxed);
 }
 
+/// Whether `--no-cost-limit` was passed ([`lift_cost_limit`]).
+pub fn cost_limit_lifted() -> bool {
+    COST_LIMIT_LIFTED.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// Refuses an experiment whose costliest job (the largest budget each rule
 /// runs at, every quantity) would pass [`MAX_JOB_EVALUATIONS`], with the
 /// estimate: the nested depth scheme at a budget of 1e6 was accepted and ran
@@ -405,7 +410,7 @@ fn check_cost<F: Family>(
     scene: &F::Scene,
     budgets: &[usize],
 ) -> Result<(), SpecError> {
-    if COST_LIMIT_LIFTED.load(std::sync::atomic::Ordering::Relaxed) {
+    if cost_limit_lifted() {
         return Ok(());
     }
     // The converged reference runs before the report: adaptive
