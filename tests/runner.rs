@@ -2805,7 +2805,7 @@ fn what_is_in_the_way_is_named_and_replaced_results_are_said() {
 /// (a full disk during the report said only "No space left on device"; the
 /// hostile probe of issue 10).
 #[test]
-fn a_report_file_that_cannot_be_written_is_named() {
+fn a_report_that_cannot_be_written_is_named_and_leaves_no_partial_pages() {
     let dir = scratch("unwritable");
     let path = dir.join("no-such-folder").join("report.md");
     let e = lightquad::experiment::run::write_report_file(&path, b"x").expect_err("no folder");
@@ -2813,5 +2813,39 @@ fn a_report_file_that_cannot_be_written_is_named() {
         e.contains(&path.display().to_string()) && e.contains("not found"),
         "{e}"
     );
+    let _ = fs::remove_dir_all(&dir);
+
+    // A report that fails at its index (a folder where index.md goes, as a
+    // full disk there would) left the plots and pages written before it; now
+    // they are removed, the results kept, and a --resume writes the report.
+    let dir = scratch("unfinished");
+    let file = dir.join("e.json");
+    fs::write(&file, VALID).expect("write");
+    let out = dir.join("out");
+    fs::create_dir_all(out.join("index.md").join("x")).expect("mkdir");
+    let o = bin()
+        .args(["run", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    let msg = stderr(&o);
+    assert!(!o.status.success(), "{msg}");
+    assert!(
+        msg.contains("index.md") && msg.contains("the results are kept"),
+        "{msg}"
+    );
+    let mut left: Vec<String> = fs::read_dir(out.join("t"))
+        .expect("experiment folder")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["experiment.json", "results.jsonl"]);
+    assert!(!out.join("index.html").exists());
+    fs::remove_dir_all(out.join("index.md")).expect("rm");
+    let o = resume(&out, &file);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.join("t").join("index.html").is_file() && out.join("index.md").is_file());
     let _ = fs::remove_dir_all(&dir);
 }

@@ -439,6 +439,14 @@ fn failures(done: &[(Box<dyn Loaded>, Vec<JobResult>)]) -> (usize, usize) {
     (failed, all.count())
 }
 
+/// A report that could not be finished, said with what was kept.
+fn unfinished(why: String) -> String {
+    format!(
+        "{why}; no report was written (its files so far were removed), the results are kept: \
+         `run --resume` (or `merge`) with the same experiments writes it once this is fixed"
+    )
+}
+
 /// The report path shared by `run` and `merge`: a page per experiment, the
 /// index, and an error when jobs failed or (after a merge) are missing.
 fn write_reports(
@@ -447,6 +455,7 @@ fn write_reports(
     done: &[(Box<dyn Loaded>, Vec<JobResult>)],
     missing: Vec<String>,
 ) -> Result<PathBuf, RunError> {
+    let report_files = run::ReportFiles::begin();
     let mut entries = Vec::new();
     let mut checks = Vec::new();
     let mut problems = missing;
@@ -460,7 +469,9 @@ fn write_reports(
                 exp.name()
             );
         }
-        let written = exp.write_report(&dir, results).map_err(|e| io(&dir, e))?;
+        let written = exp
+            .write_report(&dir, results)
+            .map_err(|e| io(&dir, unfinished(e)))?;
         entries.push((
             exp.name().to_string(),
             exp.description().to_string(),
@@ -491,7 +502,8 @@ fn write_reports(
         .unwrap_or_default();
     earlier.sort();
     report::write_index(out, &entries, &checks, &audits, &problems, &earlier)
-        .map_err(|e| io(out, e))?;
+        .map_err(|e| io(out, unfinished(e)))?;
+    report_files.finish();
     let index = out.join("index.md");
     if !problems.is_empty() {
         return Err(RunError::Incomplete {

@@ -436,9 +436,56 @@ pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
     written
 }
 
+thread_local! {
+    /// The files written since [`ReportFiles::begin`] on this thread.
+    static WRITTEN: std::cell::RefCell<Option<Vec<PathBuf>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// A report written whole or not at all: the files [`write_report_file`]
+/// writes on this thread between [`begin`](Self::begin) and
+/// [`finish`](Self::finish) are removed again when the guard is dropped
+/// unfinished (a full disk at the index left the plots and pages written
+/// before it, with no index). Results files are not report files and stay.
+#[derive(Debug)]
+pub struct ReportFiles {
+    finished: bool,
+}
+
+impl ReportFiles {
+    /// Starts recording the report files written on this thread.
+    pub fn begin() -> Self {
+        WRITTEN.with(|w| *w.borrow_mut() = Some(Vec::new()));
+        ReportFiles { finished: false }
+    }
+
+    /// Keeps every file written: the report is complete.
+    pub fn finish(mut self) {
+        self.finished = true;
+        WRITTEN.with(|w| *w.borrow_mut() = None);
+    }
+}
+
+impl Drop for ReportFiles {
+    fn drop(&mut self) {
+        if self.finished {
+            return;
+        }
+        for path in WRITTEN.with(|w| w.borrow_mut().take()).unwrap_or_default() {
+            let _ = fs::remove_file(path);
+        }
+    }
+}
+
 /// [`write_atomic`] for a report's files, its failure in words with the
-/// file named (a full disk said only "No space left on device").
+/// file named (a full disk said only "No space left on device"); recorded
+/// for [`ReportFiles`].
 pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    WRITTEN.with(|w| {
+        if let Some(list) = w.borrow_mut().as_mut() {
+            list.push(path.to_path_buf());
+        }
+    });
     write_atomic(path, bytes).map_err(|e| {
         format!(
             "cannot write {}: {}",
