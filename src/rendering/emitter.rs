@@ -299,8 +299,13 @@ pub trait Emitter<V: Value> {
     fn pdf(&self, receiver: &Receiver, how: LightSampling, w: Vec3) -> f64 {
         let x = receiver.point();
         match how {
+            // A direction of the cone that misses the light is never
+            // produced ([`Emitter::sample`] gives `None` there): density 0,
+            // so that the density integrates to the chance of a sample.
             LightSampling::Cone => match self.cone(receiver) {
-                Ok(cone) if cone.contains_direction(w) => 1.0 / cone.measure(),
+                Ok(cone) if cone.contains_direction(w) && self.hit(x, w, 0.0).is_some() => {
+                    1.0 / cone.measure()
+                }
                 _ => 0.0,
             },
             LightSampling::Area => {
