@@ -2150,7 +2150,15 @@ fn underflow_constant_integrands_and_missing_estimates_are_labelled() {
     assert!(rows.len() >= 6, "{section}");
     for row in rows {
         assert!(row.contains("underflows"), "unflagged: {row}");
+        // 0 against 0 is no error of 0 (the second independent check): the
+        // true and estimated errors are shown as none.
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        assert_eq!((cells[4], cells[5]), ("—", "—"), "{row}");
     }
+    assert!(
+        section.starts_with(" (reference 0.000000000000000e0: the true value underflows f64"),
+        "{section}"
+    );
     let index = fs::read_to_string(out.join("index.md")).expect("index");
     let ib = index
         .lines()

@@ -465,7 +465,8 @@ fn section(page: &Page, s: &Section) -> String {
             &format!("time to {t:.0e} (s)"),
             &format!(
                 "least median time among the rows from the budget on which the error stays at \
-                 most {t:.0e} at every larger budget"
+                 most {t:.0e} at every larger budget (a row whose value underflows has no \
+                 error and reaches nothing)"
             ),
             true,
         ));

@@ -118,7 +118,8 @@ pub enum RowFlag {
     Job(Flag),
     /// A random estimate whose standard error misses the true error.
     OutsideStandardErrors,
-    /// A deterministic error estimate off by more than 10x, above the rounding floor.
+    /// A deterministic error estimate off by more than 10x: too small beside
+    /// an error above 1e-13, too large beside one of at least 1e-12.
     EstimateOff,
     /// The error grew with the budget, above the rounding floor.
     ErrorGrew,
@@ -159,13 +160,15 @@ impl std::fmt::Display for RowFlag {
 pub const FLAG_LEGEND: &str = "Flags: `failed` (the job's reason follows); `non-finite value`; \
 `outside 4 standard errors` (a random estimate whose standard error misses the true error: \
 the root mean square over channels of error / standard error above 4); \
-`estimate off by more than 10x` (a deterministic error estimate, above the rounding floor); \
+`estimate off by more than 10x` (a deterministic error estimate: too small beside an error \
+above 1e-13, or too large beside an error, or the reference's accuracy, of at least 1e-12); \
 `error estimate unreliable (rule's own check)` (the rule doubts its own estimate: a \
 deterministic rule too small to check it (below 16 Gauss–Legendre nodes or 17 composite points \
 per axis), whose differences do not shrink the way its order says, or whose sum one node \
 carries; or a random one whose \
 samples were all alike, a constant integrand included, since nothing was seen to vary, or whose \
-sample variance is carried by a few samples); `error grew with the budget`; `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
+sample variance is carried by a few samples); `error grew with the budget` (by more than 1.5x \
+from one budget to the next, from an error above 1e-11; smaller rises are not flagged); `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
 parts); `relative error beyond the f64 range` (a finite value against a finite reference too small to \
 divide by); `underflows` (the value is below the smallest f64 and reads 0; its logarithm is exact: ask for `ln_tau`, \
 and `ln I_B = ln B + ln tau`); `no error estimate` (the method had too little to estimate from: \
@@ -385,6 +388,17 @@ fn row(
     if let Some(flag) = judge_estimate(&measured, reference, rel_error, rel_estimate, random) {
         flags.push(flag);
     }
+    // A value that underflowed (0 in f64 against a reference that also reads
+    // 0) has no error f64 can show: 0 on paper, 100% against the true value
+    // (e^-100000 on the stiff sphere). Shown as none; its logarithm is the
+    // quantity that carries it.
+    let underflow = flags.contains(&RowFlag::Job(Flag::Underflow));
+    let none_if_underflow = |x: f64| if underflow { f64::NAN } else { x };
+    let (rel_error, rel_estimate, max_error) = (
+        none_if_underflow(rel_error),
+        none_if_underflow(rel_estimate),
+        none_if_underflow(max_error),
+    );
     Row {
         rule_index,
         budget,
@@ -450,9 +464,11 @@ fn judge_estimate(
         // 1e-13 (ten times the floor): at a cut of 1e-12 an error of 1e-12
         // with an estimate of 2.2e-16 went unflagged or flagged as rounding
         // put it at 0.99997e-12 or 1.0001e-12. One more than 10x too large
-        // (the safe side) is judged from 1e-12.
+        // (the safe side) is judged against an error of at least 1e-12: an
+        // estimate of 8.2e-3 beside a true error of 1.8e-16 (the trapezoid
+        // at the rounding floor) went unflagged.
         let low = rel_error > 10.0 * FLOOR && rel_estimate < rel_error / 10.0;
-        let high = rel_error > 100.0 * FLOOR && rel_estimate > 10.0 * rel_error;
+        let high = rel_estimate > 10.0 * rel_error.max(100.0 * FLOOR);
         let off = rel_estimate.is_finite() && (low || high);
         off.then_some(RowFlag::EstimateOff)
     }
@@ -684,6 +700,12 @@ pub fn sections(page: &Page, results: &[JobResult]) -> Result<Vec<Section>, Stri
         for r in rows.iter_mut() {
             if accuracy > 0.0 && r.rel_error <= accuracy {
                 r.flags.push(RowFlag::AtReferenceAccuracy(accuracy));
+                // The true error is known only to be below the reference's
+                // accuracy: an estimate is contradicted only beyond ten
+                // times that.
+                if r.rel_estimate <= 10.0 * accuracy.max(100.0 * FLOOR) {
+                    r.flags.retain(|f| *f != RowFlag::EstimateOff);
+                }
             }
         }
         let pictures = match page.images.get(i).copied().flatten() {
@@ -907,7 +929,8 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
             md,
             "\nTime to a target: the least median time among the rows from the budget on which \
              the error stays at or below the target at every larger budget (an error that dips \
-             below it at one budget and rises again does not count)."
+             below it at one budget and rises again does not count; a row whose value underflows \
+             has no error and reaches nothing)."
         );
         md.push('\n');
         for (what, file, text) in &s.plots {
@@ -1309,6 +1332,20 @@ fn orders_and_plots(
             plots.push((what, format!("{base}-{suffix}.svg"), text));
         }
     }
+    // A reference of 0 that the rows' values underflow to is not 0.
+    let reference = if rows
+        .iter()
+        .any(|r| r.flags.contains(&RowFlag::Job(Flag::Underflow)))
+        && page
+            .reference
+            .values
+            .get(q)
+            .is_some_and(|v| v.iter().all(|&x| x == 0.0))
+    {
+        format!("{reference}: the true value underflows f64; its logarithm is exact (ln_tau)")
+    } else {
+        reference
+    };
     Ok(Section {
         quantity: q,
         reference: Ok(reference),
@@ -1482,6 +1519,23 @@ mod tests {
         let labels: Vec<&str> = r.iter().map(|x| x.label.as_str()).collect();
         assert_eq!(labels, ["a", "b", "c", "d", "e"]);
         assert_eq!(ranks(&r), [1, 1, 3, 4, 5]);
+    }
+
+    /// An estimate of 8.2e-3 beside a true error of 1.8e-16 (the trapezoid
+    /// on v-b-background-blobs at the rounding floor; the second independent
+    /// check) was not flagged: too large is judged against an error of at
+    /// least 1e-12. Too small stays judged from 1e-13.
+    #[test]
+    fn an_estimate_far_above_an_error_at_the_floor_is_flagged() {
+        let judged = |error: f64, estimate: f64| {
+            judge_estimate(&[], &[1.0], error, estimate, false) == Some(RowFlag::EstimateOff)
+        };
+        assert!(judged(1.8e-16, 8.2e-3));
+        assert!(judged(0.0, 1.1e-11));
+        assert!(!judged(1.8e-16, 9e-12));
+        assert!(!judged(2e-14, 2e-13));
+        assert!(judged(1e-12, 1.1e-11) && !judged(1e-12, 9e-12));
+        assert!(judged(1e-12, 9e-14) && !judged(5e-14, 1e-16));
     }
 
     fn row(budget: usize, rel_error: f64, seconds: f64) -> Row {
