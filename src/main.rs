@@ -225,6 +225,9 @@ fn run(command: Command) -> Result<(), Failure> {
         }
         Command::Schema => writeln!(out, "{}", serde_json::to_string_pretty(&registry.schema())?)?,
         Command::Merge { inputs, out: dir } => {
+            // A merge runs no job: the cost guard, which shards that needed
+            // --no-cost-limit passed, would refuse to join them.
+            experiment::validate::lift_cost_limit();
             let index = experiment::merge(&registry, &inputs, &dir)?;
             writeln!(out, "report: {}", index.display())?;
         }

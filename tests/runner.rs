@@ -2857,3 +2857,42 @@ fn a_report_that_cannot_be_written_is_named_and_leaves_no_partial_pages() {
     assert!(out.join("t").join("index.html").is_file() && out.join("index.md").is_file());
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// Shards that needed `--no-cost-limit` (tracking through a blob of
+/// amplitude 1e307: its walks would collide about 1e307 times) could never
+/// be merged: `merge`, which runs no job, re-ran the cost guard and had no
+/// flag to lift it (hostile probe, issue 10). And `check` advised lowering
+/// the budget, which cannot help there.
+#[test]
+fn shards_run_past_the_cost_limit_merge_and_the_advice_fits_the_cause() {
+    let text = r#"{"name": "blob", "family": "volume",
+      "scene": {"ray": {"origin": [-6.0, 0.0, 0.05], "direction": [1.0, 0.02, 0.0]},
+        "medium": {"type": "gaussian-blobs", "blobs": [
+          {"centre": [0.0, 0.1, 0.0], "amplitude": 1e307, "width": 0.4}]}},
+      "quantities": ["tau"], "rules": [{"rule": "gauss-legendre"}, {"rule": "delta-tracking"}],
+      "budgets": [4, 16], "reference": {"type": "closed-form"}}"#;
+    let dir = scratch("costly-shards");
+    let file = dir.join("blob.json");
+    fs::write(&file, text).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    let msg = stderr(&o);
+    assert!(
+        !o.status.success() && msg.contains("rules[1]") && msg.contains("at any budget"),
+        "{msg}"
+    );
+    for k in ["1/2", "2/2"] {
+        let o = bin()
+            .args(["run", "--no-cost-limit", "--shard", k, "--out"])
+            .arg(dir.join(k.replace('/', "-")))
+            .arg(&file)
+            .output()
+            .expect("runs");
+        assert!(!stderr(&o).contains("costs about"), "{}", stderr(&o));
+    }
+    let merged = dir.join("merged");
+    let o = merge(&merged, &[&dir.join("1-2"), &dir.join("2-2")]);
+    let msg = stderr(&o);
+    assert!(!msg.contains("costs about"), "merge refused: {msg}");
+    assert!(merged.join("blob").join("report.md").is_file(), "{msg}");
+    let _ = fs::remove_dir_all(&dir);
+}

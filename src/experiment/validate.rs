@@ -458,12 +458,31 @@ fn check_cost<F: Family>(
             .map(|&q| F::cost(scene, m, largest, q))
             .sum();
         if cost.is_nan() || cost > MAX_JOB_EVALUATIONS {
+            // Where even the smallest budget costs too much, the scene makes
+            // the rule too dear (tracking through a blob of amplitude 1e307
+            // collides about that often a walk): lowering the budget, the
+            // advice given, could not help.
+            let least = budgets.first().copied().unwrap_or(largest);
+            let at_least: f64 = spec
+                .quantities
+                .iter()
+                .map(|&q| F::cost(scene, m, least, q))
+                .sum();
+            let advice = if at_least.is_nan() || at_least > MAX_JOB_EVALUATIONS {
+                format!(
+                    "even at budget {least} it costs about {at_least:.1e}, so this scene makes the \
+                     rule too dear at any budget: remove rules[{i}] or change the scene (a \
+                     tracking walk collides about as often as the majorant's optical depth)"
+                )
+            } else {
+                "lower the budget".to_string()
+            };
             return Err(SpecError::at(
                 "budgets",
                 format!(
                     "a job of rules[{i}] ({}) at budget {largest} costs about {cost:.1e} integrand \
-                     evaluations: expected at most {MAX_JOB_EVALUATIONS:.0e} per job (lower the \
-                     budget, or pass --no-cost-limit to check and run to go ahead)",
+                     evaluations: expected at most {MAX_JOB_EVALUATIONS:.0e} per job ({advice}, \
+                     or pass --no-cost-limit to check and run to go ahead)",
                     m.label()
                 ),
             ));
