@@ -127,6 +127,27 @@ fn values_are_found_beside_the_experiment_then_among_the_bundled_ones() {
         row.contains(&format!("scene is that of the bundled `{NAME}`")) && !row.contains(" +- "),
         "{row}"
     );
+
+    // Renamed and edited (another kappa): no bundled scene matches, but its
+    // description speaks of Mitsuba, and the row says the values are missing.
+    let edited = fs::read_to_string(dir.join("renamed/my-tau.json"))
+        .expect("read")
+        .replace("\"my-tau\"", "\"my-tau2\"");
+    let mut json: serde_json::Value = serde_json::from_str(&edited).expect("json");
+    json["scene"]["medium"]["kappa"] = 0.9.into();
+    fs::write(dir.join("renamed/my-tau2.json"), json.to_string()).expect("write");
+    let o = bin(&dir.join("elsewhere"))
+        .args(["run", "--out", "out-edited"])
+        .arg(dir.join("renamed/my-tau2.json"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", text(&o));
+    let index = fs::read_to_string(dir.join("elsewhere/out-edited/index.md")).expect("index");
+    let row = index
+        .lines()
+        .find(|l| l.starts_with("| my-tau2 | tau | "))
+        .unwrap_or_else(|| panic!("no Mitsuba row in {index}"));
+    assert!(row.contains("no Mitsuba values for `my-tau2`"), "{row}");
     let _ = fs::remove_dir_all(&dir);
 }
 

@@ -257,7 +257,8 @@ fn stale_values(path: &str, made_from: &str, hash: &str) -> SpecError {
         "reference.file",
         format!(
             "{path} is stale: it was made from an experiment file with hash {made_from:?}, this one \
-             hashes to {hash:?}; regenerate it (scripts/reference.sh)"
+             hashes to {hash:?} (the hash is of the file's bytes: any edit counts, reformatting \
+             included); regenerate it (scripts/reference.sh)"
         ),
     )
 }
@@ -594,6 +595,13 @@ pub struct Crosscheck {
     pub note: String,
 }
 
+/// Whether the experiment's name or description speaks of Mitsuba.
+fn mentions_mitsuba<F: Family>(exp: &Experiment<F>) -> bool {
+    [&exp.spec.name, &exp.spec.description]
+        .iter()
+        .any(|t| t.to_lowercase().contains("mitsuba"))
+}
+
 /// The bundled experiment with Mitsuba values whose scene `exp` has, under
 /// another name.
 fn copy_of_bundled<F: Family>(exp: &Experiment<F>) -> Option<String> {
@@ -637,6 +645,19 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
                     exp.spec.name
                 )),
             ),
+            // An experiment that says it is cross-checked against Mitsuba
+            // (its name or description) but has no values: said, not
+            // dropped (an edited, renamed copy of a bundled one).
+            None if mentions_mitsuba(exp) => (
+                serde_json::Value::Null,
+                Some(format!(
+                    "no Mitsuba values for `{}` (it names Mitsuba, but no values file was found \
+                     for its name and file hash): make them with `cd reference && \
+                     .venv/bin/python -m lqref --out DIR FILE`, DIR being `reference/values` \
+                     beside the experiment's folder",
+                    exp.spec.name
+                )),
+            ),
             None => return Vec::new(),
         },
         Values::Found { json, .. } => (json, None),
@@ -648,7 +669,8 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
             serde_json::Value::Null,
             Some(format!(
                 "values file {location} is stale (made from experiment hash {made_from}, this \
-                 file hashes to {}): regenerate with scripts/reference.sh",
+                 file hashes to {}; the hash is of the file's bytes: any edit counts, \
+                 reformatting included): regenerate with scripts/reference.sh",
                 exp.hash
             )),
         ),
