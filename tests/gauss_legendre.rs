@@ -70,7 +70,7 @@ fn compiled_table_matches_newton_in_double_double_for_every_n_up_to_100() {
     for n in 1..=TABLE_MAX_ORDER {
         for k in 1..=n.div_ceil(2) {
             let t = half_node(n, k).expect("valid node");
-            let r = newton::node(n, k, bogaert::node(n, k));
+            let r = newton::node(n, k, bogaert::node(n, k).expect("valid")).expect("valid");
             let d = [
                 ulps(t.x, r.x),
                 ulps(t.one_minus_x, r.one_minus_x),
@@ -336,4 +336,25 @@ fn half_node_refuses_orders_and_indices_that_have_no_node() {
     }
     let middle = half_node(5, 3).expect("the middle node");
     assert_eq!(middle.one_minus_x, 1.0);
+}
+
+/// The public building blocks refuse what is out of range (hostile probe,
+/// issue 10): `bogaert::node(0, 0)` gave x = -3.4e62 and a weight of
+/// -3.7e17, and the unguarded entry point of a rule at `usize::MAX` in three
+/// dimensions ran on (1.8e19 evaluations).
+#[test]
+fn node_building_blocks_and_unguarded_rules_refuse_out_of_range_input() {
+    use lightquad::quadrature::Trapezoid;
+    for (n, k) in [(0, 0), (5, 0), (5, 4), (usize::MAX, usize::MAX)] {
+        let e = bogaert::node(n, k).expect_err("out of range");
+        assert!(e.to_string().contains("1..="), "{e}");
+        let start = bogaert::node(5, 1).expect("valid");
+        assert!(newton::node(n, k, start).is_err());
+    }
+    let ok = bogaert::node(201, 101).expect("the middle node");
+    assert!(ok.x.abs() < 1e-15 && ok.weight > 0.0);
+    let e = Trapezoid
+        .integrate_unguarded::<3, f64, _, _>(usize::MAX, &mut rand::rng(), |_| Ok(1.0))
+        .expect_err("beyond the budget limit");
+    assert!(e.to_string().contains("2^40"), "{e}");
 }

@@ -347,6 +347,7 @@ impl Rule for GaussKronrod {
         _rng: &mut R,
         mut f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        crate::quadrature::check_budget(n)?;
         if D != 1 {
             return Err(QuadError::UnsupportedDimension {
                 rule: "gauss-kronrod",

@@ -306,6 +306,7 @@ impl Rule for GenzMalik {
         _rng: &mut R,
         mut f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        crate::quadrature::check_budget(n)?;
         if !(2..=MAX_DIM).contains(&D) {
             return Err(QuadError::UnsupportedDimension {
                 rule: "genz-malik",

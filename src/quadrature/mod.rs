@@ -147,7 +147,8 @@ pub trait Rule {
     /// The rule itself, which [`Rule::try_integrate`] guards against
     /// overflow: estimates `int_{[0,1]^D} f(u) du` with a budget of about `n`
     /// evaluations, for an integrand that may fail: its first error stops the
-    /// rule and is returned as is.
+    /// rule and is returned as is. `n` above [`MAX_BUDGET`] is an error here
+    /// too.
     ///
     /// `rng` drives the randomised rules and is ignored by deterministic ones;
     /// with the same `rng` state the result is bit-for-bit reproducible.
@@ -202,13 +203,7 @@ pub trait Rule {
         rng: &mut R,
         mut f: F,
     ) -> Result<Estimate<V>, QuadError> {
-        if n > MAX_BUDGET {
-            return Err(QuadError::invalid(
-                "n",
-                n,
-                format!("a budget of at most 2^40 = {MAX_BUDGET} evaluations"),
-            ));
-        }
+        check_budget(n)?;
         // Working memory that grows with n (an adaptive rule's intervals, a
         // node table): G7-K15 at n = 2^40 grew to gigabytes until the machine
         // ran out.
@@ -456,6 +451,20 @@ pub(crate) fn check_tolerances(abs_tol: f64, rel_tol: f64) -> Result<(), QuadErr
 /// from an unchecked computation) is refused at once instead of looping for
 /// centuries.
 pub const MAX_BUDGET: usize = 1 << 40;
+
+/// Refuses a budget above [`MAX_BUDGET`]: every rule's entry points, the
+/// unguarded ones included (a trapezoid in three dimensions at `usize::MAX`
+/// ran on for 1.8e19 evaluations).
+pub(crate) fn check_budget(n: usize) -> Result<(), QuadError> {
+    if n > MAX_BUDGET {
+        return Err(QuadError::invalid(
+            "n",
+            n,
+            format!("a budget of at most 2^40 = {MAX_BUDGET} evaluations"),
+        ));
+    }
+    Ok(())
+}
 
 /// The most working memory one integral may need by its rule's own
 /// estimate ([`Rule::memory`]): 32 GiB, more than the machines this runs on

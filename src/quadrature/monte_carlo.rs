@@ -267,6 +267,7 @@ impl Rule for MonteCarlo {
         rng: &mut R,
         mut f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        crate::quadrature::check_budget(n)?;
         if n < 2 {
             return Err(QuadError::invalid(
                 "n",

@@ -168,6 +168,7 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
         rng: &mut R,
         mut f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        crate::quadrature::check_budget(n)?;
         if D != 2 {
             return Err(QuadError::UnsupportedDimension {
                 rule: "product",

@@ -102,6 +102,7 @@ impl Rule for Simpson {
         _rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        crate::quadrature::check_budget(n)?;
         COMPOSITE.integrate(n, f)
     }
 }

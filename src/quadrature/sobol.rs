@@ -198,6 +198,7 @@ impl Rule for Sobol {
         rng: &mut R,
         mut f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        crate::quadrature::check_budget(n)?;
         if D > 2 {
             return Err(QuadError::UnsupportedDimension {
                 rule: "sobol",

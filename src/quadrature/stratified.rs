@@ -135,6 +135,7 @@ impl Rule for Stratified {
         rng: &mut R,
         mut f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        crate::quadrature::check_budget(n)?;
         if D == 0 {
             return Err(QuadError::UnsupportedDimension {
                 rule: "stratified",

@@ -103,6 +103,7 @@ impl Rule for Trapezoid {
         _rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        crate::quadrature::check_budget(n)?;
         COMPOSITE.integrate(n, f)
     }
 }

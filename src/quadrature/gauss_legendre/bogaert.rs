@@ -34,6 +34,7 @@
 //! small `delta = theta - alpha` by the angle-addition formula, without
 //! cancellation.
 
+use crate::error::QuadError;
 use super::bessel::alpha_and_weight_factor;
 use super::lanes::Lanes;
 
@@ -67,8 +68,31 @@ pub struct HalfNode<T = f64> {
     pub weight: T,
 }
 
-/// The k-th node counted from `x = +1` (k in 1..=ceil(n/2)) of the n-point rule.
-pub fn node(n: usize, k: usize) -> HalfNode {
+/// The k-th node counted from `x = +1` (k in 1..=ceil(n/2)) of the n-point
+/// rule; any other `n` or `k` is an error (`node(0, 0)` gave x = -3.4e62).
+pub fn node(n: usize, k: usize) -> Result<HalfNode, QuadError> {
+    check_node(n, k)?;
+    Ok(node_unchecked(n, k))
+}
+
+/// `n >= 1`, at most [`crate::quadrature::MAX_BUDGET`], and `1 <= k <=
+/// ceil(n/2)`.
+pub(crate) fn check_node(n: usize, k: usize) -> Result<(), QuadError> {
+    if n == 0 || n > crate::quadrature::MAX_BUDGET {
+        return Err(QuadError::invalid("n", n, "an order in 1..=2^40"));
+    }
+    if k == 0 || k > n.div_ceil(2) {
+        return Err(QuadError::invalid(
+            "k",
+            k,
+            format!("a node index in 1..={} (from x = +1, half of the rule)", n.div_ceil(2)),
+        ));
+    }
+    Ok(())
+}
+
+/// [`node`] for `n`, `k` already checked.
+pub(crate) fn node_unchecked(n: usize, k: usize) -> HalfNode {
     let (a, a_lo, p) = alpha_and_weight_factor(k, n);
     let (a, a_lo, p) = (Lanes([a]), Lanes([a_lo]), Lanes([p]));
     let node = match terms_for(n) {

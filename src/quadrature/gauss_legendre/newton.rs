@@ -45,8 +45,15 @@ fn eval_dd(n: usize, x: DD) -> (DD, DD) {
     (p, p_prev.sub(x.mul(p)).mul_f(n as f64))
 }
 
-/// The k-th node from `x = +1` of the n-point rule, polished by Newton's method.
-pub fn node(n: usize, k: usize, start: HalfNode) -> HalfNode {
+/// The k-th node from `x = +1` of the n-point rule, polished by Newton's
+/// method from `start`; `n` and `k` out of range are an error.
+pub fn node(n: usize, k: usize, start: HalfNode) -> Result<HalfNode, crate::error::QuadError> {
+    super::bogaert::check_node(n, k)?;
+    Ok(node_unchecked(n, k, start))
+}
+
+/// [`node`] for `n`, `k` already checked.
+pub(crate) fn node_unchecked(n: usize, k: usize, start: HalfNode) -> HalfNode {
     let one = DD::from(1.0);
     // The middle node of an odd rule is exactly zero.
     let x = if 2 * k == n + 1 {
