@@ -117,6 +117,14 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
+        // A reader that stopped early (`lightquad schema | head`) is no
+        // failure of ours: quiet, as other tools end on a closed pipe.
+        Err(e)
+            if e.downcast_ref::<std::io::Error>()
+                .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("error: {}", short_numbers(&e.to_string()));
             ExitCode::FAILURE

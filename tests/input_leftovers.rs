@@ -540,6 +540,18 @@ fn empty_cut_short_and_unreadable_keys_are_named_where_they_are() {
         "scene",
         &["key must be a string"],
     );
+    // A byte-order mark was "expected value at line 1 column 1", and more
+    // after the object "trailing characters" (hostile probe, issue 10).
+    refused(
+        &check_text(&format!("\u{feff}{text}")),
+        ".",
+        &["byte-order mark"],
+    );
+    refused(
+        &check_text(&format!("{text}\n{{}}")),
+        ".",
+        &["more after the experiment's JSON object", "one JSON object"],
+    );
 }
 
 /// `render` counts the whole ray tree, as `run` does: a scene at depth 16
@@ -606,4 +618,32 @@ fn an_equation_id_in_a_family_without_equations_says_there_are_none() {
         v["equations"] = json!(["ZZZ"]);
     });
     refused(&o, "equations[0]", &["\"ZZZ\"", "instantiates no equation"]);
+}
+
+/// `lightquad schema | head -1` ended with "error: Broken pipe": a reader
+/// that stops early is no failure (hostile probe, issue 10).
+#[test]
+fn a_reader_that_stops_early_is_no_error() {
+    use std::io::Read;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_lightquad"))
+        .arg("schema")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("runs");
+    let mut first = [0u8; 1];
+    child
+        .stdout
+        .take()
+        .expect("stdout")
+        .read_exact(&mut first)
+        .expect("a byte");
+    // The pipe is closed here, before the schema is written whole.
+    let o = child.wait_with_output().expect("ends");
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(
+        o.status.success() && err.is_empty(),
+        "{:?}: {err}",
+        o.status
+    );
 }

@@ -76,6 +76,16 @@ fn parse_raw(text: &str) -> Result<serde_json::Value, (String, serde_json::Error
             ),
         ));
     }
+    // A byte-order mark (some editors on Windows write one): said in words
+    // (serde says "expected value at line 1 column 1").
+    if text.starts_with('\u{feff}') {
+        return Err((
+            ".".into(),
+            serde::de::Error::custom(
+                "the file starts with a byte-order mark (U+FEFF): save it as UTF-8 without one",
+            ),
+        ));
+    }
     let de = &mut serde_json::Deserializer::from_str(text);
     // serde_path_to_error names a key it could not read (not a string) `?`:
     // the fault is then placed at the object that holds it.
@@ -87,7 +97,17 @@ fn parse_raw(text: &str) -> Result<serde_json::Value, (String, serde_json::Error
         };
         (path, e.into_inner())
     })?;
-    de.end().map_err(|e| (".".to_string(), e))?;
+    de.end().map_err(|e| {
+        (
+            ".".to_string(),
+            serde::de::Error::custom(format!(
+                "more after the experiment's JSON object at line {} column {}: a file holds one \
+                 JSON object and nothing else",
+                e.line(),
+                e.column()
+            )),
+        )
+    })?;
     Ok(json)
 }
 
