@@ -1078,6 +1078,32 @@ fn infinite_error_estimates_survive_the_results_file() {
     assert!(o.status.success(), "{}", stderr(&o));
     same(&results(&merged, "t"), &results(&out, "t"));
     let _ = fs::remove_dir_all(&dir);
+
+    // Where tau underflows to 0 its error was 0 * inf, written as NaN
+    // (hostile probe, issue 10): no estimate is inf there too.
+    let stiff = fs::read_to_string(root().join("experiments/v-tau-stiff-sphere.json"))
+        .expect("bundled")
+        .replace(
+            "{ \"rule\": \"gauss-legendre\" }",
+            "{ \"rule\": \"gauss-legendre\", \"error_estimate\": false }",
+        );
+    assert!(
+        stiff.contains("error_estimate"),
+        "the rule was not replaced"
+    );
+    let (dir, out, o) = run_text("inf-underflow", &stiff);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = fs::read_to_string(out.join("v-tau-stiff-sphere/results.jsonl")).expect("results");
+    assert!(!text.contains("NaN"), "{text}");
+    let read = lightquad::experiment::run::read_results(
+        &out.join("v-tau-stiff-sphere/results.jsonl"),
+        None,
+    );
+    assert!(
+        read.iter().any(|r| r.quantities["tau"].value[0] == 0.0
+            && r.quantities["tau"].error[0] == f64::INFINITY)
+    );
+    let _ = fs::remove_dir_all(&dir);
 }
 
 /// Values near the top of the f64 range are integrated (the rules rescale),

@@ -931,7 +931,10 @@ fn collect(res: &VolumeResult, quantities: &[VolumeQuantity]) -> Outcome<VolumeQ
                 VolumeQuantity::Tau => {
                     let tau = measured(super::Term {
                         value: res.transmittance,
-                        error: res.transmittance * res.optical_depth.error,
+                        error: super::terms::transmittance_error(
+                            res.transmittance,
+                            res.optical_depth.error,
+                        ),
                         ..res.optical_depth
                     });
                     if res.underflow {

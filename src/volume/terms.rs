@@ -582,7 +582,11 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
     let background = scene.background.map(|b| Term {
         id: "V-B",
         value: b * transmittance,
-        error: b * transmittance * depth.error,
+        error: if b == 0.0 {
+            0.0
+        } else {
+            b.abs() * transmittance_error(transmittance, depth.error)
+        },
         evaluations: optical_depth.evaluations,
         kind: depth.kind,
         reliable: depth.reliable,
@@ -753,4 +757,15 @@ pub fn evaluate<R: Rule, Rg: rand::Rng + ?Sized>(
         total,
         evaluated,
     })
+}
+
+/// The error of `tau = e^-depth` from the depth's: `|d tau| = tau |d depth|`,
+/// and no estimate (infinite) where the depth has none, also where tau
+/// underflowed to 0 (`0 * inf` was NaN in the results file).
+pub fn transmittance_error(transmittance: f64, depth_error: f64) -> f64 {
+    if depth_error.is_infinite() {
+        f64::INFINITY
+    } else {
+        transmittance * depth_error
+    }
 }
