@@ -254,9 +254,17 @@ fn run(command: Command) -> Result<(), Failure> {
                         .into(),
                 );
             }
+            // The flags are named as flags, not as the file's camera fields
+            // they replace.
+            let most = lightquad::whitted::scene::MAX_SIDE;
             for (flag, given) in [("--width", width), ("--height", height)] {
-                if given == Some(0) {
-                    return Err(format!("invalid {flag} = 0: expected at least 1 pixel").into());
+                if let Some(g) = given
+                    && !(1..=most).contains(&g)
+                {
+                    return Err(format!(
+                        "invalid {flag} = {g}: expected a number of pixels in 1..={most}"
+                    )
+                    .into());
                 }
             }
             if let Some(p) = &pfm

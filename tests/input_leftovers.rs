@@ -591,6 +591,16 @@ fn render_counts_the_ray_tree_and_checks_its_outputs_first() {
     let o = render(&["--width", "0"]);
     assert!(!o.status.success(), "accepted");
     assert!(stderr(&o).contains("--width = 0"), "{}", stderr(&o));
+    // Past the largest side too: it was named as the file's camera width.
+    let o = render(&["--height", "100000"]);
+    let msg = stderr(&o);
+    assert!(!o.status.success(), "accepted");
+    assert!(
+        msg.contains("--height = 100000")
+            && msg.contains("1..=16384")
+            && !msg.contains("scene.camera"),
+        "{msg}"
+    );
     let pfm = dir.join("no").join("r.pfm");
     let o = render(&[
         "--width",

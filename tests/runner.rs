@@ -233,6 +233,21 @@ fn an_unwritable_output_folder_is_an_error_before_any_job() {
         .expect("runs");
     assert!(!run.status.success());
     assert!(stderr(&run).contains("blocker"), "{}", stderr(&run));
+    // A link to nothing was "already exists (os error 17)".
+    let link = dir.join("dangling");
+    std::os::unix::fs::symlink(dir.join("nowhere").join("x"), &link).expect("symlink");
+    let run = bin()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(&link)
+        .output()
+        .expect("runs");
+    let msg = stderr(&run);
+    assert!(
+        !run.status.success() && msg.contains("which does not exist"),
+        "{msg}"
+    );
     let _ = fs::remove_dir_all(&dir);
 }
 

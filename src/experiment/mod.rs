@@ -281,6 +281,19 @@ fn writable(dir: &Path) -> Result<(), RunError> {
              not exist yet",
         ));
     }
+    // A link to nothing: creating the folder says only "already exists".
+    if fs::metadata(dir).is_err()
+        && let Ok(target) = fs::read_link(dir)
+    {
+        return Err(io(
+            dir,
+            format!(
+                "is a link to {}, which does not exist: the output folder (--out) must be a \
+                 directory or not exist yet (make the link's target, or choose another --out)",
+                target.display()
+            ),
+        ));
+    }
     fs::create_dir_all(dir).map_err(|e| {
         io(
             dir,
