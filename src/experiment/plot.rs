@@ -103,11 +103,13 @@ pub fn svg(
         y0 = y0.min(*y);
         y1 = y1.max(*y);
     }
-    // Whole decades, at least one wide on each axis: plotters' log axis
-    // misbehaves on ranges that are very narrow or start off a decade.
+    // Whole decades, at least two wide on each axis: plotters' log axis
+    // misbehaves on ranges that are very narrow or start off a decade, and
+    // on one decade it labelled no y tick and the x tick 1e1 twice (every
+    // error 0 on a ray that misses).
     let decades = |lo: f64, hi: f64| {
         let a = lo.log10().floor().clamp(-300.0, 300.0);
-        let b = hi.log10().ceil().clamp(-300.0, 300.0).max(a + 1.0);
+        let b = hi.log10().ceil().clamp(-300.0, 300.0).max(a + 2.0);
         (10f64.powf(a), 10f64.powf(b))
     };
     let (x0, x1) = decades(x0, x1);
@@ -132,7 +134,7 @@ pub fn svg(
         chart
             .configure_mesh()
             .x_desc(x_label)
-            .y_desc("relative error")
+            .y_desc("error (relative; absolute where the reference is 0)")
             .label_style(("sans-serif", 15))
             .axis_desc_style(("sans-serif", 16))
             .x_label_formatter(&|v| format!("{v:.0e}"))

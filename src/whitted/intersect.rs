@@ -263,19 +263,9 @@ fn sphere_hit(centre: Vec3, radius: f64, ray: &Ray) -> Option<Hit> {
     } else {
         return None;
     };
-    // Reprojected onto the sphere (pbrt-v4): error gamma_5 |p_l|. A sphere
-    // far below the precision of the ray (radius 1e-20 seen from 1.8e19,
-    // where `f + w t` rounds by about 4e3) can leave `f + w t` exactly 0:
-    // the point is then the sphere's point facing the ray's origin (the
-    // near pole, exact for a ray through the centre), not 0/0.
+    // Reprojected onto the sphere (pbrt-v4): error gamma_5 |p_l|.
     let raw = f + w * t;
-    let norm = raw.norm();
-    let local = if norm > 0.0 && norm.is_finite() {
-        raw * (radius / norm)
-    } else {
-        let towards = normalize("f", f).or_else(|_| normalize("w", -w)).ok()?;
-        towards * radius
-    };
+    let local = raw * (radius / raw.norm());
     let point = centre + local;
     let error = local.abs() * gamma(5) + point.abs() * gamma(1);
     Some(Hit {
