@@ -552,6 +552,22 @@ fn empty_cut_short_and_unreadable_keys_are_named_where_they_are() {
         ".",
         &["more after the experiment's JSON object", "one JSON object"],
     );
+    // `Infinity` (what JavaScript and Python write) was "expected value".
+    let infinite = text.replacen(
+        "{\"type\": \"closed-form\"}",
+        "{\"type\": \"literal\", \"values\": {\"exp\": Infinity}}",
+        1,
+    );
+    assert_ne!(infinite, text, "the reference was not replaced");
+    refused(
+        &check_text(&infinite),
+        "reference.values.exp",
+        &[
+            "Infinity",
+            "is not a JSON number",
+            "expected a finite number",
+        ],
+    );
 }
 
 /// `render` counts the whole ray tree, as `run` does: a scene at depth 16

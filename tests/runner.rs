@@ -248,6 +248,23 @@ fn an_unwritable_output_folder_is_an_error_before_any_job() {
         !run.status.success() && msg.contains("which does not exist"),
         "{msg}"
     );
+    // A results file that links to a device was read as earlier results
+    // without end until the process was killed.
+    let out = dir.join("device");
+    fs::create_dir_all(out.join("t")).expect("mkdir");
+    std::os::unix::fs::symlink("/dev/zero", out.join("t").join("results.jsonl")).expect("symlink");
+    let run = bin()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("runs");
+    let msg = stderr(&run);
+    assert!(
+        !run.status.success() && msg.contains("is not a regular file"),
+        "{msg}"
+    );
     let _ = fs::remove_dir_all(&dir);
 }
 

@@ -266,6 +266,15 @@ fn experiment_folder(dir: &Path) -> Result<(), RunError> {
                  or choose another --out)",
             ));
         }
+        // A device or a pipe (a link to /dev/full) was read as earlier
+        // results without end until the process was killed.
+        if fs::metadata(&path).is_ok_and(|m| !m.is_file()) {
+            return Err(io(
+                &path,
+                "is not a regular file (a device, a pipe, or a link to one) where the run keeps \
+                 a file: expected a regular file or nothing (remove it, or choose another --out)",
+            ));
+        }
     }
     Ok(())
 }
@@ -416,7 +425,18 @@ pub fn run_sources(
         } else {
             run_experiment(exp.as_ref(), opts, &bar)
         }
-        .map_err(|e| io(&dir, e))?;
+        // A full disk while the jobs run: what was written is kept, and a
+        // resumed run goes on from it.
+        .map_err(|e| {
+            io(
+                &dir,
+                format!(
+                    "{}; the results written so far are kept: fix this and `run --resume` with \
+                     the same experiments goes on from them",
+                    source::describe(&e)
+                ),
+            )
+        })?;
         progress::finished(opts.progress, &bar, exp.name(), &results, started.elapsed());
         done.push((exp, results));
     }

@@ -95,7 +95,22 @@ fn parse_raw(text: &str) -> Result<serde_json::Value, (String, serde_json::Error
             Some(parent) => parent.trim_end_matches('.').to_string(),
             None => path,
         };
-        (path, e.into_inner())
+        let e = e.into_inner();
+        // `Infinity` and `NaN` (what JavaScript and Python write) are no
+        // JSON: said so, with the word, not "expected value".
+        let word = not_json_number(text, e.line(), e.column());
+        match word {
+            Some(w) => (
+                path,
+                serde::de::Error::custom(format!(
+                    "{w} at line {} column {} is not a JSON number (JSON has no infinities or \
+                     NaN): expected a finite number",
+                    e.line(),
+                    e.column()
+                )),
+            ),
+            None => (path, e),
+        }
     })?;
     de.end().map_err(|e| {
         (
@@ -218,6 +233,22 @@ fn number_at(text: &str, line: usize, column: usize) -> Option<(usize, usize)> {
         start -= 1;
     }
     (start < end).then_some((start, end))
+}
+
+/// The non-JSON number word (`Infinity`, `-Infinity`, `NaN`, `inf`, `nan`)
+/// at serde's `line`, `column` (1-based, at the word's first character or
+/// just after a sign), if that is what stopped the reader.
+fn not_json_number(text: &str, line: usize, column: usize) -> Option<&'static str> {
+    let line_start = if line <= 1 {
+        0
+    } else {
+        text.match_indices('\n').nth(line - 2)?.0 + 1
+    };
+    let at = (line_start + column.saturating_sub(1)).min(text.len());
+    let from = text.get(at.saturating_sub(1)..)?;
+    ["-Infinity", "Infinity", "NaN", "-inf", "inf", "nan"]
+        .into_iter()
+        .find(|w| from.starts_with(w) || from.get(1..).is_some_and(|t| t.starts_with(w)))
 }
 
 /// A JSON value read with a key given twice in an object refused (serde_json
