@@ -146,7 +146,7 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
     rejected(
         &VALID.replace("\"kappa\": 2.0", "\"kappa\": NaN"),
         "scene.medium.kappa",
-        "expected value",
+        "NaN at line 7 column 95 is not a JSON number",
     );
     rejected(
         &VALID.replace("\"rule\": \"stratified\"", "\"rule\": \"boole\""),
