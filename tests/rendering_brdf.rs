@@ -7,6 +7,8 @@
 //! pbrt-v4 style); the inverse of each sampling map by a round trip;
 //! reciprocity (R-rec) and energy conservation by proptest.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use lightquad::QuadError;
@@ -16,7 +18,6 @@ use lightquad::quadrature::gauss_legendre::table;
 use lightquad::rendering::brdf::{Brdf, Ggx, Lambert, NormalizedPhong, Phong};
 use proptest::prelude::*;
 use rand::{RngExt, SeedableRng};
-use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 /// The viewer at polar angle `theta` (degrees) in the xz-plane.
 fn wo_at(theta_deg: f64) -> Vec3 {
@@ -352,38 +353,14 @@ fn chi_square(b: &dyn Brdf, wo: Vec3, n: usize, seed: u64) -> (f64, usize, f64) 
         upper <= n as f64 * (1.0 + 1e-9),
         "upper cells expect {upper}"
     );
-    let mut cells: Vec<(f64, f64)> = vec![((n as f64 - upper).max(0.0), none)];
-    cells.extend(
+    common::pearson(
+        (n as f64 - upper).max(0.0),
+        none,
         expected[lower..]
             .iter()
             .copied()
             .zip(observed[lower..].iter().copied()),
-    );
-    for &(e, o) in &cells {
-        assert!(
-            e > 0.0 || o == 0.0,
-            "{o} samples in a cell of expected count 0"
-        );
-    }
-    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut pooled = (0.0, 0.0);
-    let mut kept: Vec<(f64, f64)> = vec![];
-    for (e, o) in cells {
-        if e < 5.0 {
-            pooled = (pooled.0 + e, pooled.1 + o);
-        } else {
-            kept.push((e, o));
-        }
-    }
-    if pooled.0 >= 5.0 {
-        kept.push(pooled);
-    } else if let Some(first) = kept.first_mut() {
-        *first = (first.0 + pooled.0, first.1 + pooled.1);
-    }
-    let stat: f64 = kept.iter().map(|(e, o)| (o - e) * (o - e) / e).sum();
-    let dof = kept.len() - 1;
-    let p = ChiSquared::new(dof as f64).expect("dof > 0").sf(stat);
-    (stat, dof, p)
+    )
 }
 
 /// Every sampling routine against its pdf: 10^6 samples, Sidak-corrected

@@ -17,6 +17,8 @@
 //!   hit it;
 //! - round trips `invert(map(u)) = u` of the cap and BRDF-sampled maps.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use lightquad::QuadError;
@@ -598,46 +600,11 @@ fn light_chi_square(
         total <= n as f64 * (1.0 + 3e-4),
         "the cells expect {total} of {n}"
     );
-    pearson(
+    common::pearson(
         (n as f64 - total).max(0.0),
         missed,
         expected.into_iter().zip(observed),
     )
-}
-
-/// Pearson's statistic over `(expected, observed)` cells plus the cell of
-/// missed samples, cells expecting fewer than 5 pooled (Mitsuba 3's
-/// convention). Returns (statistic, degrees of freedom, p-value).
-fn pearson(
-    missed_expected: f64,
-    missed: f64,
-    cells: impl Iterator<Item = (f64, f64)>,
-) -> (f64, usize, f64) {
-    use statrs::distribution::{ChiSquared, ContinuousCDF};
-    let mut cells: Vec<(f64, f64)> = std::iter::once((missed_expected, missed))
-        .chain(cells)
-        .collect();
-    for &(e, o) in &cells {
-        assert!(e > 0.0 || o == 0.0, "{o} samples in a cell expecting none");
-    }
-    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (mut pooled, mut kept) = ((0.0, 0.0), Vec::new());
-    for (e, o) in cells {
-        if e < 5.0 {
-            pooled = (pooled.0 + e, pooled.1 + o);
-        } else {
-            kept.push((e, o));
-        }
-    }
-    if pooled.0 >= 5.0 {
-        kept.push(pooled);
-    } else if let Some(first) = kept.first_mut() {
-        *first = (first.0 + pooled.0, first.1 + pooled.1);
-    }
-    let stat: f64 = kept.iter().map(|(e, o)| (o - e) * (o - e) / e).sum();
-    let dof = kept.len() - 1;
-    let p = ChiSquared::new(dof as f64).expect("dof > 0").sf(stat);
-    (stat, dof, p)
 }
 
 /// Chi-square of a sphere light's area sampling, binned on the sphere: its
@@ -701,7 +668,7 @@ fn sphere_area_chi_square(
         total <= n as f64 * (1.0 + 1e-12),
         "the cells expect {total} of {n}"
     );
-    pearson(n as f64 - total, missed, expected.into_iter().zip(observed))
+    common::pearson(n as f64 - total, missed, expected.into_iter().zip(observed))
 }
 
 /// Every light's area and cone sampling against its density: 10^6 samples

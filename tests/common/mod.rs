@@ -111,3 +111,38 @@ pub fn bundled(prefix: &str) -> Vec<(std::path::PathBuf, Json)> {
     out.sort_by(|a, b| a.0.cmp(&b.0));
     out
 }
+
+/// Pearson's statistic over `(expected, observed)` cells plus the cell of
+/// missed samples, cells expecting fewer than 5 pooled (Mitsuba 3's
+/// convention). Returns (statistic, degrees of freedom, p-value).
+pub fn pearson(
+    missed_expected: f64,
+    missed: f64,
+    cells: impl Iterator<Item = (f64, f64)>,
+) -> (f64, usize, f64) {
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    let mut cells: Vec<(f64, f64)> = std::iter::once((missed_expected, missed))
+        .chain(cells)
+        .collect();
+    for &(e, o) in &cells {
+        assert!(e > 0.0 || o == 0.0, "{o} samples in a cell expecting none");
+    }
+    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut pooled, mut kept) = ((0.0, 0.0), Vec::new());
+    for (e, o) in cells {
+        if e < 5.0 {
+            pooled = (pooled.0 + e, pooled.1 + o);
+        } else {
+            kept.push((e, o));
+        }
+    }
+    if pooled.0 >= 5.0 {
+        kept.push(pooled);
+    } else if let Some(first) = kept.first_mut() {
+        *first = (first.0 + pooled.0, first.1 + pooled.1);
+    }
+    let stat: f64 = kept.iter().map(|(e, o)| (o - e) * (o - e) / e).sum();
+    let dof = kept.len() - 1;
+    let p = ChiSquared::new(dof as f64).expect("dof > 0").sf(stat);
+    (stat, dof, p)
+}
