@@ -117,12 +117,16 @@ fn a_job_that_would_exhaust_memory_is_refused_with_its_estimate() {
 fn a_job_past_a_process_memory_limit_is_refused_with_the_limit() {
     let dir = scratch("rlimit");
     let file = dir.join("e.json");
-    std::fs::write(&file, experiment("gauss-legendre", 10_000_000)).expect("write");
-    let run = |kib: u64| {
+    let spec = experiment("gauss-legendre", 10_000_000)
+        .replace(r#""budgets": [10000000]"#, r#""budgets": [8, 10000000]"#);
+    assert!(spec.contains("[8, 10000000]"), "{spec}");
+    std::fs::write(&file, spec).expect("write");
+    let run = |kib: u64, resume: bool| {
         Command::new("sh")
             .arg("-c")
             .arg(format!(
-                "ulimit -v {kib} && exec \"$0\" run --out \"$1\" \"$2\""
+                "ulimit -v {kib} && exec \"$0\" run {} --out \"$1\" \"$2\"",
+                if resume { "--resume" } else { "" }
             ))
             .arg(env!("CARGO_BIN_EXE_lightquad"))
             .arg(dir.join("out"))
@@ -130,16 +134,39 @@ fn a_job_past_a_process_memory_limit_is_refused_with_the_limit() {
             .output()
             .expect("runs")
     };
+    let refused = |o: std::process::Output| {
+        let msg = String::from_utf8_lossy(&o.stderr).to_string();
+        assert!(!o.status.success(), "ran under 0.4 GB: {msg}");
+        for want in ["at `budgets`", "0.56 GB", "address-space limit"] {
+            assert!(msg.contains(want), "no `{want}` in {msg}");
+        }
+    };
     // Gauss–Legendre at 1e7 nodes holds about 0.56 GB (the estimate tested
     // above against the measured peak).
-    let o = run(400_000);
-    let msg = String::from_utf8_lossy(&o.stderr).to_string();
-    assert!(!o.status.success(), "ran under 0.4 GB: {msg}");
-    for want in ["at `budgets`", "0.56 GB", "address-space limit"] {
-        assert!(msg.contains(want), "no `{want}` in {msg}");
-    }
+    refused(run(400_000, false));
     assert!(!dir.join("out").exists(), "output left behind");
-    let o = run(4_000_000);
+    let o = run(4_000_000, false);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Resumed under the small cap with every job finished: nothing is left
+    // to run, so nothing is refused (the finished large job was counted).
+    let o = run(400_000, true);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // With the large job's line gone it is pending again, and refused before
+    // the results file is touched.
+    let results = dir.join("out").join("m").join("results.jsonl");
+    let text = std::fs::read_to_string(&results).expect("results");
+    let small: String = text
+        .lines()
+        .filter(|l| !l.contains(r#""budget":10000000"#))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_eq!(small.lines().count(), 1, "{text}");
+    std::fs::write(&results, &small).expect("rewrite");
+    refused(run(400_000, true));
+    assert_eq!(std::fs::read_to_string(&results).expect("results"), small);
+    let o = run(4_000_000, true);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&results).expect("results");
+    assert_eq!(text.lines().count(), 2, "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }

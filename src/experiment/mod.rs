@@ -355,25 +355,31 @@ pub fn run_sources(
         }
     }
     // A job past a hard cap on this process (prlimit, a cgroup) aborts the
-    // whole run when an allocation fails: refused before any job runs.
+    // whole run when an allocation fails: refused before any job runs. Only
+    // the jobs still to run count: a --resume whose large jobs are finished
+    // goes on.
     if let Some(cap) = memory::hard_cap()
         && !validate::cost_limit_lifted()
-        && let Some((exp, source, _)) = loaded.iter().find(|(e, _, _)| e.max_job_bytes() > cap.room)
     {
-        return Err(RunError::Spec {
-            file: source.display(),
-            source: crate::error::SpecError::at(
-                "budgets",
-                format!(
-                    "its largest job needs about {:.2} GB of memory, but this process may \
-                     allocate only {:.2} GB more under {} (lower the budgets or raise the \
-                     limit; --no-cost-limit runs it anyway)",
-                    exp.max_job_bytes() / 1e9,
-                    cap.room / 1e9,
-                    cap.what
-                ),
-            ),
-        });
+        for (exp, source, _) in &loaded {
+            let need = exp.max_job_bytes(&run::pending_jobs(exp.as_ref(), opts));
+            if need > cap.room {
+                return Err(RunError::Spec {
+                    file: source.display(),
+                    source: crate::error::SpecError::at(
+                        "budgets",
+                        format!(
+                            "its largest job needs about {:.2} GB of memory, but this process \
+                             may allocate only {:.2} GB more under {} (lower the budgets or \
+                             raise the limit; --no-cost-limit runs it anyway)",
+                            need / 1e9,
+                            cap.room / 1e9,
+                            cap.what
+                        ),
+                    ),
+                });
+            }
+        }
     }
     writable(&opts.out)?;
     let _lock = lock_output(&opts.out, opts.shard)?;
@@ -409,13 +415,14 @@ pub fn run_sources(
         // No more jobs at once than the machine's memory holds (four jobs of
         // 4 GB each on four threads aborted the run).
         let threads = rayon::current_num_threads();
-        let fit = jobs_that_fit(exp.max_job_bytes(), memory::available()).min(threads);
+        let need = exp.max_job_bytes(&run::pending_jobs(exp.as_ref(), opts));
+        let fit = jobs_that_fit(need, memory::available()).min(threads);
         let results = if fit < threads {
             eprintln!(
                 "{}: its largest jobs hold about {:.1} GB each: {fit} at a time instead of \
                  {threads}, to fit in the memory available",
                 exp.name(),
-                exp.max_job_bytes() / 1e9
+                need / 1e9
             );
             rayon::ThreadPoolBuilder::new()
                 .num_threads(fit)

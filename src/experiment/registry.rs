@@ -65,11 +65,12 @@ pub trait Loaded: Send + Sync {
     /// Doubts about its scene that do not stop it ([`Family::warnings`]),
     /// each at its JSON path.
     fn warnings(&self) -> Vec<SpecError>;
-    /// The memory its costliest job holds by the family's estimate
-    /// ([`Family::memory`]: every rule at the largest budget, every
-    /// quantity), in bytes: the runner runs fewer jobs at once where the
-    /// machine cannot hold one per thread.
-    fn max_job_bytes(&self) -> f64;
+    /// The memory the costliest of `jobs` holds by the family's estimate
+    /// ([`Family::memory`], every quantity), in bytes: the runner refuses a
+    /// job past a hard cap and runs fewer jobs at once where the machine
+    /// cannot hold one per thread. Only the jobs still to run count (a
+    /// `--resume` whose large jobs are finished was refused for them).
+    fn max_job_bytes(&self, jobs: &[JobKey]) -> f64;
     /// The Mitsuba values file made from this experiment's bytes, where one
     /// was found ([`find_values`](super::source::find_values)): the run keeps
     /// a copy beside its results, so that `merge` of its folder finds it
@@ -105,18 +106,18 @@ impl<F: Family> Loaded for Experiment<F> {
     fn warnings(&self) -> Vec<SpecError> {
         F::warnings(&self.scene)
     }
-    fn max_job_bytes(&self) -> f64 {
-        let Some(&largest) = self.budgets.last() else {
-            return 0.0;
-        };
-        self.spec
-            .rules
-            .iter()
-            .flat_map(|m| {
+    fn max_job_bytes(&self, jobs: &[JobKey]) -> f64 {
+        // Repeats hold the same memory: each (rule, budget) is costed once.
+        let pairs: std::collections::BTreeSet<(usize, usize)> =
+            jobs.iter().map(|&(m, n, _)| (m, n)).collect();
+        pairs
+            .into_iter()
+            .filter_map(|(m, n)| self.spec.rules.get(m).map(|rule| (rule, n)))
+            .flat_map(|(rule, n)| {
                 self.spec
                     .quantities
                     .iter()
-                    .map(move |&q| F::memory(&self.scene, m, largest, q))
+                    .map(move |&q| F::memory(&self.scene, rule, n, q))
             })
             .fold(0.0, f64::max)
     }

@@ -530,6 +530,67 @@ pub fn remove_stale_temporaries(out: &Path) {
     }
 }
 
+/// The results file of experiment `name` under `out`: `results.jsonl`, or a
+/// shard's own file.
+pub fn results_path(out: &Path, name: &str, shard: Option<(usize, usize)>) -> PathBuf {
+    out.join(name).join(match shard {
+        None => "results.jsonl".to_string(),
+        Some((k, n)) => format!("results.shard-{k}-of-{n}.jsonl"),
+    })
+}
+
+/// The finished jobs a `--resume` keeps from a results file, and what it
+/// passes over.
+pub struct Finished {
+    /// One result per job (the last line wins), of this experiment file and
+    /// this lightquad release.
+    pub results: Vec<JobResult>,
+    /// Lines that are not results of this file's jobs.
+    pub unread: Unread,
+    /// Results written by another lightquad release.
+    pub other_release: usize,
+}
+
+/// Reads the finished jobs of `exp` from `path` ([`Finished`]); nothing is
+/// written or said.
+pub fn finished_jobs(exp: &dyn Loaded, path: &Path) -> Finished {
+    let mut by_key = BTreeMap::new();
+    let (read, mut unread) = read_results_counted(path, Some(exp.hash()));
+    let (read, misfits) = exp.reusable(read);
+    unread.unreadable += misfits;
+    let mut other_release = 0;
+    for r in read {
+        if r.version == env!("CARGO_PKG_VERSION") {
+            by_key.insert(r.key(), r);
+        } else {
+            other_release += 1;
+        }
+    }
+    Finished {
+        results: by_key.into_values().collect(),
+        unread,
+        other_release,
+    }
+}
+
+/// The jobs of `exp` a run with `opts` still has to do: all of its shard's,
+/// less those finished in its results file on `--resume`.
+pub fn pending_jobs(exp: &dyn Loaded, opts: &RunOptions) -> Vec<JobKey> {
+    let done: BTreeSet<JobKey> = if opts.resume {
+        finished_jobs(exp, &results_path(&opts.out, exp.name(), opts.shard))
+            .results
+            .iter()
+            .map(JobResult::key)
+            .collect()
+    } else {
+        BTreeSet::new()
+    };
+    exp.jobs(opts.shard)
+        .into_iter()
+        .filter(|j| !done.contains(j))
+        .collect()
+}
+
 /// Runs one experiment's pending jobs, appending to `<out>/<name>/results.jsonl`;
 /// returns every result of the experiment (old and new), sorted by job.
 pub fn run_experiment(
@@ -539,43 +600,27 @@ pub fn run_experiment(
 ) -> std::io::Result<Vec<JobResult>> {
     let dir = opts.out.join(exp.name());
     fs::create_dir_all(&dir)?;
-    let path = dir.join(match opts.shard {
-        None => "results.jsonl".to_string(),
-        Some((k, n)) => format!("results.shard-{k}-of-{n}.jsonl"),
-    });
+    let path = results_path(&opts.out, exp.name(), opts.shard);
     // Keep finished jobs on --resume (rewriting the file without a torn last
     // line); start afresh otherwise.
     let kept = if opts.resume {
-        // Lines of this experiment file and this lightquad version only, one per
-        // job (the last wins).
-        let mut by_key = BTreeMap::new();
-        let (read, mut unread) = read_results_counted(&path, Some(exp.hash()));
-        let (read, misfits) = exp.reusable(read);
-        unread.unreadable += misfits;
-        let mut other_release = 0;
-        for r in read {
-            if r.version == env!("CARGO_PKG_VERSION") {
-                by_key.insert(r.key(), r);
-            } else {
-                other_release += 1;
-            }
-        }
+        let finished = finished_jobs(exp, &path);
         // Lines not reused are said, not dropped in silence (their jobs run
         // again).
-        if unread != Unread::default() || other_release > 0 {
+        if finished.unread != Unread::default() || finished.other_release > 0 {
             eprintln!(
                 "{}: --resume does not reuse {} unreadable line(s) (torn, edited, or not a \
                  result of this file's jobs), {} result(s) of another \
                  version of the experiment file and {} of another lightquad release in {}: \
                  their jobs run again",
                 exp.name(),
-                unread.unreadable,
-                unread.other_version,
-                other_release,
+                finished.unread.unreadable,
+                finished.unread.other_version,
+                finished.other_release,
                 path.display()
             );
         }
-        by_key.into_values().collect()
+        finished.results
     } else {
         // A run without --resume starts afresh: earlier results of this very
         // file are said to be replaced, not dropped in silence (a rerun
