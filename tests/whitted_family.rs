@@ -631,6 +631,92 @@ fn extreme_numbers_anywhere_are_errors_not_panics() {
 /// wrote 183 NaN pixels of 4800 (black in the PNG) with exit 0; an energy
 /// gain was warned of by `check` but not by `render`.
 #[test]
+fn a_sphere_below_what_f64_resolves_is_warned_and_its_undefined_ray_named() {
+    // A sphere of radius 1e-20 seen from 1.8e19: size over distance
+    // 1e-20 / 1.8e19 = 5.6e-40, far below the 1e-16 rounding of a ray.
+    let dir = scratch("tiny-far");
+    let file = dir.join("tiny.json");
+    let spec = json!({"name": "tiny", "family": "whitted",
+        "scene": {"camera": {"eye": [0, 0, 1.8e19], "look_at": [0, 0, 0], "up": [0, 1, 0],
+            "fov_y": 20.0, "width": 8, "height": 8},
+          "ambient": [0.2, 0.2, 0.2], "background": [0.1, 0.2, 0.4],
+          "lights": [{"type": "point", "position": [2, 3, 5], "intensity": [1, 1, 1]}],
+          "objects": [{"type": "sphere", "centre": [0, 0, 0], "radius": 1e-20,
+            "material": {"k_a": 0.3, "k_d": 0.5, "k_s": 0.0, "phong": 20.0,
+              "colour": [0.9, 0.3, 0.2]}}],
+          "max_depth": 0, "pixel": [4, 3]},
+        "quantities": ["pixel"], "rules": [{"rule": "trapezoid"}], "budgets": [16],
+        "repeats": 1, "reference": {"type": "converged"}});
+    fs::write(&file, spec.to_string()).expect("write");
+    let check = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(check.status.success(), "{}", stderr(&check));
+    for want in ["at `scene.objects[0]`", "5.6e-40 of its distance", "1e-12"] {
+        assert!(
+            stderr(&check).contains(want),
+            "no `{want}` in {}",
+            stderr(&check)
+        );
+    }
+    // The trapezoid rule's corner [0, 1] of pixel (4, 3) is the image's
+    // centre, whose ray passes exactly through the sphere's centre: its hit
+    // point and normal are rounding (0/0), and the job fails naming the
+    // scene, not the integrand.
+    let run = bin()
+        .args(["run", "--out"])
+        .arg(dir.join("out"))
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(!run.status.success(), "{}", stderr(&run));
+    let results = fs::read_to_string(dir.join("out/tiny/results.jsonl")).expect("results");
+    for want in [
+        "invalid scene",
+        "not a number",
+        "pixel point [0.0, 1.0]",
+        "within about 1e12",
+    ] {
+        assert!(results.contains(want), "no `{want}` in {results}");
+    }
+    assert!(!results.contains("integrand returned"), "{results}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_background_on_a_display_step_boundary_is_in_doubt() {
+    // A pixel of background (0.1, 0.2, 0.4) only: 255 x 0.1 = 25.5 lies on
+    // W-Grey's rounding boundary between 25 and 26, while 51 and 102 lie a
+    // half step from one. Every ray sees the same value, so the converged
+    // reference changes by 0; rounding of a rule's weights still moves 0.1
+    // across the boundary, and the report must count that value in doubt.
+    let dir = scratch("boundary");
+    let file = dir.join("b.json");
+    let spec = json!({"name": "b", "family": "whitted",
+        "scene": {"camera": {"eye": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0],
+            "fov_y": 20.0, "width": 8, "height": 8},
+          "ambient": [0.2, 0.2, 0.2], "background": [0.1, 0.2, 0.4], "lights": [],
+          "objects": [{"type": "sphere", "centre": [0, 0, -100], "radius": 1.0,
+            "material": {"k_a": 0.3, "k_d": 0.5, "k_s": 0.0, "phong": 20.0,
+              "colour": [0.9, 0.3, 0.2]}}],
+          "max_depth": 0, "pixel": [0, 0]},
+        "quantities": ["pixel"], "rules": [{"rule": "gauss-legendre"}], "budgets": [16, 64],
+        "repeats": 1, "reference": {"type": "converged"}});
+    fs::write(&file, spec.to_string()).expect("write");
+    let run = bin()
+        .args(["run", "--out"])
+        .arg(dir.join("out"))
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(run.status.success(), "{}", stderr(&run));
+    let report = fs::read_to_string(dir.join("out/b/report.md")).expect("report");
+    assert!(
+        report.contains("leaves 1 of the reference's own displayed values in doubt"),
+        "{report}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn render_refuses_endless_and_undefined_images_and_warns() {
     let dir = scratch("render-refuses");
     let png = dir.join("r.png");

@@ -59,8 +59,8 @@ pub struct Reference {
     pub accuracy: BTreeMap<String, f64>,
     /// Absolute accuracy per quantity name and channel, where the reference
     /// knows it channel by channel (a converged reference: each channel's
-    /// last change or its own error estimate, the larger; a background pixel
-    /// that every ray sees alike has 0).
+    /// last change or its own error estimate, the larger, and never below
+    /// [`CONVERGED_FLOOR`] of its value).
     pub channel_accuracy: BTreeMap<String, Vec<f64>>,
 }
 
@@ -498,7 +498,13 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
                                 None => f64::NAN,
                             };
                             let own = y.error.get(c).copied().filter(|e| e.is_finite());
+                            // Never below the rounding floor (as the whole
+                            // quantity's): a background channel of 0.1 every
+                            // ray sees alike changed by 0, yet the rules'
+                            // weights summed it to 0.09999999999999999, a
+                            // display step below the reference's 25.5.
                             own.map_or(change, |e| change.max(e.abs()))
+                                .max(CONVERGED_FLOOR * y.value[c].abs())
                         })
                         .collect();
                     Some((q.name().to_string(), each))

@@ -1134,7 +1134,8 @@ pub fn display_line(
         .count();
     let unsure = if overall > 0.0 || each.is_some() {
         let how = if each.is_some() {
-            "Each channel's accuracy (its last change or own error estimate, the larger)"
+            "Each channel's accuracy (its last change or own error estimate, the larger, \
+             and at least 1e-13 of its value)"
         } else {
             "The reference's accuracy"
         };

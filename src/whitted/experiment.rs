@@ -497,8 +497,34 @@ pub fn evaluate_counted(
         let (est, rays) = render::coverage_block(scene, corner, w, h, &scheme, rng)?;
         return Ok((measured(&est, rays.total()), rays));
     }
-    let out = render::render_block(scene, corner, w, h, &scheme, rng)?;
+    let out = render::render_block(scene, corner, w, h, &scheme, rng).map_err(unresolved)?;
     Ok((measured(&out.image, out.rays.total()), out.rays))
+}
+
+/// The least size of an object beside its distance from the eye that f64
+/// resolves along the rays meeting it: their rounding is about 1e-16 of
+/// their length, so below 1e-12 a hit point is uncertain by more than
+/// 1e-4 of the object.
+pub const SMALLEST_RESOLVED: f64 = 1e-12;
+
+/// What a scene must be for its rays to be defined: said when a pixel comes
+/// out not a number (`render`) or a pixel's integrand does (a job).
+pub const RESOLVED_SCENE: &str = "a scene whose coordinates and sizes f64 resolves along its \
+     rays: extents and distances within about 1e12 of each other (an object of size 1e30 \
+     around the camera, a sphere of radius 1e-20 seen from 1e19 or an eye 1e16 from the scene \
+     are not)";
+
+/// A ray the scene's numbers leave undefined, said as a fault of the scene
+/// (it was "integrand returned NaN at unit-cube point …").
+fn unresolved(e: QuadError) -> QuadError {
+    match e {
+        QuadError::NonFiniteIntegrand { point, value } => QuadError::invalid(
+            "scene",
+            format!("{value} (not a number) from the ray through pixel point {point:?}"),
+            RESOLVED_SCENE,
+        ),
+        other => other,
+    }
 }
 
 /// The channels of a block's estimates as one measured value.
@@ -918,6 +944,21 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         if let Some(w) = object.material.energy_warning() {
             warnings.push(SpecError::at(format!("{at}.material"), w));
         }
+        // An object smaller than the rounding of the rays that reach it
+        // (about 1e-16 of their length) is met, or missed, by rounding.
+        if let Some(ratio) = object.shape.size_over_distance(camera.eye())
+            && (0.0..SMALLEST_RESOLVED).contains(&ratio)
+        {
+            warnings.push(SpecError::at(
+                at.clone(),
+                format!(
+                    "its size is {ratio:.1e} of its distance from the eye, below the {:.0e} that \
+                     f64 resolves along a ray: whether a ray meets it, and where, is rounding, \
+                     and a ray that meets it can come out undefined (a failed job)",
+                    SMALLEST_RESOLVED
+                ),
+            ));
+        }
         objects.push(object);
     }
     let scene = Scene::new(
@@ -1027,7 +1068,7 @@ pub fn render_spec(
         return Err(SpecError::at(
             "scene",
             format!(
-                "{undefined} of {} pixels came out undefined (NaN or infinite): the scene's coordinates or sizes are beyond what f64 resolves along these rays (an object of size 1e30 around the camera, an eye 1e16 from the scene); expected a scene whose extents and distances stay within about 1e12 of each other",
+                "{undefined} of {} pixels came out undefined (NaN or infinite): the scene's coordinates or sizes are beyond what f64 resolves along these rays; expected {RESOLVED_SCENE}",
                 out.image.values.len()
             ),
         ));

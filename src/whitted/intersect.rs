@@ -221,6 +221,25 @@ impl Shape {
         }
     }
 
+    /// Its size beside its distance from `eye`: a sphere's radius and a
+    /// triangle's longest edge over the distance to its nearest point (the
+    /// centre, a vertex); `None` for a plane, which has no size.
+    pub fn size_over_distance(&self, eye: Vec3) -> Option<f64> {
+        match self {
+            Shape::Sphere { centre, radius } => Some(radius / ((centre - eye).norm() - radius)),
+            Shape::Plane { .. } => None,
+            Shape::Triangle { vertices, .. } => {
+                let edge = (0..3).fold(0.0_f64, |m, i| {
+                    m.max((vertices[(i + 1) % 3] - vertices[i]).norm())
+                });
+                let near = vertices
+                    .iter()
+                    .fold(f64::INFINITY, |m, v| m.min((v - eye).norm()));
+                Some(edge / near)
+            }
+        }
+    }
+
     /// The first hit with `t` in `(0, ray.t_max)`.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         match *self {
