@@ -4,7 +4,7 @@
 //! ```
 //! let registry = lightquad::families::builtin();
 //! let names: Vec<&str> = registry.entries().iter().map(|f| f.name).collect();
-//! assert_eq!(names, ["calibration", "volume", "rendering", "whitted"]);
+//! assert_eq!(names, ["calibration", "volume", "rendering", "whitted", "furnace"]);
 //! assert!(registry.get("volume").expect("registered").quantities().contains(&"tau"));
 //! ```
 
@@ -18,6 +18,7 @@ pub fn builtin() -> Registry {
         .with::<crate::volume::experiment::Volume>()
         .with::<crate::rendering::experiment::Rendering>()
         .with::<crate::whitted::experiment::Whitted>()
+        .with::<crate::rendering::closed::Furnace>()
 }
 
 #[cfg(test)]
@@ -45,6 +46,7 @@ mod tests {
         names_agree::<crate::volume::experiment::Volume>()?;
         names_agree::<crate::rendering::experiment::Rendering>()?;
         names_agree::<crate::whitted::experiment::Whitted>()?;
+        names_agree::<crate::rendering::closed::Furnace>()?;
         // Every family listed above is the registry's.
         assert_eq!(
             super::builtin()
@@ -52,7 +54,7 @@ mod tests {
                 .iter()
                 .map(|e| e.name)
                 .collect::<Vec<_>>(),
-            ["calibration", "volume", "rendering", "whitted"]
+            ["calibration", "volume", "rendering", "whitted", "furnace"]
         );
         Ok(())
     }

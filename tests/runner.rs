@@ -557,7 +557,10 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
                 .expect("const family")
         })
         .collect();
-    assert_eq!(families, ["calibration", "volume", "rendering", "whitted"]);
+    assert_eq!(
+        families,
+        ["calibration", "volume", "rendering", "whitted", "furnace"]
+    );
     // Every object the schema describes is closed, as `check` refuses
     // unknown fields: `{"rule": "trapezoid", "foo": 1}` passed the schema
     // (the hostile probe of issue 10); and `name` says what `check` accepts.

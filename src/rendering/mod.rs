@@ -19,6 +19,7 @@
 
 pub mod brdf;
 pub mod cap;
+pub mod closed;
 pub mod emitter;
 pub mod experiment;
 pub mod forms;
