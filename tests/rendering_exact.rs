@@ -379,3 +379,74 @@ fn bad_input_is_refused_by_name() {
         "corners",
     );
 }
+
+/// The R-S audit (seed 002 prints the parameterized surface integral
+/// without its area element): the printed values against closed forms and
+/// a 1-D reduction computed here, and the forms with the element against
+/// the surfaces' closed forms.
+#[test]
+fn the_rs_audit_printed_form_misses_the_area_element() {
+    use lightquad::rendering::audit::rows;
+    let rows = rows();
+    let find = |prefix: &str, g: &str| {
+        rows.iter()
+            .find(|r| r.surface.starts_with(prefix) && r.g.starts_with(g))
+            .unwrap_or_else(|| panic!("no row {prefix} / {g}"))
+    };
+    for r in &rows {
+        assert!(
+            (r.with_element - r.exact).abs() <= 1e-12 * r.exact,
+            "{}: {} vs {}",
+            r.surface,
+            r.with_element,
+            r.exact
+        );
+    }
+    // Areas: the printed form integrates 1 over the parameter box.
+    assert!((find("unit square", "1").printed - 1.0).abs() < 1e-14);
+    assert!((find("rectangle", "1").printed - 1.0).abs() < 1e-14);
+    assert!((find("sphere of radius", "1").printed - 2.0 * PI * PI).abs() < 1e-12);
+    // The disk at height 1: cos theta = cos theta' = 1 / rho, rho^2 = 1 +
+    // r^2, so printed = 2 pi int_0^1 dr / (1 + r^2)^2 = 2 pi (1/4 + pi/8).
+    let disk = find("disk light", "R-A");
+    assert!(
+        (disk.printed - 2.0 * PI * (0.25 + PI / 8.0)).abs() < 1e-12,
+        "{}",
+        disk.printed
+    );
+    // The sphere light: by symmetry about the axis, printed = 2 pi int g
+    // d theta over the lit cap cos theta < -1/3, with r^2 = 10 + 6 cos
+    // theta, cos theta_x = (3 + cos theta) / r, cos theta' = -(1 + 3 cos
+    // theta) / r (Simpson's rule, 20000 intervals).
+    let g = |t: f64| {
+        let c = t.cos();
+        (3.0 + c) * (-(1.0 + 3.0 * c)) / (10.0 + 6.0 * c).powi(2)
+    };
+    let (a, b) = ((-1.0f64 / 3.0).acos(), PI);
+    let m = 20_000;
+    let h = (b - a) / f64::from(m);
+    let simpson: f64 = (0..=m)
+        .map(|i| {
+            let w = if i == 0 || i == m {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            w * g(a + h * f64::from(i))
+        })
+        .sum::<f64>()
+        * h
+        / 3.0;
+    let sphere = find("sphere light", "R-A");
+    assert!(
+        (sphere.printed - 2.0 * PI * simpson).abs() < 1e-10,
+        "{} vs {}",
+        sphere.printed,
+        2.0 * PI * simpson
+    );
+    // The printed irradiance is 2.8 times the true pi / 9: no constant of
+    // the sphere (R^2 = 1 here) repairs it.
+    assert!(sphere.printed / sphere.exact > 2.5);
+}

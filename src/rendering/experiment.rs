@@ -809,6 +809,11 @@ impl Family for Rendering {
     fn scene_audit(built: &Built) -> Option<String> {
         Some(terms_section(built))
     }
+
+    /// R-S as printed, without the area element ([`super::audit`]).
+    fn audit() -> Option<String> {
+        Some(super::audit::markdown())
+    }
 }
 
 /// Evaluations per emitter of the converged reference for each `n` of

@@ -17,6 +17,7 @@
 //!
 //! Closed forms live in [`crate::exact::rendering`].
 
+pub mod audit;
 pub mod brdf;
 pub mod cap;
 pub mod closed;
