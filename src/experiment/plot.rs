@@ -84,7 +84,7 @@ pub fn svg(
     let series: Vec<(String, Vec<(f64, f64)>)> = series
         .iter()
         .map(|(name, s)| {
-            let kept = s.iter().filter(|(_, y)| !y.is_nan());
+            let kept = s.iter().filter(|(x, y)| !y.is_nan() && !x.is_nan());
             (
                 name.clone(),
                 kept.map(|&(x, y)| (x, y.max(floor))).collect(),
@@ -103,20 +103,33 @@ pub fn svg(
         y0 = y0.min(*y);
         y1 = y1.max(*y);
     }
-    // Whole decades, at least two wide on each axis: plotters' log axis
-    // misbehaves on ranges that are very narrow or start off a decade, and
-    // on one decade it labelled no y tick and the x tick 1e1 twice (every
-    // error 0 on a ray that misses).
+    // Whole decades, at least two wide on each axis. The axes are linear in
+    // the decade exponent, labelled 1eN: plotters' own log axis misbehaves
+    // on ranges that are narrow or start off a decade, and looped without
+    // end over an error range of 320 decades (a reference of 1.5e-305
+    // beside errors of 1e0).
     let decades = |lo: f64, hi: f64| {
-        let a = lo.log10().floor().clamp(-300.0, 300.0);
-        let b = hi.log10().ceil().clamp(-300.0, 300.0).max(a + 2.0);
-        (10f64.powf(a), 10f64.powf(b))
+        let a = lo.log10().floor().clamp(-330.0, 310.0);
+        let b = hi.log10().ceil().clamp(-330.0, 310.0).max(a + 2.0);
+        (a, b)
     };
     let (x0, x1) = decades(x0, x1);
     // A decade below the floor line, so it is not drawn on the axis.
     let at_floor = pts.iter().any(|&(_, y)| y <= floor);
     let y0 = if at_floor { y0.min(floor / 10.0) } else { y0 };
     let (y0, y1) = decades(y0, y1);
+    // A point's place, an infinite error (or 0 against a floor of 0) on the
+    // chart's edge.
+    let at = |(x, y): (f64, f64)| (x.log10().clamp(x0, x1), y.log10().clamp(y0, y1));
+    // A label per decade up to 12, else per step of whole decades.
+    let labels = |a: f64, b: f64| (b - a + 1.0).min(12.0) as usize;
+    let decade = |v: &f64| {
+        if (v - v.round()).abs() < 1e-9 {
+            format!("1e{}", v.round())
+        } else {
+            String::new()
+        }
+    };
     // The legend panel is wide enough for a product label of two rule names.
     let mut text = String::new();
     {
@@ -129,7 +142,7 @@ pub fn svg(
             .margin(12)
             .x_label_area_size(48)
             .y_label_area_size(80)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
@@ -137,27 +150,32 @@ pub fn svg(
             .y_desc("error (relative; absolute where the reference is 0)")
             .label_style(("sans-serif", 15))
             .axis_desc_style(("sans-serif", 16))
-            .x_label_formatter(&|v| format!("{v:.0e}"))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .x_labels(labels(x0, x1))
+            .y_labels(labels(y0, y1))
+            .x_label_formatter(&decade)
+            .y_label_formatter(&decade)
             .draw()
             .map_err(|e| e.to_string())?;
         for (i, (name, s)) in series.iter().enumerate() {
             let colour = rule_colour(name);
             chart
-                .draw_series(LineSeries::new(s.iter().copied(), colour.stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    s.iter().map(|&p| at(p)),
+                    colour.stroke_width(2),
+                ))
                 .map_err(|e| e.to_string())?;
             chart
                 .draw_series(
                     s.iter()
                         .filter(|&&(_, y)| y > floor)
-                        .map(|&(x, y)| Circle::new((x, y), 3, colour.filled())),
+                        .map(|&p| Circle::new(at(p), 3, colour.filled())),
                 )
                 .map_err(|e| e.to_string())?;
             chart
                 .draw_series(
                     s.iter()
                         .filter(|&&(_, y)| y <= floor)
-                        .map(|&(x, y)| Circle::new((x, y), 5, colour.stroke_width(2))),
+                        .map(|&p| Circle::new(at(p), 5, colour.stroke_width(2))),
                 )
                 .map_err(|e| e.to_string())?;
             let y = 60 + 24 * i as i32;
@@ -175,7 +193,7 @@ pub fn svg(
             let grey = RGBColor(110, 110, 110);
             chart
                 .draw_series(DashedLineSeries::new(
-                    [(x0, floor), (x1, floor)],
+                    [(x0, floor.log10()), (x1, floor.log10())],
                     6,
                     4,
                     grey.stroke_width(1),
@@ -203,4 +221,58 @@ pub fn svg(
         root.present().map_err(|e| e.to_string())?;
     }
     Ok(Some(text))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::svg;
+
+    /// Errors across the whole f64 range (a reference of 1.5e-305 beside an
+    /// error of 1e305, 5e-324, an infinite error) are plotted, and promptly:
+    /// plotters' log axis looped without end over 320 decades (the hostile
+    /// probe of issue 10). A thread and a deadline make a hang a failure.
+    #[test]
+    fn a_plot_over_every_decade_of_f64_finishes_with_its_decades_labelled() {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let series = vec![
+                (
+                    "gauss-legendre".to_string(),
+                    vec![(2.0, 1e305), (8.0, 1e-16), (64.0, 5e-324)],
+                ),
+                (
+                    "trapezoid".to_string(),
+                    vec![(3.0, f64::INFINITY), (9.0, 1e-300)],
+                ),
+            ];
+            let _ = tx.send(svg("wide", "n", &series, 1e-320));
+        });
+        let page = rx
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .expect("the plot did not finish within 60 s")
+            .expect("plotted")
+            .expect("has points");
+        // Whole decades labelled 1eN, the top beyond 1e305.
+        let labels: Vec<&str> = page
+            .lines()
+            .filter(|l| l.starts_with("1e") && l[2..].parse::<i32>().is_ok())
+            .collect();
+        assert!(labels.len() >= 6, "{labels:?}");
+        assert!(
+            labels
+                .iter()
+                .any(|l| l[2..].parse::<i32>().is_ok_and(|e| e >= 250)),
+            "{labels:?}"
+        );
+        assert!(
+            labels
+                .iter()
+                .any(|l| l[2..].parse::<i32>().is_ok_and(|e| e <= -250)),
+            "{labels:?}"
+        );
+        assert!(
+            !page.contains("NaN") && !page.contains("inf"),
+            "a non-finite coordinate"
+        );
+    }
 }
