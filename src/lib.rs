@@ -51,6 +51,17 @@
 #![deny(clippy::unwrap_used, clippy::expect_used)]
 #![warn(missing_docs)]
 
+/// `eprintln!` that never panics: a message to a closed stderr (`run 2>&1 |
+/// head -2`) is dropped, and the run goes on to finish its results and
+/// report (`eprintln!` panicked there and left folders without reports).
+#[macro_export]
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 pub mod calibration;
 pub mod domain;
 pub mod error;

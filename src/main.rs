@@ -126,7 +126,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {}", short_numbers(&e.to_string()));
+            lightquad::say!("error: {}", short_numbers(&e.to_string()));
             ExitCode::FAILURE
         }
     }
@@ -214,7 +214,7 @@ fn run(command: Command) -> Result<(), Failure> {
                     .into());
                 }
                 for w in exp.warnings() {
-                    eprintln!(
+                    lightquad::say!(
                         "warning: {}: {}",
                         f.display(),
                         short_numbers(&w.to_string())
@@ -312,7 +312,7 @@ fn run(command: Command) -> Result<(), Failure> {
                 lightquad::whitted::experiment::render_spec(&json, width, height, samples)
                     .map_err(|e| in_file(&e))?;
             for w in &warnings {
-                eprintln!(
+                lightquad::say!(
                     "warning: {}: {}",
                     source.display(),
                     short_numbers(&w.to_string())

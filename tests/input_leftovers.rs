@@ -673,3 +673,50 @@ fn a_reader_that_stops_early_is_no_error() {
         o.status
     );
 }
+
+/// A run whose stderr is closed (`run 2>&1 | head -2`) finishes its jobs and
+/// its report: the first progress line to the closed pipe panicked, and the
+/// run stopped after three experiments without a report (hostile probe,
+/// issue 10). `merge` likewise.
+#[test]
+fn a_run_whose_stderr_is_closed_finishes_its_report() {
+    let dir = common::scratch("closed-stderr");
+    let experiments: Vec<std::path::PathBuf> = ["calibration-exp.json", "calibration-disk.json"]
+        .iter()
+        .map(|f| common::root().join("experiments").join(f))
+        .collect();
+    let closed = |cmd: &mut std::process::Command| {
+        let mut child = cmd
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("runs");
+        // Closed before the first line is written.
+        drop(child.stderr.take());
+        child.wait().expect("ends")
+    };
+    let status = closed(
+        std::process::Command::new(env!("CARGO_BIN_EXE_lightquad"))
+            .args(["run", "--out"])
+            .arg(dir.join("run"))
+            .args(&experiments),
+    );
+    assert!(status.success(), "{status:?}");
+    for name in ["calibration-exp", "calibration-disk"] {
+        assert!(
+            dir.join("run").join(name).join("report.md").exists(),
+            "{name}"
+        );
+    }
+    assert!(dir.join("run/index.html").exists());
+    let status = closed(
+        std::process::Command::new(env!("CARGO_BIN_EXE_lightquad"))
+            .arg("merge")
+            .arg(dir.join("run"))
+            .arg("--out")
+            .arg(dir.join("merged")),
+    );
+    assert!(status.success(), "{status:?}");
+    assert!(dir.join("merged/index.html").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

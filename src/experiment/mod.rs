@@ -350,7 +350,7 @@ pub fn run_sources(
     if opts.progress {
         for (exp, _, _) in &loaded {
             for w in exp.warnings() {
-                eprintln!("warning: {}: {w}", exp.name());
+                crate::say!("warning: {}: {w}", exp.name());
             }
         }
     }
@@ -418,7 +418,7 @@ pub fn run_sources(
         let need = exp.max_job_bytes(&run::pending_jobs(exp.as_ref(), opts));
         let fit = jobs_that_fit(need, memory::available()).min(threads);
         let results = if fit < threads {
-            eprintln!(
+            crate::say!(
                 "{}: its largest jobs hold about {:.1} GB each: {fit} at a time instead of \
                  {threads}, to fit in the memory available",
                 exp.name(),
@@ -504,7 +504,7 @@ fn write_reports(
         // A converged reference is computed now, after the jobs: say so, or
         // a long one looks like a hang (a scene of radius 1e308 took minutes).
         if let Some(n) = exp.converged_reference() {
-            eprintln!(
+            crate::say!(
                 "{}: computing the converged reference (n = {n}, doubled until it converges)",
                 exp.name()
             );

@@ -49,7 +49,7 @@ pub(super) fn finished(
     }
     let line = line(name, results, elapsed);
     if bar.is_hidden() {
-        eprintln!("{line}");
+        crate::say!("{line}");
     } else {
         bar.println(line);
     }

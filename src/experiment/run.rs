@@ -608,7 +608,7 @@ pub fn run_experiment(
         // Lines not reused are said, not dropped in silence (their jobs run
         // again).
         if finished.unread != Unread::default() || finished.other_release > 0 {
-            eprintln!(
+            crate::say!(
                 "{}: --resume does not reuse {} unreadable line(s) (torn, edited, or not a \
                  result of this file's jobs), {} result(s) of another \
                  version of the experiment file and {} of another lightquad release in {}: \
@@ -627,7 +627,7 @@ pub fn run_experiment(
         // killed at once had turned 360 results into 80).
         let earlier = results_of(&path, exp.hash());
         if earlier > 0 {
-            eprintln!(
+            crate::say!(
                 "{}: replacing {earlier} earlier result(s) of this file in {} (pass --resume to \
                  keep them and run only the rest)",
                 exp.name(),
