@@ -169,7 +169,14 @@ fn run(command: Command) -> Result<(), Failure> {
                 }
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(t)
-                    .build_global()?;
+                    .build_global()
+                    .map_err(|e| {
+                        format!(
+                            "invalid --threads = {t}: {t} worker threads could not be started \
+                             ({e}); this process's limits (ulimit -v, ulimit -u, a cgroup) allow \
+                             fewer: expected fewer threads"
+                        )
+                    })?;
             }
             let sources = sources(files)?;
             let opts = RunOptions {

@@ -52,7 +52,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 pub use registry::{FamilyEntry, Loaded, Registry};
-use run::{JobResult, RunOptions, file_hash, run_experiment, write_atomic};
+use run::{JobResult, RunOptions, file_hash, write_atomic};
 pub use source::Source;
 pub use validate::SpecError;
 
@@ -358,22 +358,27 @@ pub fn run_sources(
     // whole run when an allocation fails: refused before any job runs. Only
     // the jobs still to run count: a --resume whose large jobs are finished
     // goes on.
+    // Every worker makes its allocator's arena first (64 MB of address space
+    // each under glibc), so the room under a cap is measured with them.
+    memory::warm_workers();
     if let Some(cap) = memory::hard_cap()
         && !validate::cost_limit_lifted()
     {
         for (exp, source, _) in &loaded {
             let need = exp.max_job_bytes(&run::pending_jobs(exp.as_ref(), opts));
-            if need > cap.room {
+            if need + memory::REPORT_RESERVE > cap.room {
                 return Err(RunError::Spec {
                     file: source.display(),
                     source: crate::error::SpecError::at(
                         "budgets",
                         format!(
-                            "its largest job needs about {:.2} GB of memory, but this process \
-                             may allocate only {:.2} GB more under {} (lower the budgets or \
+                            "its largest job needs about {} of memory and its report about {}, \
+                             but this process may allocate only {} more under {} (lower the \
+                             budgets or --threads, each thread holding its own allocator arena, or \
                              raise the limit; --no-cost-limit runs it anyway)",
-                            need / 1e9,
-                            cap.room / 1e9,
+                            memory::bytes(need),
+                            memory::bytes(memory::REPORT_RESERVE),
+                            memory::bytes(cap.room),
                             cap.what
                         ),
                     ),
@@ -416,34 +421,29 @@ pub fn run_sources(
         // 4 GB each on four threads aborted the run).
         let threads = rayon::current_num_threads();
         let need = exp.max_job_bytes(&run::pending_jobs(exp.as_ref(), opts));
-        let fit = jobs_that_fit(need, memory::available()).min(threads);
-        let results = if fit < threads {
+        let room = memory::available().map(|a| (a - memory::REPORT_RESERVE).max(0.0));
+        let fit = jobs_that_fit(need, room).min(threads);
+        if fit < threads {
             crate::say!(
-                "{}: its largest jobs hold about {:.1} GB each: {fit} at a time instead of \
+                "{}: its largest jobs hold about {} each: {fit} at a time instead of \
                  {threads}, to fit in the memory available",
                 exp.name(),
-                need / 1e9
+                memory::bytes(need)
             );
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(fit)
-                .build()
-                .map_err(|e| io(&dir, e))?
-                .install(|| run_experiment(exp.as_ref(), opts, &bar))
-        } else {
-            run_experiment(exp.as_ref(), opts, &bar)
         }
-        // A full disk while the jobs run: what was written is kept, and a
-        // resumed run goes on from it.
-        .map_err(|e| {
-            io(
-                &dir,
-                format!(
-                    "{}; the results written so far are kept: fix this and `run --resume` with \
+        let results = run::run_experiment_in_lanes(exp.as_ref(), opts, &bar, fit)
+            // A full disk while the jobs run: what was written is kept, and a
+            // resumed run goes on from it.
+            .map_err(|e| {
+                io(
+                    &dir,
+                    format!(
+                        "{}; the results written so far are kept: fix this and `run --resume` with \
                      the same experiments goes on from them",
-                    source::describe(&e)
-                ),
-            )
-        })?;
+                        source::describe(&e)
+                    ),
+                )
+            })?;
         progress::finished(opts.progress, &bar, exp.name(), &results, started.elapsed());
         done.push((exp, results));
     }

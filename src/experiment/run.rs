@@ -598,6 +598,19 @@ pub fn run_experiment(
     opts: &RunOptions,
     progress: &indicatif::ProgressBar,
 ) -> std::io::Result<Vec<JobResult>> {
+    run_experiment_in_lanes(exp, opts, progress, usize::MAX)
+}
+
+/// [`run_experiment`] with at most `lanes` jobs at once (the memory holds
+/// no more): the pool's threads stay, each lane runs its share of the jobs
+/// one after another (a smaller pool of new threads could not be started
+/// under a tight memory cap).
+pub fn run_experiment_in_lanes(
+    exp: &dyn Loaded,
+    opts: &RunOptions,
+    progress: &indicatif::ProgressBar,
+    lanes: usize,
+) -> std::io::Result<Vec<JobResult>> {
     let dir = opts.out.join(exp.name());
     fs::create_dir_all(&dir)?;
     let path = results_path(&opts.out, exp.name(), opts.shard);
@@ -650,21 +663,27 @@ pub fn run_experiment(
         .collect();
     progress.inc((exp.jobs(opts.shard).len() - pending.len()) as u64);
     let file = Mutex::new(OpenOptions::new().append(true).open(&path)?);
-    let fresh: Vec<std::io::Result<JobResult>> = pending
-        .par_iter()
-        .map(|&key| {
-            let result = exp.run_job(key);
-            let line = serde_json::to_string(&result).map_err(std::io::Error::other)? + "\n";
-            // One write per line, flushed, so a killed run leaves whole lines.
-            let mut f = file
-                .lock()
-                .map_err(|_| std::io::Error::other("results file lock poisoned"))?;
-            f.write_all(line.as_bytes())?;
-            f.flush()?;
-            progress.inc(1);
-            Ok(result)
-        })
-        .collect();
+    let run = |&key: &JobKey| {
+        let result = exp.run_job(key);
+        let line = serde_json::to_string(&result).map_err(std::io::Error::other)? + "\n";
+        // One write per line, flushed, so a killed run leaves whole lines.
+        let mut f = file
+            .lock()
+            .map_err(|_| std::io::Error::other("results file lock poisoned"))?;
+        f.write_all(line.as_bytes())?;
+        f.flush()?;
+        progress.inc(1);
+        Ok(result)
+    };
+    let fresh: Vec<std::io::Result<JobResult>> = if lanes >= rayon::current_num_threads() {
+        pending.par_iter().map(run).collect()
+    } else {
+        let lanes = lanes.max(1);
+        (0..lanes)
+            .into_par_iter()
+            .flat_map_iter(|lane| pending.iter().skip(lane).step_by(lanes).map(run))
+            .collect()
+    };
     let mut all = kept;
     for r in fresh {
         all.push(r?);
