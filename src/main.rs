@@ -325,16 +325,17 @@ fn run(command: Command) -> Result<(), Failure> {
                     short_numbers(&w.to_string())
                 );
             }
+            // The PFM first: one that cannot be written leaves the PNG as it
+            // was (a PNG already there was removed), and no PNG is left
+            // without its PFM.
+            if let Some(p) = &pfm {
+                image
+                    .write_pfm(p)
+                    .map_err(|e| format!("cannot write the PFM: {e} (the PNG was not written)"))?;
+            }
             image
                 .write_png(&png)
                 .map_err(|e| format!("cannot write the PNG: {e}"))?;
-            if let Some(p) = &pfm
-                && let Err(e) = image.write_pfm(p)
-            {
-                // No PNG left without its PFM.
-                let _ = std::fs::remove_file(&png);
-                return Err(format!("cannot write the PFM: {e} (the PNG was removed)").into());
-            }
             writeln!(
                 out,
                 "{}: {} x {} pixels, {} rays ({} primary, {} shadow, {} reflection, {} refraction)",

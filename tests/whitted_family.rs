@@ -787,3 +787,35 @@ fn render_refuses_endless_and_undefined_images_and_warns() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A render whose PFM cannot be written leaves a PNG that was there as it
+/// was: it was removed with "(the PNG was removed)" (hostile probe, issue 10).
+#[test]
+#[cfg(target_os = "linux")]
+fn a_render_that_fails_leaves_an_existing_png_as_it_was() {
+    let dir = scratch("keep-png");
+    let png = dir.join("keep.png");
+    fs::write(&png, "precious").expect("write");
+    let o = bin()
+        .args([
+            "render",
+            "--width",
+            "4",
+            "--height",
+            "4",
+            "--pfm",
+            "/dev/full",
+            "--png",
+        ])
+        .arg(&png)
+        .output()
+        .expect("runs");
+    assert!(!o.status.success(), "wrote to /dev/full");
+    assert!(
+        stderr(&o).contains("cannot write the PFM"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(fs::read_to_string(&png).expect("kept"), "precious");
+    let _ = fs::remove_dir_all(&dir);
+}
