@@ -672,12 +672,56 @@ fn a_sphere_below_what_f64_resolves_is_warned_and_its_undefined_ray_named() {
     for want in [
         "invalid scene",
         "not a number",
-        "pixel point [0.0, 1.0]",
+        "pixel [4, 3] at [0.0, 1.0] of its square",
         "within about 1e12",
     ] {
         assert!(results.contains(want), "no `{want}` in {results}");
     }
     assert!(!results.contains("integrand returned"), "{results}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_scene_whose_squares_underflow_is_warned_and_every_scheme_names_the_pixel() {
+    // A sphere of radius 1e-170 seen from 5e-170: r^2 = 1e-340 is below the
+    // smallest normal f64 (2.2e-308), so its hits are undefined.
+    let dir = scratch("underflow");
+    let file = dir.join("u.json");
+    let spec = json!({"name": "u", "family": "whitted",
+        "scene": {"camera": {"eye": [0, 0, 5e-170], "look_at": [0, 0, 0], "up": [0, 1, 0],
+            "fov_y": 20.0, "width": 8, "height": 8},
+          "ambient": [0.2, 0.2, 0.2], "background": [0.1, 0.2, 0.4],
+          "lights": [{"type": "point", "position": [2e-170, 3e-170, 5e-170],
+            "intensity": [1, 1, 1]}],
+          "objects": [{"type": "sphere", "centre": [0, 0, 0], "radius": 1e-170,
+            "material": {"k_a": 0.3, "k_d": 0.5, "k_s": 0.4, "phong": 20.0,
+              "colour": [0.9, 0.3, 0.2]}}],
+          "max_depth": 2, "pixel": [4, 3]},
+        "quantities": ["pixel"], "rules": [{"rule": "centre"}, {"rule": "gauss-legendre"}],
+        "budgets": [4], "repeats": 1, "reference": {"type": "converged"}});
+    fs::write(&file, spec.to_string()).expect("write");
+    let check = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(check.status.success(), "{}", stderr(&check));
+    assert!(
+        stderr(&check).contains("its size is 1.0e-170, below 1e-150"),
+        "{}",
+        stderr(&check)
+    );
+    let run = bin()
+        .args(["run", "--out"])
+        .arg(dir.join("out"))
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(!run.status.success(), "{}", stderr(&run));
+    let results = fs::read_to_string(dir.join("out/u/results.jsonl")).expect("results");
+    // Whitted's own scheme and a rule of the core alike name the pixel.
+    assert!(
+        results.contains("pixel [4, 3] came out not a number"),
+        "{results}"
+    );
+    assert!(results.contains("through pixel [4, 3] at"), "{results}");
+    assert!(!results.contains("non-finite pixel"), "{results}");
     let _ = fs::remove_dir_all(&dir);
 }
 

@@ -498,6 +498,16 @@ pub fn evaluate_counted(
         return Ok((measured(&est, rays.total()), rays));
     }
     let out = render::render_block(scene, corner, w, h, &scheme, rng).map_err(unresolved)?;
+    // Whitted's own schemes average rays without a rule's check: a pixel
+    // that is not a number is named here.
+    if let Some(k) = out.image.values.iter().position(|v| !v.all_finite()) {
+        let (i, j) = (corner[0] + k % w.max(1), corner[1] + k / w.max(1));
+        return Err(QuadError::invalid(
+            "scene",
+            format!("pixel [{i}, {j}] came out not a number"),
+            RESOLVED_SCENE,
+        ));
+    }
     Ok((measured(&out.image, out.rays.total()), out.rays))
 }
 
@@ -506,6 +516,10 @@ pub fn evaluate_counted(
 /// their length, so below 1e-12 a hit point is uncertain by more than
 /// 1e-4 of the object.
 pub const SMALLEST_RESOLVED: f64 = 1e-12;
+
+/// The least size of an object whose squared sizes stay normal f64
+/// numbers (1e-150 squared is 1e-300).
+pub const SMALLEST_SIZE: f64 = 1e-150;
 
 /// What a scene must be for its rays to be defined: said when a pixel comes
 /// out not a number (`render`) or a pixel's integrand does (a job).
@@ -520,7 +534,7 @@ fn unresolved(e: QuadError) -> QuadError {
     match e {
         QuadError::NonFiniteIntegrand { point, value } => QuadError::invalid(
             "scene",
-            format!("{value} (not a number) from the ray through pixel point {point:?}"),
+            format!("{value} (not a number) from the ray through point {point:?}"),
             RESOLVED_SCENE,
         ),
         other => other,
@@ -943,6 +957,19 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         let object = object(o, &at)?;
         if let Some(w) = object.material.energy_warning() {
             warnings.push(SpecError::at(format!("{at}.material"), w));
+        }
+        // An object whose squared size underflows f64 has no area to hit.
+        if let Some(size) = object.shape.size()
+            && size < SMALLEST_SIZE
+        {
+            warnings.push(SpecError::at(
+                at.clone(),
+                format!(
+                    "its size is {size:.1e}, below {SMALLEST_SIZE:.0e}: its squared sizes and \
+                     distances underflow f64, so its hits are undefined or missed (a failed \
+                     job); expected the scene in units that make its sizes nearer 1"
+                ),
+            ));
         }
         // An object smaller than the rounding of the rays that reach it
         // (about 1e-16 of their length) is met, or missed, by rounding.

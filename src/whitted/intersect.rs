@@ -221,6 +221,18 @@ impl Shape {
         }
     }
 
+    /// Its size: a sphere's radius, a triangle's longest edge; `None` for a
+    /// plane.
+    pub fn size(&self) -> Option<f64> {
+        match self {
+            Shape::Sphere { radius, .. } => Some(*radius),
+            Shape::Plane { .. } => None,
+            Shape::Triangle { vertices, .. } => Some((0..3).fold(0.0_f64, |m, i| {
+                m.max((vertices[(i + 1) % 3] - vertices[i]).norm())
+            })),
+        }
+    }
+
     /// Its size beside its distance from `eye`: a sphere's radius and a
     /// triangle's longest edge over the distance to its nearest point (the
     /// centre, a vertex); `None` for a plane, which has no size.

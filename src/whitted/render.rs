@@ -113,7 +113,23 @@ pub fn estimate<V: Value>(
                         Scheme::Centre => (pixel::centre(&p, &mut f), unknown),
                         Scheme::Grid { n } => (pixel::grid(&p, *n, &mut f), unknown),
                         Scheme::Rule { rule, n } => {
-                            let est = pixel::by_rule(rule, &p, *n, rng, &mut f)?;
+                            // A ray left undefined by the scene's numbers,
+                            // said with its pixel.
+                            let (pi, pj) = (origin[0] + i as f64, origin[1] + j as f64);
+                            let est =
+                                pixel::by_rule(rule, &p, *n, rng, &mut f).map_err(|e| match e {
+                                    QuadError::NonFiniteIntegrand { point, value } => {
+                                        QuadError::invalid(
+                                            "scene",
+                                            format!(
+                                                "{value} (not a number) from the ray through \
+                                                 pixel [{pi}, {pj}] at {point:?} of its square"
+                                            ),
+                                            super::experiment::RESOLVED_SCENE,
+                                        )
+                                    }
+                                    other => other,
+                                })?;
                             out.reliable &= est.reliable;
                             (est.value, est.error)
                         }
