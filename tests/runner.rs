@@ -2762,8 +2762,8 @@ fn shards_with_a_relative_mitsuba_values_file_merge() {
 /// `--resume` and `merge` reuse only results of the file's own jobs, shaped
 /// as this version writes them: a line copied with `"rule_index": 99` was
 /// kept as a fifth job of a four-job file and shown as a row "rule #99", and
-/// a value of two channels for a scalar was shown with no true error (the
-/// hostile probe of issue 10).
+/// a value of two channels for a scalar was shown with no true error, and a
+/// line whose seed was edited was reused (the hostile probe of issue 10).
 #[test]
 fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     let (dir, out, o) = run_text("misfits", VALID);
@@ -2782,6 +2782,9 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
         .and_then(|m| m.keys().next().cloned())
         .expect("a quantity");
     lines[1]["quantities"][&q]["value"] = serde_json::json!([1.0, 2.0]);
+    // A seed that is not the job's (the values were not drawn from it).
+    let seed = lines[2]["seed"].as_u64().expect("a seed");
+    lines[2]["seed"] = serde_json::json!(seed ^ 1);
     lines.push(foreign);
     let edited: String = lines.iter().map(|l| format!("{l}\n")).collect();
     fs::write(&path, &edited).expect("write");
@@ -2791,7 +2794,7 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     let o = merge(&merged, &[&out]);
     assert!(!o.status.success(), "an incomplete merge succeeded");
     assert!(
-        stderr(&o).contains("2 unreadable line(s)"),
+        stderr(&o).contains("3 unreadable line(s)"),
         "{}",
         stderr(&o)
     );
@@ -2801,7 +2804,7 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     let o = resume(&out, &dir.join("e.json"));
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("does not reuse 2 unreadable line(s)"),
+        stderr(&o).contains("does not reuse 3 unreadable line(s)"),
         "{}",
         stderr(&o)
     );

@@ -292,7 +292,7 @@ fn shaped<F: Family>(
 
 /// The results read back from a file (`--resume`, `merge`) that are results
 /// of `exp`'s jobs as this version runs them: a job of its list, by the rule
-/// its index names, with exactly its quantities, each with its channel count
+/// its index names, with the job's own seed (an edited seed was reused), with exactly its quantities, each with its channel count
 /// of finite values and of errors (or a failure). Returns them and how many
 /// were not: a hand-edited line with `"rule_index": 99` was reused as a job
 /// of a rule the file does not have, and one with two channels of a scalar
@@ -306,6 +306,7 @@ pub fn reusable<F: Family>(
         let job = r.experiment == exp.spec.name
             && r.family == F::NAME
             && jobs.contains(&r.key())
+            && r.seed == job_seed(exp.spec.seed, r.rule_index, r.budget, r.repeat)
             && exp
                 .spec
                 .rules
