@@ -569,6 +569,10 @@ impl Family for Whitted {
                                  square by every 2-D rule and Whitted's grid, corner and \
                                  adaptive schemes";
     const EQUATIONS: &'static [&'static str] = &["W-6.1", "W-Phong", "W-Grey", "W-SS", "W-Corner"];
+    const OVER_BUDGET: &'static str = "evaluations count every ray traced: a primary ray per \
+        point of the rule and the shadow, reflection and refraction rays it spawns (up to 4 a \
+        point in a scene of two lights and a mirror), and a rule's own error estimate takes \
+        more points than n (Gauss–Legendre about 3.5 n)";
     const BUDGET_UNIT: &'static str = "primary rays per pixel (the corner and adaptive schemes \
                                        share rays between pixels; evaluations count every ray \
                                        traced)";
