@@ -333,9 +333,14 @@ fn run(command: Command) -> Result<(), Failure> {
                     .write_pfm(p)
                     .map_err(|e| format!("cannot write the PFM: {e} (the PNG was not written)"))?;
             }
-            image
-                .write_png(&png)
-                .map_err(|e| format!("cannot write the PNG: {e}"))?;
+            image.write_png(&png).map_err(|e| {
+                let pfm = if pfm.is_some() {
+                    " (the PFM was written)"
+                } else {
+                    ""
+                };
+                format!("cannot write the PNG: {e}{pfm}")
+            })?;
             writeln!(
                 out,
                 "{}: {} x {} pixels, {} rays ({} primary, {} shadow, {} reflection, {} refraction)",

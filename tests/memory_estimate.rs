@@ -201,6 +201,15 @@ fn a_run_under_a_tight_cap_is_refused_whole_or_runs_whole() {
         );
         assert!(!dir.join("out").exists(), "{kib} KiB: output left behind");
     }
+    // --no-cost-limit lifts the cost guard, not a hard cap: past the cap the
+    // process aborted (rc 134) with every folder left without a report.
+    let o = under(130_000, "--threads 2 --no-cost-limit");
+    assert!(
+        !o.status.success() && o.status.code() == Some(1),
+        "{:?}",
+        o.status
+    );
+    assert!(!dir.join("out").exists(), "output left behind");
     let o = under(1_000_000, "--threads 256");
     let msg = String::from_utf8_lossy(&o.stderr).to_string();
     assert!(!o.status.success(), "256 threads under 1 GB ran");

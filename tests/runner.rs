@@ -2785,6 +2785,8 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     // A seed that is not the job's (the values were not drawn from it).
     let seed = lines[2]["seed"].as_u64().expect("a seed");
     lines[2]["seed"] = serde_json::json!(seed ^ 1);
+    // An error estimate below 0 (no rule gives one).
+    lines[3]["quantities"][&q]["error"] = serde_json::json!([-1.0]);
     lines.push(foreign);
     let edited: String = lines.iter().map(|l| format!("{l}\n")).collect();
     fs::write(&path, &edited).expect("write");
@@ -2794,7 +2796,7 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     let o = merge(&merged, &[&out]);
     assert!(!o.status.success(), "an incomplete merge succeeded");
     assert!(
-        stderr(&o).contains("3 unreadable line(s)"),
+        stderr(&o).contains("4 unreadable line(s)"),
         "{}",
         stderr(&o)
     );
@@ -2804,7 +2806,7 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     let o = resume(&out, &dir.join("e.json"));
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("does not reuse 3 unreadable line(s)"),
+        stderr(&o).contains("does not reuse 4 unreadable line(s)"),
         "{}",
         stderr(&o)
     );

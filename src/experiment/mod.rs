@@ -359,25 +359,35 @@ pub fn run_sources(
     // the jobs still to run count: a --resume whose large jobs are finished
     // goes on.
     // Every worker makes its allocator's arena first (64 MB of address space
-    // each under glibc), so the room under a cap is measured with them.
+    // each under glibc), so the room under a cap is measured with them. A
+    // hard cap is not lifted by --no-cost-limit: past it the process aborts
+    // (it did, with the flag the refusal had suggested).
     memory::warm_workers();
-    if let Some(cap) = memory::hard_cap()
-        && !validate::cost_limit_lifted()
-    {
+    if let Some(cap) = memory::hard_cap() {
         for (exp, source, _) in &loaded {
             let need = exp.max_job_bytes(&run::pending_jobs(exp.as_ref(), opts));
             if need + memory::REPORT_RESERVE > cap.room {
+                let what = if need > 0.0 {
+                    format!(
+                        "its largest pending job needs about {} of memory and the run keeps {} \
+                         for the families' working memory and the reports",
+                        memory::bytes(need),
+                        memory::bytes(memory::REPORT_RESERVE)
+                    )
+                } else {
+                    format!(
+                        "no job is pending, but writing its report keeps about {}",
+                        memory::bytes(memory::REPORT_RESERVE)
+                    )
+                };
                 return Err(RunError::Spec {
                     file: source.display(),
                     source: crate::error::SpecError::at(
                         "budgets",
                         format!(
-                            "its largest job needs about {} of memory and its report about {}, \
-                             but this process may allocate only {} more under {} (lower the \
-                             budgets or --threads, each thread holding its own allocator arena, or \
-                             raise the limit; --no-cost-limit runs it anyway)",
-                            memory::bytes(need),
-                            memory::bytes(memory::REPORT_RESERVE),
+                            "{what}, and this process may allocate only {} more under {} \
+                             (raise the limit; or lower the budgets or --threads, each worker \
+                             thread holding an allocator arena of 64 MB of address space)",
                             memory::bytes(cap.room),
                             cap.what
                         ),

@@ -1265,7 +1265,12 @@ fn orders_and_plots(
         let slope = |against| match order_and_scatter(&mine, against, accuracy) {
             None => "—".into(),
             Some((o, off, grew)) if off > limit || (deterministic && grew) => format!(
-                "{o:.2} (erratic: errors up to {off:.1}x off the line{}, not an order)",
+                "{o:.2} (erratic: errors up to {}x off the line{}, not an order)",
+                if off < 1e4 {
+                    format!("{off:.1}")
+                } else {
+                    format!("{off:.1e}")
+                },
                 if deterministic && grew {
                     ", growing with n"
                 } else {

@@ -320,6 +320,7 @@ pub fn reusable<F: Family>(
                         m.value.len() == want
                             && m.error.len() == want
                             && m.value.iter().all(|x| x.is_finite())
+                            && !m.error.iter().any(|e| *e < 0.0)
                     })
                 }));
         job && shaped && r.seconds.is_finite()

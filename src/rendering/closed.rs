@@ -207,7 +207,8 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         return Err(SpecError::at(
             "scene.point",
             format!(
-                "{:?}: expected a finite, non-zero direction from the centre",
+                "{:?}: expected a non-zero direction from the centre whose length f64 holds \
+                 (components up to about 1e154)",
                 spec.point
             ),
         ));

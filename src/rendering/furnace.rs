@@ -89,7 +89,7 @@ impl IntegratingSphere {
             return Err(QuadError::invalid(
                 "axis",
                 format!("{:?}", axis.as_slice()),
-                "a finite, non-zero vector",
+                "a non-zero vector whose length f64 holds (components up to about 1e154)",
             ));
         }
         Ok(IntegratingSphere {
