@@ -720,3 +720,28 @@ fn a_run_whose_stderr_is_closed_finishes_its_report() {
     assert!(dir.join("merged/index.html").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A voxel count names a range a person can read: `1..=18446744073709551615`
+/// was printed for `resolution[0]: []` (hostile probe, issue 10).
+#[test]
+fn a_voxel_count_names_a_readable_range() {
+    let mut spec: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("experiments/v-i-total-voxel-grid.json"))
+            .expect("read"),
+    )
+    .expect("json");
+    spec["scene"]["medium"]["resolution"][0] = serde_json::json!([]);
+    let dir = scratch("voxel-count");
+    let file = dir.join("e.json");
+    std::fs::write(&file, spec.to_string()).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    let msg = stderr(&o);
+    assert!(!o.status.success(), "accepted");
+    for want in [
+        "at `scene.medium.resolution[0]`",
+        "1..=4294967295 (their product is the length of data)",
+    ] {
+        assert!(msg.contains(want), "no {want:?} in {msg}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

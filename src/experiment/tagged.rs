@@ -328,7 +328,15 @@ pub struct Count(pub usize);
 
 impl<'de> Deserialize<'de> for Count {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        whole(d, 1, usize::MAX as i128, "").map(Count)
+        // A bound a person can read (18446744073709551615 was printed):
+        // data holds one value per voxel, so no file reaches 2^32 per axis.
+        whole(
+            d,
+            1,
+            i128::from(u32::MAX),
+            " (their product is the length of data)",
+        )
+        .map(Count)
     }
 }
 
