@@ -39,6 +39,7 @@ use std::fmt::Write as _;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+use super::experiment::renamed;
 use super::furnace::IntegratingSphere;
 use crate::domain::Vec3;
 use crate::error::{QuadError, SpecError};
@@ -181,7 +182,8 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         spec.half_angle,
         vec3(spec.axis),
     )
-    .map_err(|e| SpecError::from_quad("scene", renamed(e)))?;
+    // The library's `alpha` is the file's `half_angle`.
+    .map_err(|e| SpecError::from_quad("scene", renamed(e, "alpha", "half_angle")))?;
     // The answer is the same at every size; sizes whose chords overflow, or
     // radiances whose sum over the bounces does, are refused.
     if !(1e-100..=1e100).contains(&spec.radius) {
@@ -239,22 +241,6 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         },
     };
     Ok(Built { sphere, x, bounces })
-}
-
-/// The library's `alpha` is the file's `half_angle`.
-fn renamed(e: QuadError) -> QuadError {
-    match e {
-        QuadError::InvalidParameter {
-            name,
-            value,
-            accepted,
-        } if name == "alpha" => QuadError::InvalidParameter {
-            name: "half_angle".into(),
-            value,
-            accepted,
-        },
-        other => other,
-    }
 }
 
 impl Family for Furnace {

@@ -1315,7 +1315,7 @@ fn vec3(v: [f64; 3]) -> Vec3 {
 
 /// A library error renamed from the library's parameter `from` to the
 /// file's field `to`.
-fn renamed(e: QuadError, from: &str, to: &str) -> QuadError {
+pub(crate) fn renamed(e: QuadError, from: &str, to: &str) -> QuadError {
     match e {
         QuadError::InvalidParameter {
             name,

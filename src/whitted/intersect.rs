@@ -241,13 +241,10 @@ impl Shape {
             Shape::Sphere { centre, radius } => Some(radius / ((centre - eye).norm() - radius)),
             Shape::Plane { .. } => None,
             Shape::Triangle { vertices, .. } => {
-                let edge = (0..3).fold(0.0_f64, |m, i| {
-                    m.max((vertices[(i + 1) % 3] - vertices[i]).norm())
-                });
                 let near = vertices
                     .iter()
                     .fold(f64::INFINITY, |m, v| m.min((v - eye).norm()));
-                Some(edge / near)
+                self.size().map(|edge| edge / near)
             }
         }
     }
