@@ -876,3 +876,67 @@ fn extreme_numbers_anywhere_in_a_bundled_file_are_errors_not_panics() {
         assert!(!leaves.is_empty(), "{}", path.display());
     }
 }
+
+/// `pi sin^2 alpha cos theta_c`: the projected solid angle of a sphere of
+/// radius `r` about `c`, wholly above the horizon of `(x, n)`.
+fn sphere_projected(x: Vec3, n: Vec3, c: Vec3, r: f64) -> f64 {
+    let d = c - x;
+    PI * (r * r / d.norm_squared()) * n.normalize().dot(&d.normalize())
+}
+
+/// A sky behind small blockers, and a small blocker in front of a large
+/// light: the converged reference subtracts what each blocker hides over
+/// the blocker's own surface. Genz–Malik over the light's whole domain
+/// missed the sphere (it returned pi L with an error estimate of 1e-17) and
+/// lost a triangle's corners (0.0750 hidden for 0.0795).
+#[test]
+fn blockers_small_beside_the_light_are_subtracted_whole() {
+    let (x, n) = (Vec3::new(0.2, -0.1, 0.0), Vec3::new(-0.1, 0.15, 1.0));
+    let receiver = json!({"point": [0.2, -0.1, 0.0], "normal": [-0.1, 0.15, 1.0]});
+    let sky = json!({"type": "environment", "radiance": 0.25});
+    let sphere = json!({"type": "sphere", "centre": [-0.1, 0.4, 0.8], "radius": 0.2});
+
+    // A sky behind a sphere occluder: pi L less L times the sphere's
+    // projected solid angle.
+    let exp = with_scene(
+        json!({"receiver": receiver, "emitters": [sky], "occluders": [sphere]}),
+        &["E_area"],
+    );
+    let want = 0.25 * (PI - sphere_projected(x, n, Vec3::new(-0.1, 0.4, 0.8), 0.2));
+    let (got, error) = converged(&exp, Q::EArea);
+    assert!(rel(got, want) < 1e-10, "{got} vs {want} (+- {error:e})");
+    assert!(error <= 1e-9 * want, "{error:e}");
+
+    // A sky behind a triangle light: the triangle shows its own radiance
+    // where it hides the sky (Lambert's contour formula for both).
+    let corners = [
+        Vec3::new(-0.8, 0.3, 1.4),
+        Vec3::new(0.2, 1.3, 1.6),
+        Vec3::new(0.6, -0.2, 1.2),
+    ];
+    let exp = with_scene(
+        json!({"receiver": receiver, "emitters": [
+            {"type": "triangle", "a": [-0.8, 0.3, 1.4], "b": [0.2, 1.3, 1.6],
+             "c": [0.6, -0.2, 1.2], "radiance": 2.0},
+            sky]}),
+        &["E_area"],
+    );
+    let psa = PI * contour(x, n.normalize(), &corners);
+    let want = 0.25 * (PI - psa) + 2.0 * psa;
+    let (got, error) = converged(&exp, Q::EArea);
+    assert!(rel(got, want) < 1e-10, "{got} vs {want} (+- {error:e})");
+
+    // A small sphere in front of a large coaxial disk light.
+    let exp = with_scene(
+        json!({"receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+               "emitters": [{"type": "disk", "centre": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, -1.0],
+                             "radius": 1.0, "radiance": 3.0}],
+               "occluders": [{"type": "sphere", "centre": [0.3, 0.1, 0.5], "radius": 0.01}]}),
+        &["E_cone"],
+    );
+    let z = Vec3::z();
+    let want =
+        3.0 * (PI / 2.0 - sphere_projected(Vec3::zeros(), z, Vec3::new(0.3, 0.1, 0.5), 0.01));
+    let (got, error) = converged(&exp, Q::ECone);
+    assert!(rel(got, want) < 1e-10, "{got} vs {want} (+- {error:e})");
+}

@@ -190,7 +190,7 @@ impl Domain<2> for LightDomain {
 /// The cone of directions from `x` that contains the sphere about `centre`
 /// of radius `radius`: `sin alpha = R / d`, or the whole sphere of
 /// directions for `x` inside it.
-fn bounding_cone(x: Vec3, centre: Vec3, radius: f64) -> Result<Cap, QuadError> {
+pub fn bounding_cone(x: Vec3, centre: Vec3, radius: f64) -> Result<Cap, QuadError> {
     let to_centre = centre - x;
     let d = to_centre.norm();
     if d <= radius {

@@ -101,6 +101,7 @@ use std::f64::consts::PI;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+use super::blocked;
 use super::brdf::{Brdf, Ggx, Lambert, NormalizedPhong, Phong, Sample};
 use super::emitter::{
     AnyEmitter, CapLight, DiskLight, Emitter, EnvironmentLight, LightSampling, RectangleLight,
@@ -1026,7 +1027,18 @@ fn converged_by_emitter<K: Kernel>(
     let (scene, receiver) = (&built.scene, &built.receiver);
     let mut total = Estimate::zero();
     for (k, e) in scene.emitters().iter().enumerate() {
-        let along = || forms::cone_integrand(scene, receiver, kernel, k);
+        let lit = lit_triangles(scene, receiver.point(), k);
+        // Where something can stand in the way and the shadow boundaries are
+        // not computed, the light is taken with nothing in the way, and what
+        // each blocker hides is subtracted over the blocker's own cone (an
+        // adaptive rule over the light's domain can miss a small blocker:
+        // crate::rendering::blocked).
+        let split = lit.is_none() && scene.has_blockers(Some(k));
+        let along = || {
+            let free = blocked::unblocked(e, receiver, kernel);
+            let seen = forms::cone_integrand(scene, receiver, kernel, k);
+            move |w: Vec3| if split { free(w) } else { seen(w) }
+        };
         let by_lobe = |lobe: &Reflected<'_, AnyBrdf>, rng: &mut rand_pcg::Pcg64| {
             integrate_over(&rule, &BrdfSampled::new(*lobe), budget, rng, along())
         };
@@ -1037,15 +1049,18 @@ fn converged_by_emitter<K: Kernel>(
             _ => {
                 let own = if exact_cone(e, receiver) {
                     integrate_over(&rule, &e.cone(receiver)?, budget, &mut rng, along())?
-                } else if let Some(lit) = lit_triangles(scene, receiver.point(), k) {
+                } else if let Some(lit) = &lit {
                     // Split at the shadow boundaries: smooth on every piece.
                     let g = forms::area_integrand_with(scene, receiver, kernel, k, |_| true)?;
                     let per = (budget / lit.len().max(1)).max(rule.min_budget(2));
                     let mut sum = Estimate::zero();
-                    for t in &lit {
+                    for t in lit {
                         sum = sum.combine(integrate_over(&rule, t, per, &mut rng, &g)?);
                     }
                     sum
+                } else if split {
+                    let g = forms::area_integrand_with(scene, receiver, kernel, k, |_| true)?;
+                    integrate_over(&rule, &e.surface(receiver)?, budget, &mut rng, g)?
                 } else {
                     let g = forms::area_integrand(scene, receiver, kernel, k)?;
                     integrate_over(&rule, &e.surface(receiver)?, budget, &mut rng, g)?
@@ -1059,6 +1074,34 @@ fn converged_by_emitter<K: Kernel>(
                     None => own,
                 }
             }
+        };
+        let part = if split {
+            let mut hidden = Estimate::zero();
+            for (j, o) in blocked::blockers(scene, k).iter().enumerate() {
+                let h = blocked::hidden(scene, receiver, kernel, k, j)?;
+                let domain = blocked::domain(o, receiver.point())?;
+                let own = integrate_over(&rule, &domain, budget, &mut rng, &h)?;
+                let checked = match lobe {
+                    Some(lobe) => cross_checked(
+                        own,
+                        integrate_over(
+                            &rule,
+                            &BrdfSampled::new(*lobe),
+                            budget,
+                            &mut rng,
+                            blocked::hidden_along(scene, receiver, kernel, k, j)?,
+                        )?,
+                    ),
+                    None => own,
+                };
+                hidden = hidden.combine(checked);
+            }
+            part.combine(Estimate {
+                value: -hidden.value,
+                ..hidden
+            })
+        } else {
+            part
         };
         total = total.combine(part);
     }

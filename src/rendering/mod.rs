@@ -18,6 +18,7 @@
 //! Closed forms live in [`crate::exact::rendering`].
 
 pub mod audit;
+pub mod blocked;
 pub mod brdf;
 pub mod cap;
 pub mod closed;

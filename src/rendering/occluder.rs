@@ -81,6 +81,41 @@ impl Occluder {
         }
     }
 
+    /// The unit normal at a point `y` of the shape (either orientation: an
+    /// occluder blocks on both sides).
+    pub fn normal_at(&self, y: Vec3) -> Vec3 {
+        match self {
+            Occluder::Sphere(s) => (y - s.centre) / s.radius,
+            Occluder::Disk(d) => d.frame().n,
+            Occluder::Rectangle(r) => r.normal(),
+            Occluder::Triangle(t) => t.normal(),
+        }
+    }
+
+    /// A sphere containing the shape: `(centre, radius)` (the sphere itself,
+    /// the disk's circle; a parallelogram's or triangle's centre with its
+    /// farthest corner).
+    pub fn bounding_sphere(&self) -> (Vec3, f64) {
+        let around = |centre: Vec3, corners: &[Vec3]| {
+            let r = corners
+                .iter()
+                .fold(0.0_f64, |m, p| m.max((p - centre).norm()));
+            (centre, r)
+        };
+        match self {
+            Occluder::Sphere(s) => (s.centre, s.radius),
+            Occluder::Disk(d) => (d.centre(), d.radius()),
+            Occluder::Rectangle(r) => {
+                let (o, a, b) = (r.origin(), r.edge_u(), r.edge_v());
+                around(o + (a + b) / 2.0, &[o, o + a, o + b, o + a + b])
+            }
+            Occluder::Triangle(t) => {
+                let v = t.vertices();
+                around((v[0] + v[1] + v[2]) / 3.0, &v)
+            }
+        }
+    }
+
     /// A bound on the size of the coordinates of the shape's points
     /// (`|centre|_inf + radius`, or the largest corner coordinate): the
     /// scale of the rounding of its intersections, for the offsets of

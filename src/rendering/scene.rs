@@ -132,9 +132,15 @@ impl<V: Value> Scene<V> {
                 .any(|(i, e)| Some(i) != skip && e.occluder().is_some())
     }
 
+    /// The offset `delta` below which a ray from `x` ignores hits (module
+    /// documentation).
+    pub fn ray_offset(&self, x: Vec3) -> f64 {
+        self.offset(x, x)
+    }
+
     /// True when some blocker (every occluder, every finite emitter but
     /// `skip`) meets `x + t w` for `t` in `(t_min, t_max)`.
-    fn blocked(&self, x: Vec3, w: Vec3, t_min: f64, t_max: f64, skip: Option<usize>) -> bool {
+    pub fn blocked(&self, x: Vec3, w: Vec3, t_min: f64, t_max: f64, skip: Option<usize>) -> bool {
         self.occluders
             .iter()
             .any(|o| o.intersect(x, w, t_min, t_max).is_some())
