@@ -214,3 +214,24 @@ fn the_bundled_white_furnace_runs_and_its_report_tells_the_truncation() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// The converged value of `L` is `L` itself, whatever `K` the file keeps
+/// for the rules' series (the report's cross-check column showed `L_5 =
+/// 4.686` as lightquad's `L` beside Mitsuba's 9.9993 and the closed form
+/// 10); `L_K` keeps the file's `K`.
+#[test]
+fn the_converged_whole_radiance_ignores_the_files_truncation() {
+    let built = scene(
+        json!({"albedo": 0.9, "emission": 1.0, "point": [0.0, 0.0, -1.0],
+                             "bounces": 5}),
+    );
+    let out = Furnace::converged(&built, 4, &[Q::L, Q::LK]).expect("converges");
+    let (l, lk) = (&out[&Q::L], &out[&Q::LK]);
+    assert!(rel(l.value[0], 10.0) < 1e-12, "{:?}", l.value);
+    assert!(l.error[0] < 1e-12 * 10.0, "{:?}", l.error);
+    assert!(
+        rel(lk.value[0], series(1.0, 1.0, 0.9, 5)) < 1e-13,
+        "{:?}",
+        lk.value
+    );
+}

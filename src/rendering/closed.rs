@@ -44,7 +44,7 @@ use super::furnace::IntegratingSphere;
 use crate::domain::Vec3;
 use crate::error::{QuadError, SpecError};
 use crate::experiment::tagged;
-use crate::family::{self, Family, Measured, Method, Outcome};
+use crate::family::{self, Family, Measured, Method, Outcome, Quantity as _};
 use crate::quadrature::{AnyRule, BaseRule, GenzMalik, Rule};
 
 /// The furnace family.
@@ -325,7 +325,10 @@ impl Family for Furnace {
     }
 
     /// The series with adaptive Genz–Malik (relative tolerance 1e-12) at
-    /// `n^2` evaluations per hemisphere integral.
+    /// `n^2` evaluations per hemisphere integral: for `L_K` to the file's
+    /// `K`, for `L` to as many bounces as a truncation of 1e-16 of `L` needs
+    /// whatever the file's `K` (the converged value of `L` is `L`, not the
+    /// rules' truncated series), the truncation left added to its error.
     fn converged(
         built: &Built,
         n: usize,
@@ -335,14 +338,35 @@ impl Family for Furnace {
             abs_tol: 0.0,
             rel_tol: 1e-12,
         }));
-        let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
-        Self::evaluate(
-            built,
-            &Method::Rule(rule),
-            n.saturating_mul(n).max(17),
-            &mut rng,
-            quantities,
-        )
+        let mut out = Outcome::new();
+        for &q in quantities {
+            let mut series = built.clone();
+            if q == FurnaceQuantity::L {
+                series.bounces = built
+                    .sphere
+                    .bounces_needed(&built.x, DEFAULT_TRUNCATION)
+                    .map_or(0, |k| k.min(f64::from(MAX_BOUNCES)) as u32);
+            }
+            let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
+            let mut m = Self::evaluate(
+                &series,
+                &Method::Rule(rule.clone()),
+                n.saturating_mul(n).max(17),
+                &mut rng,
+                &[q],
+            )?
+            .remove(&q)
+            .ok_or_else(|| QuadError::invalid("quantity", q.name(), "a furnace quantity"))?;
+            if q == FurnaceQuantity::L {
+                let left = built.sphere.radiance(&built.x)
+                    - built.sphere.truncated(&built.x, series.bounces);
+                for e in &mut m.error {
+                    *e += left.abs();
+                }
+            }
+            out.insert(q, m);
+        }
+        Ok(out)
     }
 
     fn settings(spec: &SceneSpec) -> String {
