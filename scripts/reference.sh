@@ -34,7 +34,8 @@ if [ "${1:-}" = "--ci" ]; then
   scratch=$(mktemp -d)
   trap 'rm -rf "$scratch"' EXIT
   (cd reference && .venv/bin/python -m lqref --quick --out "$scratch" \
-    ../experiments/mitsuba-tau-constant-sphere.json ../experiments/v-l-single-scattering.json)
+    ../experiments/mitsuba-tau-constant-sphere.json ../experiments/v-l-single-scattering.json \
+    ../experiments/r-h-vs-a-tilted-rectangle.json ../experiments/mitsuba-r-furnace-bounces.json)
   LIGHTQUAD_REFERENCE_VALUES="$scratch" cargo test --release --test mitsuba
 else
   # Every experiment that has a committed values file (Mitsuba cannot express

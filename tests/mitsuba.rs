@@ -2,14 +2,18 @@
 //! (reference/values/*.json, or the folder named by LIGHTQUAD_REFERENCE_VALUES,
 //! which CI points at a quick regeneration) must match lightquad's converged
 //! values within 4 standard errors plus a float32 floor, and must have been made
-//! from the experiment file as it is now (a stale hash fails the test).
+//! from the experiment file as it is now (a stale hash fails the test). Every
+//! family the harness knows is compared: volume (V-tau, V-L), rendering
+//! (irradiance and Lambertian reflected radiance, R-H and R-A) and the furnace.
 
 use std::path::{Path, PathBuf};
 
 use lightquad::experiment::run::file_hash;
-use lightquad::experiment::validate::{deserialize, parse_json};
-use lightquad::family::Family;
+use lightquad::experiment::validate::{deserialize, parse_json, validate};
+use lightquad::family::{Family, Quantity as _};
 use lightquad::quadrature::GaussLegendre;
+use lightquad::rendering::closed::Furnace;
+use lightquad::rendering::experiment::Rendering;
 use lightquad::volume::experiment::{Built, Volume, VolumeQuantity as Quantity};
 use lightquad::volume::{DepthScheme, ShadowMethod, evaluate};
 use rand::SeedableRng;
@@ -61,6 +65,38 @@ fn volume_scene(file: &Path) -> Built {
     Volume::build(&spec.scene).unwrap_or_else(|e| panic!("{}: {e}", file.display()))
 }
 
+/// lightquad's converged value of quantity `name` of an experiment of family
+/// `F` (its converged evaluation at n = 400, as the report's cross-check
+/// table shows it).
+fn converged<F: Family>(file: &Path, name: &str) -> f64 {
+    let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    let exp = parse_json(&text)
+        .and_then(deserialize::<F>)
+        .and_then(|spec| validate::<F>(spec, "hash"))
+        .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    let q = *exp
+        .spec
+        .quantities
+        .iter()
+        .find(|q| q.name() == name)
+        .unwrap_or_else(|| panic!("{}: no quantity {name}", file.display()));
+    let out = F::converged(&exp.scene, 400, &[q]).unwrap_or_else(|e| panic!("{e}"));
+    out[&q].value[0]
+}
+
+/// lightquad's value of quantity `name` of the experiment at `file`, by its
+/// family, with `ln tau` beside V-tau (NaN otherwise).
+fn lightquad(file: &Path, name: &str) -> (f64, f64) {
+    let json: Value = serde_json::from_str(&std::fs::read_to_string(file).expect("read"))
+        .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    match json["family"].as_str() {
+        Some("volume") => lightquad_value(file, quantity(name)),
+        Some("rendering") => (converged::<Rendering>(file, name), f64::NAN),
+        Some("furnace") => (converged::<Furnace>(file, name), f64::NAN),
+        other => panic!("{}: no comparison for family {other:?}", file.display()),
+    }
+}
+
 fn quantity(name: &str) -> Quantity {
     match name {
         "tau" => Quantity::Tau,
@@ -96,8 +132,7 @@ fn lightquad_agrees_with_mitsuba_within_four_standard_errors() {
             path.display()
         );
         for (name, entry) in v["quantities"].as_object().expect("quantities") {
-            let q = quantity(name);
-            let (lq, lq_log) = lightquad_value(&experiment, q);
+            let (lq, lq_log) = lightquad(&experiment, name);
             let mi = entry["value"].as_f64().expect("value");
             let se = entry["std_error"].as_f64().expect("std_error");
             // float32 renderer: at least 1e-6 relative, or the harness's own bound.
@@ -128,5 +163,10 @@ fn lightquad_agrees_with_mitsuba_within_four_standard_errors() {
         }
     }
     assert!(compared >= 2, "only {compared} values compared");
-    assert!(kinds.contains("tau") && kinds.contains("I_L"), "{kinds:?}");
+    // Both families' CI regeneration (scripts/reference.sh --ci) and the
+    // committed values cover V-tau, V-L, irradiance, reflected radiance and
+    // the furnace.
+    for kind in ["tau", "I_L", "E_area", "L_area", "L"] {
+        assert!(kinds.contains(kind), "no {kind} compared: {kinds:?}");
+    }
 }

@@ -16,6 +16,6 @@ A family module provides
   ``value``, ``std_error``, ``samples``, ``method`` and details.
 """
 
-from . import volume
+from . import furnace, rendering, volume
 
-FAMILIES = {"volume": volume}
+FAMILIES = {"volume": volume, "rendering": rendering, "furnace": furnace}
