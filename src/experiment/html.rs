@@ -33,7 +33,7 @@ use std::path::Path;
 
 use super::markdown::{escape, inline, to_html};
 use super::plot;
-use super::reference::{Crosscheck, crosscheck_markdown};
+use super::reference::{CROSSCHECK_INTRO, Crosscheck, crosscheck_markdown};
 use super::report::{
     EXACT_FROM_START, FLAG_LEGEND, Page, Row, RowFlag, SHARED, Section, Summary, TIED, cell, label,
     provenance, ranked, ranks, show_value, skipped,
@@ -754,10 +754,8 @@ pub fn write_index(
     if !crosscheck.is_empty() {
         let _ = writeln!(
             b,
-            "<h2>lightquad vs Mitsuba 3 vs closed form</h2>\n<p>Every case the Mitsuba harness (<code>reference/</code>) covers: \
-             lightquad's converged value, Mitsuba's value with its standard error (float32 renderer: \
-             expect ~1e-6 relative at best), the closed form where one exists; where Mitsuba has no \
-             value, the row says why.</p>\n{}",
+            "<h2>lightquad vs Mitsuba 3 vs closed form</h2>\n<p>{}</p>\n{}",
+            escape(CROSSCHECK_INTRO),
             to_html(&crosscheck_markdown(crosscheck), 1)
         );
     }

@@ -721,10 +721,17 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
         .collect()
 }
 
+/// What the comparison's table shows, said above it in every report.
+pub const CROSSCHECK_INTRO: &str = "Every case the Mitsuba harness (reference/) covers: \
+     lightquad's converged value (the family's converged evaluation at n = 400, computed apart \
+     from the experiment's reference), Mitsuba's value with its standard error (float32 \
+     renderer: expect ~1e-6 relative at best), the closed form where one exists; where Mitsuba \
+     has no value, the row says why.";
+
 /// The comparison as a Markdown table.
 pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
     let mut md = String::from(
-        "| experiment | quantity | lightquad (the family's converged evaluation at n = 400, apart from the experiment's reference) | Mitsuba 3 +- std. error | closed form | lightquad - Mitsuba |\n\
+        "| experiment | quantity | lightquad (converged) | Mitsuba 3 +- std. error | closed form | lightquad - Mitsuba |\n\
          |---|---|---:|---:|---:|---|\n",
     );
     for r in rows {

@@ -43,7 +43,7 @@ use std::path::Path;
 
 use super::fit::fitted_line;
 use super::plot;
-use super::reference::{Crosscheck, Reference, crosscheck_markdown, rms};
+use super::reference::{CROSSCHECK_INTRO, Crosscheck, Reference, crosscheck_markdown, rms};
 use super::run::{JobResult, write_report_file};
 use crate::family::{Display, Flag, Measured};
 
@@ -1484,10 +1484,7 @@ pub fn write_index(
     if !crosscheck.is_empty() {
         let _ = writeln!(
             md,
-            "## lightquad vs Mitsuba 3 vs closed form\n\nEvery case the Mitsuba harness (reference/) covers: \
-             lightquad's converged value, Mitsuba's value with its standard error (float32 renderer: \
-             expect ~1e-6 relative at best), the closed form where one exists; where Mitsuba has no \
-             value, the row says why.\n\n{}",
+            "## lightquad vs Mitsuba 3 vs closed form\n\n{CROSSCHECK_INTRO}\n\n{}",
             crosscheck_markdown(crosscheck)
         );
     }
