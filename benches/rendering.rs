@@ -130,7 +130,8 @@ fn rendering(c: &mut Criterion) {
                     continue;
                 };
                 eprintln!(
-                    "{form} {rule}: {target:e} reached at {n} evaluations (error {error:.1e})"
+                    "{form} {rule}: {target:e} held from {n} evaluations (error there \
+                     {error:.1e}, at {largest} {last:.1e})"
                 );
                 let id = BenchmarkId::new(format!("{form}/{rule}/{target:e}"), n);
                 g.bench_function(id, |b| {
