@@ -940,3 +940,35 @@ fn blockers_small_beside_the_light_are_subtracted_whole() {
     let (got, error) = converged(&exp, Q::ECone);
     assert!(rel(got, want) < 1e-10, "{got} vs {want} (+- {error:e})");
 }
+
+/// A sphere light covering 1e-15 of the hemisphere's solid angle: R-H over
+/// its exact cone finds it with 16 nodes, to 1e-10 of `pi L sin^2 alpha cos
+/// theta` (written out here), and R-A over its visible cap to 1e-9: there
+/// the normal `(y - c)/R` comes from a point `y` rounded at 1e-16 of `|c| ~
+/// 1`, 2e-9 of `R = 4.8e-8`, which leaves 3e-10. R-H over the whole
+/// hemisphere misses the light entirely.
+#[test]
+fn a_light_covering_1e_15_of_the_hemisphere_is_found_by_its_own_domain() {
+    let centre = v3(0.3, -0.2, 1.0);
+    let d = centre.norm();
+    let radius = d * (2.0e-15_f64).sqrt(); // pi sin^2 alpha = 1e-15 of 2 pi
+    let exp = with_scene(
+        json!({"receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+               "emitters": [{"type": "sphere", "centre": [0.3, -0.2, 1.0], "radius": radius,
+                             "radiance": 5.0}]}),
+        &["E_area", "E_cone", "E_hemisphere"],
+    );
+    let sin2 = (radius / d).powi(2);
+    let want = 5.0 * PI * sin2 * (centre.z / d);
+    assert!(rel(PI * sin2, 2.0 * PI * 1e-15) < 1e-12);
+    let gl = json!({"rule": "gauss-legendre"});
+    for (q, within) in [(Q::ECone, 1e-10), (Q::EArea, 1e-9)] {
+        let (got, _) = by(&exp, gl.clone(), 16, q);
+        assert!(rel(got, want) < within, "{q:?}: {got:e} vs {want:e}");
+    }
+    let (missed, _) = by(&exp, gl, 65536, Q::EHemisphere);
+    assert_eq!(
+        missed, 0.0,
+        "the hemisphere's nodes should all miss a light of 1e-15"
+    );
+}
