@@ -103,6 +103,7 @@ use serde::{Deserialize, Serialize};
 
 use super::blocked;
 use super::brdf::{Brdf, Ggx, Lambert, NormalizedPhong, Phong, Sample};
+use super::clipped;
 use super::emitter::{
     AnyEmitter, CapLight, DiskLight, Emitter, EnvironmentLight, LightSampling, RectangleLight,
     SphereLight, TriangleLight,
@@ -1044,8 +1045,19 @@ fn converged_by_emitter<K: Kernel>(
         };
         let part = match (e, lobe) {
             // Under a peaked lobe the environment's integrand is the lobe:
-            // smooth in the BRDF's own map.
-            (AnyEmitter::Environment(_), Some(lobe)) => by_lobe(lobe, &mut rng)?,
+            // smooth in the BRDF's own map, but for the horizon where it
+            // cuts the lobe; a Phong lobe is split there (clipped.rs), the
+            // two checked against each other.
+            (AnyEmitter::Environment(_), Some(lobe)) => match phong_cone(built)? {
+                Some(pieces) => {
+                    let mut sum = Estimate::zero();
+                    for piece in &pieces {
+                        sum = sum.combine(integrate_over(&rule, piece, budget, &mut rng, along())?);
+                    }
+                    cross_checked(sum, by_lobe(lobe, &mut rng)?)
+                }
+                None => by_lobe(lobe, &mut rng)?,
+            },
             _ => {
                 let own = if exact_cone(e, receiver) {
                     integrate_over(&rule, &e.cone(receiver)?, budget, &mut rng, along())?
@@ -1106,6 +1118,29 @@ fn converged_by_emitter<K: Kernel>(
         total = total.combine(part);
     }
     Ok(total)
+}
+
+/// The pieces of a Phong lobe's cone about its mirror direction, cut at
+/// the receiver's horizon ([`clipped::pieces`]), out to where `cos^n alpha`
+/// falls below 1e-30 of its peak; `None` for other BRDFs or no viewer.
+fn phong_cone(built: &Built) -> Result<Option<Vec<clipped::ClippedCone>>, QuadError> {
+    let n = match built.brdf {
+        Some(AnyBrdf::Phong(p)) => p.exponent(),
+        Some(AnyBrdf::NormalizedPhong(p)) => p.exponent(),
+        _ => return Ok(None),
+    };
+    let Some(wo) = built.toward_viewer else {
+        return Ok(None);
+    };
+    let normal = built.receiver.normal();
+    let mirror = normal * (2.0 * normal.dot(&wo)) - wo;
+    // cos^n alpha_max = 1e-30, at most 90 degrees (the lobe is clamped there).
+    let one_minus_cos = if n > 0.0 {
+        (-(1e-30_f64.ln() / n).exp_m1()).min(1.0)
+    } else {
+        1.0
+    };
+    clipped::pieces(mirror.normalize(), normal, one_minus_cos).map(Some)
 }
 
 /// The lit part of planar emitter `k` seen from `x`, as triangles, when the

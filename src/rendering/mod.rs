@@ -21,6 +21,7 @@ pub mod audit;
 pub mod blocked;
 pub mod brdf;
 pub mod cap;
+pub mod clipped;
 pub mod closed;
 pub mod emitter;
 pub mod experiment;
