@@ -544,11 +544,30 @@ fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
             }
         }
     }
-    let unconverged: Vec<String> = accuracy
+    // A converged evaluation that doubts its own error estimate (the
+    // rendering family's, across outlines it does not split at) is not
+    // called converged, whatever its change between budgets.
+    let doubted: Vec<String> = exp
+        .spec
+        .quantities
         .iter()
-        .filter(|(_, c)| c.is_nan() || **c > goal)
+        .filter(|q| {
+            fine.get(q)
+                .is_some_and(|m| m.flags.contains(&crate::family::Flag::UnreliableEstimate))
+        })
+        .map(|q| q.name().to_string())
+        .collect();
+    let mut unconverged: Vec<String> = accuracy
+        .iter()
+        .filter(|(q, c)| (c.is_nan() || **c > goal) && !doubted.contains(q))
         .map(|(q, c)| format!("{q} ({c:.1e})"))
         .collect();
+    unconverged.extend(doubted.iter().map(|q| {
+        format!(
+            "{q} (unverified: its evaluation crosses discontinuities it does not split at, where \
+             the change between budgets can understate the error)"
+        )
+    }));
     let floor = if goal == CONVERGED_FLOOR {
         format!(
             " (the goal: a hundredth of the tightest target, {tightest:.0e}, but not below \

@@ -62,6 +62,37 @@ pub fn domain(o: &Occluder, x: Vec3) -> Result<LightDomain, QuadError> {
     })
 }
 
+/// True when what blocker `j` hides of emitter `k` is smooth over the
+/// blocker's domain, so that the converged evaluation's error estimate can
+/// be trusted: `k` is the environment (behind every direction, the same
+/// radiance), and `j`'s cone from `x` lies wholly above the horizon and
+/// apart from every other blocker's cone. Otherwise `k`'s outline, the
+/// horizon or another blocker cuts the domain: a sliver 0.15 degrees wide at
+/// the edge of a sphere light's cone, where it hid a rectangle light, was
+/// missed at every budget while the change between budgets said 7e-8.
+pub fn smooth(scene: &Scene<f64>, receiver: &Receiver, k: usize, j: usize) -> bool {
+    if !matches!(scene.emitters().get(k), Some(AnyEmitter::Environment(_))) {
+        return false;
+    }
+    let x = receiver.point();
+    let cones: Vec<Option<(Vec3, f64)>> = blockers(scene, k)
+        .iter()
+        .map(|o| {
+            let cap = bounding_cone(x, o.bounding_sphere().0, o.bounding_sphere().1).ok()?;
+            let omc = cap.one_minus_cos();
+            (omc < 1.0).then(|| (cap.axis(), (1.0 - omc).acos()))
+        })
+        .collect();
+    let Some(Some((axis, half))) = cones.get(j).copied() else {
+        return false;
+    };
+    let above = receiver.normal().dot(&axis) > half.sin();
+    let apart = cones.iter().enumerate().all(|(i, c)| {
+        i == j || c.is_some_and(|(a, h)| a.dot(&axis).clamp(-1.0, 1.0).acos() > half + h)
+    });
+    above && apart
+}
+
 /// Emitter `k`'s light with nothing in the way, along unit `w`: `K(w) cos
 /// theta L_k(w)`, `L_k(w)` the radiance of `k`'s first point along the ray
 /// (its back is dark), zero below the horizon. No shadow ray.

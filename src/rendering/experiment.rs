@@ -1106,7 +1106,13 @@ fn converged_by_emitter<K: Kernel>(
                     ),
                     None => own,
                 };
-                hidden = hidden.combine(checked);
+                // Outlines, the horizon or other blockers crossing the
+                // domain make the evaluation's own error estimate unsafe.
+                let trusted = blocked::smooth(scene, receiver, k, j);
+                hidden = hidden.combine(Estimate {
+                    reliable: checked.reliable && trusted,
+                    ..checked
+                });
             }
             part.combine(Estimate {
                 value: -hidden.value,
