@@ -27,7 +27,12 @@ def main(argv=None):
 
     if args.check:
         bad = 0
-        for status, name, message in check(args.files, args.out):
+        try:
+            report = check(args.files, args.out)
+        except (OSError, ValueError) as e:
+            print(f"error: --check: {type(e).__name__}: {e}", file=sys.stderr)
+            return 2
+        for status, name, message in report:
             print(f"{status.upper():8s}{name}: {message}")
             bad += status != "ok"
         return 1 if bad else 0
@@ -55,6 +60,14 @@ def main(argv=None):
             rec = compute(path, args.quick, args.out)
         except SpecError as e:
             print(f"error: {path}: {e}", file=sys.stderr, flush=True)
+            failed += 1
+            continue
+        except (OSError, ValueError, TypeError, KeyError, AttributeError, IndexError,
+                RuntimeError) as e:
+            # A file the readers did not foresee (a wrong type deep in the
+            # scene, a shape Mitsuba refuses): said, and the next file runs.
+            print(f"error: {path}: cannot compute it: {type(e).__name__}: {e}",
+                  file=sys.stderr, flush=True)
             failed += 1
             continue
         print(f"  -> {args.out}/{rec['experiment']}.json ({rec['run_seconds']:.1f} s)")

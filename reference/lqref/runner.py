@@ -3,6 +3,7 @@ quantity), writing them, and checking values files against their experiment
 files (stale when the hash differs)."""
 
 import json
+import math
 import os
 import platform
 import time
@@ -42,6 +43,10 @@ def compute(path, quick=False, out_dir=DEFAULT_OUT, log=_log):
             continue
         t0 = time.perf_counter()
         result = family.compute(exp, q, settings)
+        if not all(math.isfinite(result[key]) for key in ("value", "std_error")):
+            raise spec.SpecError(
+                "scene", f"Mitsuba's {q} came out {result['value']} +- {result['std_error']}: "
+                         "not finite (float32 overflow?); no values file written")
         result["seconds"] = round(time.perf_counter() - t0, 3)
         values[q] = result
         log(f"  {q:4s} = {result['value']:.10g} +- {result['std_error']:.3g}"

@@ -51,19 +51,29 @@ def load(path) -> Experiment:
             raise SpecError(key, "missing field")
     scene = family.read_scene(raw["scene"])
 
+    if not isinstance(raw["quantities"], list):
+        raise SpecError("quantities", f"expected a list, got {raw['quantities']!r}")
     quantities = list(raw["quantities"])
     for i, q in enumerate(quantities):
         if q not in family.QUANTITIES:
             raise SpecError(f"quantities[{i}]",
                             f"unknown quantity {q!r}; known: {family.QUANTITIES}")
 
+    name = raw["name"]
+    if not isinstance(name, str) or not name or "/" in name or "\\" in name \
+            or name.startswith("."):
+        raise SpecError("name", f"{name!r}: expected a file name (no '/', '\\' or leading "
+                                "'.'): the values file is <out>/<name>.json")
+    seed = raw.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise SpecError("seed", f"expected a whole number >= 0, got {seed!r}")
     return Experiment(
-        name=str(raw["name"]),
+        name=name,
         path=str(path),
         family=tag,
         scene=scene,
         quantities=quantities,
-        seed=int(raw.get("seed", 0)),
+        seed=seed,
     )
 
 

@@ -571,3 +571,73 @@ def test_mitsubas_sphere_seen_from_its_own_wall_is_biased(tmp_path):
     sphere, cube = l3("sphere"), l3("cube")
     assert abs(sphere[0] - 1.875) > 8.0 * sphere[1], sphere
     assert abs(cube[0] - 1.875) < 4.0 * cube[1], cube
+
+
+# ---------------------------------------------------------------- bad input (hostile probe)
+
+
+@pytest.mark.parametrize("change, path", [
+    (lambda s: s.update(emitters=[{"type": "triangle", "a": [0, 0, 1], "b": [1, 0, 1],
+                                   "c": [2, 0, 1], "radiance": 1}]), "scene.emitters[0]"),
+    (lambda s: s.update(emitters=[{"type": "disk", "centre": [0, 0, 1], "normal": [0, 0, -1],
+                                   "radius": float("nan"), "radiance": 1}]),
+     "scene.emitters[0].radius"),
+    (lambda s: s.update(emitters=[{"type": "sphere", "centre": [0, 0, 2], "radius": -1,
+                                   "radiance": 1}]), "scene.emitters[0].radius"),
+    (lambda s: s.update(receiver="abc"), "scene.receiver"),
+    (lambda s: s["emitters"][0].update(radiance=1e300), "scene.emitters[0].radiance"),
+    (lambda s: s["receiver"]["brdf"].pop("albedo"), "scene.receiver.brdf.albedo"),
+    (lambda s: s["receiver"]["brdf"].update(albedo=True), "scene.receiver.brdf.albedo"),
+    (lambda s: s.update(occluders="none"), "scene.occluders"),
+])
+def test_rendering_bad_scenes_are_named_and_write_nothing(tmp_path, change, path):
+    scene = {"receiver": {"point": [0, 0, 0], "normal": [0, 0, 1],
+                          "brdf": {"type": "lambert", "albedo": 0.5},
+                          "toward_viewer": [0, 0, 1]},
+             "emitters": [{"type": "disk", "centre": [0, 0, 1], "normal": [0, 0, -1],
+                           "radius": 1.0, "radiance": 1.0}]}
+    change(scene)
+    bad = write_rendering(tmp_path, "bad", scene, ["E_area", "L_brdf"])
+    with pytest.raises(spec.SpecError) as err:
+        runner.compute(bad, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
+    assert err.value.path == path
+    assert not (tmp_path / "v" / "bad.json").exists()
+
+
+def test_names_are_file_names_and_a_bad_file_does_not_stop_the_rest(tmp_path):
+    good = write_rendering(tmp_path, "good", {
+        "receiver": {"point": [0, 0, 0], "normal": [0, 0, 1]},
+        "emitters": [{"type": "environment", "radiance": 1.0}]}, ["E_area"])
+    escaping = json.loads(good.read_text())
+    escaping["name"] = "../escaped"
+    bad = tmp_path / "escaping.json"
+    bad.write_text(json.dumps(escaping))
+    with pytest.raises(spec.SpecError, match="file name") as err:
+        spec.load(bad)
+    assert err.value.path == "name"
+    out = tmp_path / "v"
+    assert main([str(bad), str(tmp_path / "absent.json"), str(good), "--quick",
+                 "--out", str(out)]) == 2
+    assert (out / "good.json").exists() and not (tmp_path / "escaped.json").exists()
+
+
+def test_furnace_reflections_past_the_cap_are_refused(tmp_path):
+    near_one = write_furnace(tmp_path, "near", {"albedo": 0.99999999, "emission": 1.0,
+                                                "point": [0, 0, -1]}, ["L"])
+    with pytest.raises(spec.SpecError) as err:
+        runner.compute(near_one, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
+    assert err.value.path == "scene.albedo"
+    many = write_furnace(tmp_path, "many", {"albedo": 0.5, "emission": 1.0,
+                                            "point": [0, 0, -1], "bounces": 5 * 10 ** 9},
+                         ["L", "L_K"])
+    with pytest.raises(spec.SpecError) as err:
+        runner.compute(many, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
+    assert err.value.path == "scene.bounces"
+    assert not (tmp_path / "v" / "many.json").exists()
+    for scene, path in (({"albedo": 0.5, "emission": 1e300, "point": [0, 0, -1]},
+                         "scene.emission"),
+                        ({"albedo": 0.5, "emission": 1.0, "half_angle": 4,
+                          "point": [0, 0, -1]}, "scene.half_angle")):
+        with pytest.raises(spec.SpecError) as err:
+            spec.load(write_furnace(tmp_path, "x", scene, ["L"]))
+        assert err.value.path == path

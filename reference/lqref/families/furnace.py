@@ -67,13 +67,17 @@ def read_scene(scene) -> Scene:
     if not 0.0 <= albedo < 1.0:
         raise SpecError("scene.albedo", f"expected an albedo in [0, 1), got {albedo}")
     emission = _number(scene, "emission")
-    if emission < 0.0:
-        raise SpecError("scene.emission", f"expected a radiance >= 0, got {emission}")
+    if not 0.0 <= emission <= 1e30:
+        raise SpecError("scene.emission", f"expected a radiance in [0, 1e30] (float32, "
+                                          f"Mitsuba's, overflows near 3.4e38), got {emission}")
     bounces = scene.get("bounces")
     if bounces is not None and (isinstance(bounces, bool) or not isinstance(bounces, int)
                                 or bounces < 0):
         raise SpecError("scene.bounces", f"expected a whole number >= 0, got {bounces!r}")
-    return Scene(albedo, emission, _number(scene, "half_angle", math.pi), bounces)
+    half_angle = _number(scene, "half_angle", math.pi)
+    if not 0.0 <= half_angle <= math.pi:
+        raise SpecError("scene.half_angle", f"expected an angle in [0, pi], got {half_angle}")
+    return Scene(albedo, emission, half_angle, bounces)
 
 
 class Settings:
@@ -88,7 +92,7 @@ class Settings:
 
     def renders(self, reflections):
         """``(passes, spp)`` for paths of ``reflections + 1`` segments."""
-        spp = 128 if reflections > 1000 else 4096
+        spp = 128 if reflections > 1000 else (256 if self.quick else 4096)
         paths = self.bounces / (reflections + 1)
         return max(8, round(paths / spp)), spp
 
@@ -112,15 +116,29 @@ def unsupported_reason(exp, quantity):
     return None
 
 
+MAX_REFLECTIONS = 10 ** 6
+"""The most reflections a path may take (a path of 1e6 bounces takes about
+half a second; an albedo of 1 - 1e-8 would ask for 2e9)."""
+
+
 def reflections(exp, quantity):
     """``K``: the file's for ``L_K``; for ``L`` the fewest with ``rho^(K+1)`` below
-    TRUNCATION."""
+    TRUNCATION. More than MAX_REFLECTIONS is a SpecError naming the field."""
     rho = exp.scene.albedo
     if quantity == "L_K":
-        return exp.scene.bounces
+        k = exp.scene.bounces
+        if k > MAX_REFLECTIONS:
+            raise SpecError("scene.bounces", f"{k}: expected at most {MAX_REFLECTIONS} "
+                                             "reflections for Mitsuba's paths")
+        return k
     if rho == 0.0:
         return 0
-    return max(0, math.ceil(math.log(TRUNCATION) / math.log(rho)) - 1)
+    k = max(0, math.ceil(math.log(TRUNCATION) / math.log(rho)) - 1)
+    if k > MAX_REFLECTIONS:
+        raise SpecError("scene.albedo", f"{rho}: L to a truncation of {TRUNCATION:g} needs {k} "
+                                        f"reflections, more than {MAX_REFLECTIONS}: expected an "
+                                        "albedo further from 1")
+    return k
 
 
 def float32_series(rho, emission, k):

@@ -82,11 +82,17 @@ class Scene:
     occluders: list
 
 
+LARGEST_RADIANCE = 1e30
+"""The largest radiance accepted: float32 (Mitsuba) overflows near 3.4e38."""
+
+
 def read_scene(scene) -> Scene:
     """The ``scene`` object of a rendering experiment file."""
-    if not isinstance(scene, dict) or "receiver" not in scene:
-        raise SpecError("scene.receiver", "missing field")
-    r = scene["receiver"]
+    if not isinstance(scene, dict):
+        raise SpecError("scene", f"expected an object, got {scene!r}")
+    r = scene.get("receiver")
+    if not isinstance(r, dict):
+        raise SpecError("scene.receiver", f"expected an object, got {r!r}")
     point = vec3(r.get("point"), "scene.receiver.point")
     normal = unit(vec3(r.get("normal"), "scene.receiver.normal"), "scene.receiver.normal")
     viewer = r.get("toward_viewer")
@@ -94,27 +100,67 @@ def read_scene(scene) -> Scene:
         viewer = unit(vec3(viewer, "scene.receiver.toward_viewer"),
                       "scene.receiver.toward_viewer")
     brdf = r.get("brdf")
-    if brdf is not None and brdf.get("type") not in BRDF_TYPES:
-        raise SpecError("scene.receiver.brdf.type", f"unknown BRDF {brdf.get('type')!r}")
+    if brdf is not None:
+        if not isinstance(brdf, dict) or brdf.get("type") not in BRDF_TYPES:
+            raise SpecError("scene.receiver.brdf.type",
+                            f"unknown BRDF {brdf!r}; known: {', '.join(BRDF_TYPES)}")
+        if brdf["type"] == "lambert":
+            _number(brdf.get("albedo"), "scene.receiver.brdf.albedo", 0.0, 1.0)
 
-    emitters = scene.get("emitters") or []
+    emitters = _list(scene.get("emitters"), "scene.emitters")
     for k, e in enumerate(emitters):
-        if e.get("type") not in EMITTER_TYPES:
-            raise SpecError(f"scene.emitters[{k}].type", f"unknown emitter {e.get('type')!r}")
-        _check_radiance(e.get("radiance"), f"scene.emitters[{k}].radiance")
-    occluders = scene.get("occluders") or []
+        path = f"scene.emitters[{k}]"
+        if not isinstance(e, dict) or e.get("type") not in EMITTER_TYPES:
+            raise SpecError(f"{path}.type",
+                            f"unknown emitter {e!r}; known: {', '.join(EMITTER_TYPES)}")
+        _number(e.get("radiance"), f"{path}.radiance", 0.0, LARGEST_RADIANCE)
+        _check_shape(e, path)
+    occluders = _list(scene.get("occluders"), "scene.occluders")
     for k, o in enumerate(occluders):
-        if o.get("type") not in OCCLUDER_TYPES:
-            raise SpecError(f"scene.occluders[{k}].type",
-                            f"unknown occluder {o.get('type')!r}")
+        path = f"scene.occluders[{k}]"
+        if not isinstance(o, dict) or o.get("type") not in OCCLUDER_TYPES:
+            raise SpecError(f"{path}.type",
+                            f"unknown occluder {o!r}; known: {', '.join(OCCLUDER_TYPES)}")
+        _check_shape(o, path)
     return Scene(point, normal, brdf, viewer, list(emitters), list(occluders))
 
 
-def _check_radiance(value, path):
+def _list(value, path):
+    if value is None:
+        return []
+    if not isinstance(value, list):
+        raise SpecError(path, f"expected a list, got {value!r}")
+    return value
+
+
+def _number(value, path, lo, hi):
+    """``value`` as a float in ``[lo, hi]``; a SpecError at ``path`` otherwise
+    (booleans, strings, NaN and infinities included)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not math.isfinite(value) or value < 0:
-        raise SpecError(path, f"expected a finite radiance >= 0 (a number: the harness "
-                              f"compares scalars), got {value!r}")
+            or not math.isfinite(value) or not lo <= value <= hi:
+        raise SpecError(path, f"expected a number in [{lo:g}, {hi:g}], got {value!r}")
+    return float(value)
+
+
+def _check_shape(item, path):
+    """The fields of a rectangle, disk, triangle or sphere: points, a
+    radius > 0, a parallelogram or triangle of non-zero area."""
+    kind = item["type"]
+    if kind in ("disk", "sphere"):
+        _number(item.get("radius"), f"{path}.radius", 1e-300, 1e300)
+        vec3(item.get("centre"), f"{path}.centre")
+        if kind == "disk":
+            unit(vec3(item.get("normal"), f"{path}.normal"), f"{path}.normal")
+    elif kind == "rectangle":
+        vec3(item.get("origin"), f"{path}.origin")
+        eu = np.asarray(vec3(item.get("edge_u"), f"{path}.edge_u"))
+        ev = np.asarray(vec3(item.get("edge_v"), f"{path}.edge_v"))
+        if not np.linalg.norm(np.cross(eu, ev)) > 0.0:
+            raise SpecError(path, "a parallelogram of zero area (parallel or zero edges)")
+    elif kind == "triangle":
+        a, b, c = (np.asarray(vec3(item.get(v), f"{path}.{v}")) for v in ("a", "b", "c"))
+        if not np.linalg.norm(np.cross(b - a, c - a)) > 0.0:
+            raise SpecError(path, "a triangle of zero area (collinear corners)")
 
 
 # ----------------------------------------------------------------------------
