@@ -1016,3 +1016,40 @@ fn a_phong_lobe_cut_by_the_horizon_under_a_sky_converges_to_1e_12() {
         assert!(error < 1e-9 * want, "{degrees}: claimed {error:e}");
     }
 }
+
+/// A converged reference that crosses outlines it does not split at says so
+/// instead of claiming convergence. Hostile probe: a disk light shut inside
+/// a sphere occluder (the true irradiance is 0) got a reference of 0.0906
+/// "converged to 1e-8" (the hidden part, a 0.04 sr light in the whole
+/// sphere of directions, was missed); its Gauss–Legendre value 0 was then
+/// shown as 100% off.
+#[test]
+fn a_reference_across_unsplit_outlines_is_unverified_not_converged() {
+    let dir = scratch("unverified");
+    let file = dir.join("shut-in.json");
+    let exp = json!({
+        "name": "shut-in", "family": "rendering",
+        "scene": {"receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+                  "emitters": [{"type": "disk", "centre": [0.0, 0.0, 5.0],
+                                "normal": [0.0, 0.0, -1.0], "radius": 1.0, "radiance": 1.0}],
+                  "occluders": [{"type": "sphere", "centre": [0.1, 0.2, 0.3], "radius": 2.0}]},
+        "quantities": ["E_area"], "rules": [{"rule": "gauss-legendre"}], "budgets": [16],
+        "repeats": 1, "reference": {"type": "converged"}
+    });
+    fs::write(&file, serde_json::to_string(&exp).expect("json")).expect("write");
+    let out = dir.join("out");
+    let run = bin()
+        .args(["run", "--threads", "1", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(run.status.success(), "{}", stderr(&run));
+    let report = fs::read_to_string(out.join("shut-in/report.md")).expect("report");
+    let line = report
+        .lines()
+        .find(|l| l.starts_with("Reference:"))
+        .expect("a reference line");
+    assert!(line.contains("E_area (unverified"), "{line}");
+    assert!(!line.contains("every quantity converged"), "{line}");
+}
