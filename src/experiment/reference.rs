@@ -612,6 +612,9 @@ pub struct Crosscheck {
     pub quantity: &'static str,
     /// lightquad's converged value (the family's converged evaluation at n = 400).
     pub lightquad: f64,
+    /// False when that evaluation doubts its own error (it crosses outlines
+    /// it does not split at): the table marks the value unverified.
+    pub verified: bool,
     /// Mitsuba's value and standard error, when it has one.
     pub mitsuba: Option<(f64, f64)>,
     /// The closed form, where the family has one.
@@ -711,7 +714,7 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
             )),
         ),
     };
-    let lightquad = converged(exp, 400).unwrap_or_default();
+    let lightquad = converged_measured(exp, 400).unwrap_or_default();
     let scalar = |v: Option<&Vec<f64>>| v.and_then(|v| (v.len() == 1).then(|| v[0]));
     exp.spec
         .quantities
@@ -731,7 +734,10 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
             Crosscheck {
                 experiment: exp.spec.name.clone(),
                 quantity: q.name(),
-                lightquad: scalar(lightquad.get(q)).unwrap_or(f64::NAN),
+                lightquad: scalar(lightquad.get(q).map(|m| &m.value)).unwrap_or(f64::NAN),
+                verified: lightquad
+                    .get(q)
+                    .is_none_or(|m| !m.flags.contains(&crate::family::Flag::UnreliableEstimate)),
                 mitsuba,
                 closed_form: scalar(F::closed_form(&exp.scene, *q).as_ref()),
                 note,
@@ -773,8 +779,13 @@ pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
             ),
             None => "—".into(),
         };
+        let unverified = if r.verified {
+            ""
+        } else {
+            " (unverified: across outlines it does not split at)"
+        };
         md.push_str(&format!(
-            "| {} | {} | {:.10e} | {mitsuba} | {closed} | {agreement} |\n",
+            "| {} | {} | {:.10e}{unverified} | {mitsuba} | {closed} | {agreement} |\n",
             r.experiment, r.quantity, r.lightquad
         ));
     }
