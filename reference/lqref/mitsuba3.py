@@ -59,3 +59,19 @@ def vector(v):
     """``v`` (three numbers) as a Mitsuba ``Vector3f``."""
     mi, _ = require_mitsuba()
     return mi.Vector3f(float(v[0]), float(v[1]), float(v[2]))
+
+
+def mean_of_renders(scene, passes, spp, seed):
+    """The float64 mean of ``passes`` renders of ``spp`` samples each of a
+    scene with a 1x1 film (its RGB averaged), and the standard error over the
+    renders: one film accumulating far more samples drifts in float32. The
+    renders' seeds follow from ``seed``, so a rerun reproduces the value."""
+    mi, _ = require_mitsuba()
+    import numpy as np
+
+    values = np.empty(passes)
+    base = (seed * 1_000_003) % 2 ** 32
+    for k in range(passes):
+        img = np.asarray(mi.render(scene, spp=spp, seed=(base + k) % 2 ** 32), dtype=np.float64)
+        values[k] = float(np.mean(img[0, 0, :3]))
+    return float(np.mean(values)), float(np.std(values, ddof=1) / np.sqrt(values.size))

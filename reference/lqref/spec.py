@@ -97,5 +97,13 @@ def unit(v, path):
     return tuple(x / n for x in v)
 
 
+def number(value, path, lo=-math.inf, hi=math.inf):
+    """``value`` as a float in ``[lo, hi]``; a SpecError at ``path`` otherwise
+    (booleans, strings, None, NaN and infinities included)."""
+    if not (_is_num(value) and lo <= value <= hi):
+        raise SpecError(path, f"expected a number in [{lo:g}, {hi:g}], got {value!r}")
+    return float(value)
+
+
 def _is_num(x):
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)

@@ -26,7 +26,7 @@
 use crate::domain::Vec3;
 use crate::error::QuadError;
 use crate::rendering::emitter::{AnyEmitter, Emitter, LightDomain, bounding_cone};
-use crate::rendering::forms::Kernel;
+use crate::rendering::forms::{Kernel, emitter_at};
 use crate::rendering::occluder::Occluder;
 use crate::rendering::receiver::Receiver;
 use crate::rendering::scene::Scene;
@@ -78,7 +78,8 @@ pub fn smooth(scene: &Scene<f64>, receiver: &Receiver, k: usize, j: usize) -> bo
     let cones: Vec<Option<(Vec3, f64)>> = blockers(scene, k)
         .iter()
         .map(|o| {
-            let cap = bounding_cone(x, o.bounding_sphere().0, o.bounding_sphere().1).ok()?;
+            let (centre, radius) = o.bounding_sphere();
+            let cap = bounding_cone(x, centre, radius).ok()?;
             let omc = cap.one_minus_cos();
             (omc < 1.0).then(|| (cap.axis(), (1.0 - omc).acos()))
         })
@@ -135,14 +136,7 @@ impl<'a, K: Kernel> Hidden<'a, K> {
         k: usize,
         j: usize,
     ) -> Result<Self, QuadError> {
-        let count = scene.emitters().len();
-        let emitter = scene.emitters().get(k).ok_or_else(|| {
-            QuadError::invalid(
-                "k",
-                k,
-                format!("an emitter index below {count}, the scene's number of emitters"),
-            )
-        })?;
+        let emitter = emitter_at(scene, k)?;
         let blockers = blockers(scene, k);
         if j >= blockers.len() {
             return Err(QuadError::invalid(

@@ -154,18 +154,56 @@ impl Domain<2> for ClippedCone {
     }
 
     /// Solid angle: `int 2 phi_0 d(1 - cos alpha)` (exact for the whole
-    /// circle, by 64-point Gauss–Legendre for a clipped piece).
+    /// circle; for a clipped piece by 64-point Gauss–Legendre in `t`, `k =
+    /// k_lo + (k_hi - k_lo) t^2`, which takes out the square root with which
+    /// `phi_0` leaves `pi` at the piece's start; 1e-10 relative with the
+    /// mirror direction 0.003 rad above the horizon).
     fn measure(&self) -> f64 {
         let span = self.k_hi - self.k_lo;
         if self.full {
             return 2.0 * PI * span;
         }
-        crate::quadrature::gauss_legendre::table(64).map_or(f64::NAN, |t| {
-            t.x.iter()
-                .zip(t.w.iter())
-                .map(|(x, w)| w * self.half_range(self.k_lo + (x + 1.0) / 2.0 * span))
+        crate::quadrature::gauss_legendre::table(64).map_or(f64::NAN, |table| {
+            table
+                .x
+                .iter()
+                .zip(table.w.iter())
+                .map(|(x, w)| {
+                    let t = (x + 1.0) / 2.0;
+                    // (w / 2) 2 phi_0 (2 span t) over t in [0, 1].
+                    w * self.half_range(self.k_lo + span * t * t) * 2.0 * span * t
+                })
                 .sum::<f64>()
-                * span
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pieces of the hemisphere about an axis at elevation `e` cover the
+    /// lune it shares with the upper hemisphere, `2 (pi - beta)` for poles
+    /// `beta = pi/2 - e` apart; every mapped direction is above the horizon,
+    /// and `invert` undoes `map`.
+    #[test]
+    fn the_pieces_cover_the_lune_above_the_horizon_and_invert() -> Result<(), QuadError> {
+        let normal = Vec3::z();
+        for e in [0.003_f64, 0.3, 1.2] {
+            let axis = Vec3::new(e.cos(), 0.0, e.sin());
+            let pieces = pieces(axis, normal, 1.0)?;
+            let total: f64 = pieces.iter().map(|p| p.measure()).sum();
+            let want = 2.0 * (PI - (PI / 2.0 - e));
+            assert!((total - want).abs() < 1e-9 * want, "{e}: {total} vs {want}");
+            for p in &pieces {
+                for u in [[0.1, 0.2], [0.5, 0.5], [0.9, 0.97]] {
+                    let (w, jacobian) = p.map(u);
+                    assert!(w.z >= -1e-15 && jacobian > 0.0, "{e} {u:?}: {w:?}");
+                    let back = p.invert(&w).ok_or(QuadError::invalid("u", 0, "inverted"))?;
+                    assert!((back[0] - u[0]).abs() < 1e-9 && (back[1] - u[1]).abs() < 1e-9);
+                }
+            }
+        }
+        Ok(())
     }
 }

@@ -68,7 +68,7 @@ use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::quadrature::Rule;
 use crate::rendering::brdf::{Brdf, Ggx, Lambert, NormalizedPhong, Phong};
-use crate::rendering::emitter::Emitter;
+use crate::rendering::emitter::{AnyEmitter, Emitter};
 use crate::rendering::receiver::{Receiver, unit_direction};
 use crate::rendering::scene::Scene;
 use crate::value::Value;
@@ -284,6 +284,19 @@ pub fn cone_integrand<'a, V: Value, K: Kernel>(
     }
 }
 
+/// Emitter `k` of the scene; an index past its emitters is an error naming
+/// `k`.
+pub fn emitter_at<V: Value>(scene: &Scene<V>, k: usize) -> Result<&AnyEmitter<V>, QuadError> {
+    let count = scene.emitters().len();
+    scene.emitters().get(k).ok_or_else(|| {
+        QuadError::invalid(
+            "k",
+            k,
+            format!("an emitter index below {count}, the scene's number of emitters"),
+        )
+    })
+}
+
 /// R-A's integrand over the surface of emitter `k` ([`Emitter::surface`]):
 ///
 /// `y -> L_e K(wi) cos theta cos theta' / r^2 V(x, y)`, `r = |y - x|`, `wi =
@@ -340,14 +353,7 @@ pub fn area_integrand_with<'a, V: Value, K: Kernel, W: Fn(Vec3) -> bool + 'a>(
     visible: W,
 ) -> Result<impl Fn(Vec3) -> V + 'a, QuadError> {
     let x = receiver.point();
-    let count = scene.emitters().len();
-    let emitter = scene.emitters().get(k).ok_or_else(|| {
-        QuadError::invalid(
-            "k",
-            k,
-            format!("an emitter index below {count}, the scene's number of emitters"),
-        )
-    })?;
+    let emitter = emitter_at(scene, k)?;
     let infinite = emitter.at_infinity();
     let radiance = emitter.radiance();
     Ok(move |y: Vec3| {

@@ -35,8 +35,8 @@ import math
 
 import numpy as np
 
-from ..mitsuba3 import require_mitsuba
-from ..spec import SpecError, _is_num
+from ..mitsuba3 import mean_of_renders, require_mitsuba
+from ..spec import SpecError, number
 
 QUANTITIES = ("L", "L_K")
 TRUNCATION = 1e-9
@@ -51,32 +51,22 @@ class Scene:
         self.bounces = bounces
 
 
-def _number(scene, key, default=None):
-    value = scene.get(key, default)
-    if not _is_num(value):
-        raise SpecError(f"scene.{key}", f"expected a finite number, got {value!r}")
-    return float(value)
-
-
 def read_scene(scene) -> Scene:
     """The ``scene`` object of a furnace experiment file (its ``radius``,
     ``axis`` and ``point`` do not change the white furnace's values)."""
     if not isinstance(scene, dict):
         raise SpecError("scene", "expected an object")
-    albedo = _number(scene, "albedo")
-    if not 0.0 <= albedo < 1.0:
-        raise SpecError("scene.albedo", f"expected an albedo in [0, 1), got {albedo}")
-    emission = _number(scene, "emission")
-    if not 0.0 <= emission <= 1e30:
-        raise SpecError("scene.emission", f"expected a radiance in [0, 1e30] (float32, "
-                                          f"Mitsuba's, overflows near 3.4e38), got {emission}")
+    albedo = number(scene.get("albedo"), "scene.albedo", 0.0, 1.0)
+    if albedo == 1.0:
+        raise SpecError("scene.albedo", "expected an albedo in [0, 1), got 1.0: a furnace "
+                                        "of albedo 1 has no finite radiance")
+    # float32, Mitsuba's, overflows near 3.4e38.
+    emission = number(scene.get("emission"), "scene.emission", 0.0, 1e30)
     bounces = scene.get("bounces")
     if bounces is not None and (isinstance(bounces, bool) or not isinstance(bounces, int)
                                 or bounces < 0):
         raise SpecError("scene.bounces", f"expected a whole number >= 0, got {bounces!r}")
-    half_angle = _number(scene, "half_angle", math.pi)
-    if not 0.0 <= half_angle <= math.pi:
-        raise SpecError("scene.half_angle", f"expected an angle in [0, pi], got {half_angle}")
+    half_angle = number(scene.get("half_angle", math.pi), "scene.half_angle", 0.0, math.pi)
     return Scene(albedo, emission, half_angle, bounces)
 
 
@@ -173,12 +163,7 @@ def compute(exp, quantity, settings):
                             "component_format": "float32"},
                    "sampler": {"type": "independent", "sample_count": spp}},
     })
-    values = np.empty(passes)
-    base = (exp.seed * 1_000_003) % 2 ** 32
-    for p in range(passes):
-        img = np.asarray(mi.render(scene, spp=spp, seed=(base + p) % 2 ** 32),
-                         dtype=np.float64)
-        values[p] = float(np.mean(img[0, 0, :3]))
+    value, std_error = mean_of_renders(scene, passes, spp, exp.seed)
     rho, le = s.albedo, s.emission
     exact_k = le * (1.0 - rho ** (k + 1)) / (1.0 - rho)
     truncation = le * rho ** (k + 1) / (1.0 - rho) if quantity == "L" else 0.0
@@ -186,8 +171,8 @@ def compute(exp, quantity, settings):
     rho32 = float(np.float32(rho))
     exact_k32 = float(np.float32(le)) * (1.0 - rho32 ** (k + 1)) / (1.0 - rho32)
     return {
-        "value": float(np.mean(values)),
-        "std_error": float(np.std(values, ddof=1) / math.sqrt(values.size)),
+        "value": value,
+        "std_error": std_error,
         "samples": int(passes * spp),
         "float32_error": 2.0 * (abs(exact_k32 - exact_k) + abs(f32 - exact_k32)) + truncation,
         "method": f"Mitsuba path integrator in a closed cube (inward normals, every wall "

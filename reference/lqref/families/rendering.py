@@ -48,8 +48,8 @@ from typing import Optional
 
 import numpy as np
 
-from ..mitsuba3 import require_mitsuba
-from ..spec import SpecError, unit, vec3
+from ..mitsuba3 import mean_of_renders, require_mitsuba
+from ..spec import SpecError, number, unit, vec3
 
 QUANTITIES = ("E_hemisphere", "E_cosine", "E_cone", "E_area",
               "L_hemisphere", "L_cosine", "L_brdf", "L_cone", "L_area")
@@ -105,7 +105,7 @@ def read_scene(scene) -> Scene:
             raise SpecError("scene.receiver.brdf.type",
                             f"unknown BRDF {brdf!r}; known: {', '.join(BRDF_TYPES)}")
         if brdf["type"] == "lambert":
-            _number(brdf.get("albedo"), "scene.receiver.brdf.albedo", 0.0, 1.0)
+            number(brdf.get("albedo"), "scene.receiver.brdf.albedo", 0.0, 1.0)
 
     emitters = _list(scene.get("emitters"), "scene.emitters")
     for k, e in enumerate(emitters):
@@ -113,7 +113,7 @@ def read_scene(scene) -> Scene:
         if not isinstance(e, dict) or e.get("type") not in EMITTER_TYPES:
             raise SpecError(f"{path}.type",
                             f"unknown emitter {e!r}; known: {', '.join(EMITTER_TYPES)}")
-        _number(e.get("radiance"), f"{path}.radiance", 0.0, LARGEST_RADIANCE)
+        number(e.get("radiance"), f"{path}.radiance", 0.0, LARGEST_RADIANCE)
         _check_shape(e, path)
     occluders = _list(scene.get("occluders"), "scene.occluders")
     for k, o in enumerate(occluders):
@@ -133,21 +133,12 @@ def _list(value, path):
     return value
 
 
-def _number(value, path, lo, hi):
-    """``value`` as a float in ``[lo, hi]``; a SpecError at ``path`` otherwise
-    (booleans, strings, NaN and infinities included)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not math.isfinite(value) or not lo <= value <= hi:
-        raise SpecError(path, f"expected a number in [{lo:g}, {hi:g}], got {value!r}")
-    return float(value)
-
-
 def _check_shape(item, path):
     """The fields of a rectangle, disk, triangle or sphere: points, a
     radius > 0, a parallelogram or triangle of non-zero area."""
     kind = item["type"]
     if kind in ("disk", "sphere"):
-        _number(item.get("radius"), f"{path}.radius", 1e-300, 1e300)
+        number(item.get("radius"), f"{path}.radius", 1e-300, 1e300)
         vec3(item.get("centre"), f"{path}.centre")
         if kind == "disk":
             unit(vec3(item.get("normal"), f"{path}.normal"), f"{path}.normal")
@@ -261,9 +252,7 @@ def _shape(item, x, path, tmp):
         o = _local(vec3(item.get("origin"), f"{path}.origin"), x)
         eu = SCALE * np.asarray(vec3(item.get("edge_u"), f"{path}.edge_u"))
         ev = SCALE * np.asarray(vec3(item.get("edge_v"), f"{path}.edge_v"))
-        n = np.cross(eu, ev)
-        if not np.linalg.norm(n) > 0:
-            raise SpecError(path, "a rectangle of zero area")
+        n = np.cross(eu, ev)  # non-zero: read_scene checked the area
         # Mitsuba's rectangle is [-1, 1]^2 at z = 0 with normal +z; a third
         # column along edge_u x edge_v keeps that orientation.
         return {"type": "rectangle",
@@ -338,7 +327,6 @@ def reflected_radiance(exp, settings, irradiance):
     """Mitsuba's radiance reflected by the receiver toward the viewer: with
     reflectance 1 viewed along the normal for ``irradiance`` (returned as
     ``E = pi L``), with the Lambertian BRDF's albedo for ``L``."""
-    mi, _ = require_mitsuba()
     require_expressible(exp)
     s = exp.scene
     if irradiance:
@@ -347,9 +335,6 @@ def reflected_radiance(exp, settings, irradiance):
         if s.brdf is None or s.brdf["type"] != "lambert" or s.toward_viewer is None:
             raise AssertionError("unsupported_reason screens these")
         reflectance, view, scale = float(s.brdf["albedo"]), np.asarray(s.toward_viewer), 1.0
-        if not 0.0 <= reflectance <= 1.0:
-            raise SpecError("scene.receiver.brdf.albedo",
-                            f"expected an albedo in [0, 1], got {reflectance}")
         if float(np.dot(view, s.normal)) <= 0.0:
             raise SpecError("scene.receiver.toward_viewer",
                             "the viewer is below the receiver's plane: it sees no reflection")
@@ -361,17 +346,12 @@ def reflected_radiance(exp, settings, irradiance):
         d = _viewer_distance(exp, view, tmp)
         scene = build_scene(exp, tmp, receiver=(reflectance, 0.1 * d),
                             sensor=(d * view, -view, settings.spp))
-        values = np.empty(settings.passes)
-        base = (exp.seed * 1_000_003) % 2 ** 32
-        for k in range(settings.passes):
-            img = np.asarray(mi.render(scene, spp=settings.spp, seed=(base + k) % 2 ** 32),
-                             dtype=np.float64)
-            values[k] = scale * float(np.mean(img[0, 0, :3]))
+        value, std_error = mean_of_renders(scene, settings.passes, settings.spp, exp.seed)
     what = "E = pi L of a white (reflectance 1)" if irradiance else \
         f"L of the Lambertian (albedo {reflectance})"
     return {
-        "value": float(np.mean(values)),
-        "std_error": float(np.std(values, ddof=1) / math.sqrt(values.size)),
+        "value": scale * value,
+        "std_error": scale * std_error,
         "samples": int(settings.passes * settings.spp),
         "method": f"Mitsuba direct integrator (one emitter and one BSDF sample, MIS): {what} "
                   f"receiver disk seen by a 1x1 radiancemeter with a box filter, the scene "

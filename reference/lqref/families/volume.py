@@ -34,7 +34,7 @@ from typing import Optional
 
 import numpy as np
 
-from ..mitsuba3 import point, require_mitsuba, vector
+from ..mitsuba3 import mean_of_renders, point, require_mitsuba, vector
 from ..spec import SpecError, unit, vec3
 
 QUANTITIES = ("tau", "ln_tau", "I_E", "I_B", "I_L", "I")
@@ -506,15 +506,10 @@ def light_single_scattering(exp, settings):
                    "film": film,
                    "sampler": {"type": "independent", "sample_count": settings.spp}},
     })
-    values = np.empty(settings.passes)
-    base = (exp.seed * 1_000_003) % 2 ** 32
-    for k in range(settings.passes):
-        img = np.asarray(mi.render(scene, spp=settings.spp, seed=(base + k) % 2 ** 32),
-                         dtype=np.float64)
-        values[k] = float(np.mean(img[0, 0, :3]))
+    value, std_error = mean_of_renders(scene, settings.passes, settings.spp, exp.seed)
     return {
-        "value": float(np.mean(values)),
-        "std_error": float(np.std(values, ddof=1) / math.sqrt(values.size)),
+        "value": value,
+        "std_error": std_error,
         "samples": int(settings.passes * settings.spp),
         "method": f"Mitsuba volpath, max_depth 2 (single scattering), directional emitter "
                   f"(irradiance = I_p), 1x1 radiancemeter inside the medium at the ray's "
