@@ -11,12 +11,14 @@
 //! | [`scene`] | incident radiance `L_i(x, w)` and visibility `V(x, y)` |
 //! | [`forms`] | R-H and R-A integrands for any rule, over the hemisphere, a BRDF-sampled map, emitter cones and emitter surfaces |
 //! | [`mis`] | multiple importance sampling of light and BRDF samples (balance, power heuristics) |
+//! | [`arcs`] | the exact arcs of a great half-circle of directions that a shape, a cone or a half-space covers (pieces on which visibility is constant) |
 //! | [`cap`] | spherical caps and cones of directions given by `1 - cos theta_max` |
 //! | [`furnace`] | the full equation in a closed scene (an integrating sphere, the white furnace): Neumann series bounce by bounce and path tracing with Russian roulette |
 //! | [`experiment`] | the family of the experiment layer (`"family": "rendering"`): scene format, quantities by form, MIS estimators, closed forms, converged reference |
 //!
 //! Closed forms live in [`crate::exact::rendering`].
 
+pub mod arcs;
 pub mod audit;
 pub mod blocked;
 pub mod brdf;

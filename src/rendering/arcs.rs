@@ -1,0 +1,387 @@
+//! The exact pieces of a great half-circle of directions that a shape, a
+//! cone of directions or a half-space covers, seen from a point: what makes
+//! an integrand with visibility jumps smooth piece by piece.
+//!
+//! A spoke is the half-circle `w(rho) = cos rho a + sin rho b` (`a`, `b`
+//! orthonormal) for `rho` in `[0, reach]`: the directions of a polar map
+//! about `a`. Its full circle lies in the plane through `x` with normal `m =
+//! a x b`, and each outline meets it where that plane does:
+//!
+//! - a convex planar shape (rectangle, triangle, disk): the plane cuts the
+//!   shape's plane in a line and the shape in a segment, found where the
+//!   edges (the rim) change side of the plane; the directions to the
+//!   segment are one arc, shorter than `pi`, between its ends;
+//! - the cone of directions within `beta` of unit `c` (a sphere from
+//!   outside, a cap light, `beta = pi/2` a half-space: the horizon, a lobe's
+//!   clamp): with `gamma` the angle of `c` from the plane (`sin gamma = c .
+//!   m`), the circle comes no nearer `c` than `|gamma|` and no farther than
+//!   `pi - |gamma|`; between, the arc about `c`'s projection has half-width
+//!   `delta`, `cos beta = cos gamma cos delta` (the right spherical
+//!   triangle), taken as `sin^2(delta/2) = sin((beta + gamma)/2) sin((beta
+//!   - gamma)/2) / cos gamma` without cancellation for small angles.
+//!
+//! Every angle is measured from `a` toward `b`, so an arc's ends are exact
+//! to the rounding of the geometry, and pieces are combined as sorted lists
+//! of intervals ([`intersect`], [`subtract`]).
+
+use std::f64::consts::PI;
+
+use crate::domain::{Disk, Vec3};
+use crate::rendering::occluder::Occluder;
+
+/// Sorted, disjoint closed intervals of the angle `rho` along a spoke.
+pub type Pieces = Vec<(f64, f64)>;
+
+/// The great half-circle of unit directions `cos rho a + sin rho b` from
+/// `x`, `rho` in `[0, reach]` (module text).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spoke {
+    /// The apex.
+    pub x: Vec3,
+    /// The direction at `rho = 0` (unit).
+    pub a: Vec3,
+    /// The direction at `rho = pi/2` (unit, orthogonal to `a`).
+    pub b: Vec3,
+    /// The largest `rho`, at most `pi`.
+    pub reach: f64,
+}
+
+impl Spoke {
+    /// The direction at angle `rho` from `a`.
+    pub fn direction(&self, rho: f64) -> Vec3 {
+        self.a * rho.cos() + self.b * rho.sin()
+    }
+
+    /// The whole spoke.
+    pub fn all(&self) -> Pieces {
+        vec![(0.0, self.reach)]
+    }
+
+    /// `m = a x b`, the normal of the spoke's plane.
+    fn normal(&self) -> Vec3 {
+        self.a.cross(&self.b)
+    }
+
+    /// The angle of `w` (in the spoke's plane) from `a` toward `b`, in
+    /// `(-pi, pi]`.
+    fn angle_of(&self, w: Vec3) -> f64 {
+        w.dot(&self.b).atan2(w.dot(&self.a))
+    }
+
+    /// The part in `[0, reach]` of the arc of the full circle from angle
+    /// `start` (in `[-2 pi, 2 pi]`) through `len` (in `[0, 2 pi]`).
+    fn window(&self, start: f64, len: f64) -> Pieces {
+        if len >= 2.0 * PI {
+            return self.all();
+        }
+        let mut out: Pieces = [-4.0 * PI, -2.0 * PI, 0.0, 2.0 * PI, 4.0 * PI]
+            .iter()
+            .map(|shift| {
+                (
+                    (start + shift).max(0.0),
+                    (start + shift + len).min(self.reach),
+                )
+            })
+            .filter(|(lo, hi)| lo < hi)
+            .collect();
+        out.sort_by(|p, q| p.0.total_cmp(&q.0));
+        merge(out)
+    }
+
+    /// The directions within angle `beta` (in `[0, pi]`) of unit `c`
+    /// (module text).
+    pub fn cone(&self, c: Vec3, beta: f64) -> Pieces {
+        let g = c.dot(&self.normal()).abs().min(1.0).asin();
+        if beta <= g {
+            return Vec::new();
+        }
+        if beta >= PI - g {
+            return self.all();
+        }
+        let ratio = ((beta + g) / 2.0).sin() * ((beta - g) / 2.0).sin() / g.cos();
+        let delta = 2.0 * ratio.clamp(0.0, 1.0).sqrt().asin();
+        let psi = self.angle_of(c);
+        self.window(psi - delta, 2.0 * delta)
+    }
+
+    /// The directions on the side of the plane through `x` that unit `n`
+    /// points to: `w . n >= 0`.
+    pub fn half_space(&self, n: Vec3) -> Pieces {
+        self.cone(n, PI / 2.0)
+    }
+
+    /// The directions from `x` that meet the occluder shape `o`.
+    pub fn shape(&self, o: &Occluder) -> Pieces {
+        match o {
+            Occluder::Sphere(s) => {
+                let to = s.centre - self.x;
+                let d = to.norm();
+                if d <= s.radius {
+                    self.all()
+                } else {
+                    self.cone(to / d, (s.radius / d).min(1.0).asin())
+                }
+            }
+            Occluder::Disk(d) => self.disk(d),
+            Occluder::Rectangle(r) => {
+                let (o, e1, e2) = (r.origin(), r.edge_u(), r.edge_v());
+                self.polygon(&[o, o + e1, o + e1 + e2, o + e2], r.normal())
+            }
+            Occluder::Triangle(t) => self.polygon(&t.vertices(), t.normal()),
+        }
+    }
+
+    /// True when `x` lies in the plane through `p` with unit normal `n`
+    /// (to rounding): the shape is seen edge on and covers no solid angle.
+    fn edge_on(&self, p: Vec3, n: Vec3, size: f64) -> bool {
+        n.dot(&(p - self.x)).abs() <= 1e-14 * ((p - self.x).norm() + size)
+    }
+
+    /// The directions to a convex planar polygon (vertices in order, unit
+    /// normal `n`): the segment where the spoke's plane cuts it, through the
+    /// points where its edges change side.
+    fn polygon(&self, vertices: &[Vec3], n: Vec3) -> Pieces {
+        let size = vertices
+            .iter()
+            .fold(0.0_f64, |m, v| m.max((v - vertices[0]).norm()));
+        if self.edge_on(vertices[0], n, size) {
+            return Vec::new();
+        }
+        let m = self.normal();
+        let side: Vec<f64> = vertices.iter().map(|v| m.dot(&(v - self.x))).collect();
+        let mut points = Vec::with_capacity(4);
+        for i in 0..vertices.len() {
+            let j = (i + 1) % vertices.len();
+            if side[i] == 0.0 {
+                points.push(vertices[i]);
+            }
+            if side[i] * side[j] < 0.0 {
+                let t = side[i] / (side[i] - side[j]);
+                points.push(vertices[i] + (vertices[j] - vertices[i]) * t);
+            }
+        }
+        self.segment(&points)
+    }
+
+    /// The directions to a disk: the chord between the two rim points
+    /// `c + R (cos t s + sin t t)` in the spoke's plane, `m . (c - x) + R
+    /// k cos(t - tau) = 0`.
+    fn disk(&self, d: &Disk) -> Pieces {
+        let (c, f, r) = (d.centre(), d.frame(), d.radius());
+        if self.edge_on(c, f.n, r) {
+            return Vec::new();
+        }
+        let m = self.normal();
+        let offset = m.dot(&(c - self.x));
+        let (p, q) = (m.dot(&f.s), m.dot(&f.t));
+        let k = p.hypot(q) * r;
+        if k <= offset.abs() {
+            return Vec::new();
+        }
+        let tau = q.atan2(p);
+        let h = (-offset / k).acos();
+        let rim = |t: f64| c + (f.s * t.cos() + f.t * t.sin()) * r;
+        self.segment(&[rim(tau - h), rim(tau + h)])
+    }
+
+    /// The arc of directions from `x` to the segment spanned by `points`
+    /// (on a line in the spoke's plane not through `x`): from the smallest
+    /// to the largest angle relative to the first point.
+    fn segment(&self, points: &[Vec3]) -> Pieces {
+        let Some(first) = points.first() else {
+            return Vec::new();
+        };
+        let m = self.normal();
+        let w0 = first - self.x;
+        let (mut lo, mut hi) = (0.0_f64, 0.0_f64);
+        for p in &points[1..] {
+            let w = p - self.x;
+            let rel = w0.cross(&w).dot(&m).atan2(w0.dot(&w));
+            lo = lo.min(rel);
+            hi = hi.max(rel);
+        }
+        if hi <= lo {
+            return Vec::new();
+        }
+        self.window(self.angle_of(w0) + lo, hi - lo)
+    }
+}
+
+/// Sorted intervals with overlapping or touching ones joined.
+fn merge(sorted: Pieces) -> Pieces {
+    let mut out: Pieces = Vec::with_capacity(sorted.len());
+    for (lo, hi) in sorted {
+        match out.last_mut() {
+            Some(last) if lo <= last.1 => last.1 = last.1.max(hi),
+            _ => out.push((lo, hi)),
+        }
+    }
+    out
+}
+
+/// The intervals in both `a` and `b` (each sorted and disjoint).
+pub fn intersect(a: &[(f64, f64)], b: &[(f64, f64)]) -> Pieces {
+    let mut out = Vec::new();
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        let lo = a[i].0.max(b[j].0);
+        let hi = a[i].1.min(b[j].1);
+        if lo < hi {
+            out.push((lo, hi));
+        }
+        if a[i].1 < b[j].1 {
+            i += 1;
+        } else {
+            j += 1;
+        }
+    }
+    out
+}
+
+/// The intervals of `a` outside `b` (each sorted and disjoint).
+pub fn subtract(a: &[(f64, f64)], b: &[(f64, f64)]) -> Pieces {
+    let mut out = Vec::new();
+    for &(lo, hi) in a {
+        let mut start = lo;
+        for &(blo, bhi) in b {
+            if bhi <= start || blo >= hi {
+                continue;
+            }
+            if blo > start {
+                out.push((start, blo));
+            }
+            start = start.max(bhi);
+        }
+        if start < hi {
+            out.push((start, hi));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::QuadError;
+
+    /// A spoke about `a` at azimuth `phi` in the frame of `a`.
+    fn spoke(a: Vec3, phi: f64, reach: f64) -> Result<Spoke, QuadError> {
+        let f = crate::domain::Frame::from_normal(a)?;
+        Ok(Spoke {
+            x: Vec3::new(0.3, -0.2, 0.1),
+            a: f.n,
+            b: f.s * phi.cos() + f.t * phi.sin(),
+            reach,
+        })
+    }
+
+    /// Whether `rho` lies in `pieces`, more than `margin` from their ends
+    /// (`Some`) or too near an end to say (`None`).
+    fn inside(pieces: &Pieces, rho: f64, margin: f64) -> Option<bool> {
+        if pieces
+            .iter()
+            .any(|&(lo, hi)| (rho - lo).abs() < margin || (rho - hi).abs() < margin)
+        {
+            return None;
+        }
+        Some(pieces.iter().any(|&(lo, hi)| lo < rho && rho < hi))
+    }
+
+    /// Every shape's pieces agree with its own ray test at 2000 angles of
+    /// 40 spokes each, away from the pieces' ends: the exact arcs are the
+    /// directions the ray intersection routines say meet the shape.
+    #[test]
+    fn pieces_are_the_directions_that_meet_the_shape() -> Result<(), QuadError> {
+        let shapes = [
+            Occluder::sphere(Vec3::new(1.0, 0.5, 2.0), 0.7)?,
+            Occluder::disk(Vec3::new(0.5, 0.0, 1.5), Vec3::new(0.3, 0.1, -1.0), 0.9)?,
+            Occluder::rectangle(
+                Vec3::new(-0.5, -0.4, 1.0),
+                Vec3::new(1.2, 0.3, 0.2),
+                Vec3::new(-0.1, 0.9, 0.4),
+            )?,
+            Occluder::triangle(
+                Vec3::new(-1.0, 0.0, 0.5),
+                Vec3::new(1.5, 0.2, 0.8),
+                Vec3::new(0.1, 1.3, 1.9),
+            )?,
+        ];
+        let mut seen = 0;
+        for o in &shapes {
+            let (centre, _) = o.bounding_sphere();
+            let x = Vec3::new(0.3, -0.2, 0.1);
+            let a = (centre - x).normalize();
+            for s in 0..40 {
+                let sp = spoke(a, s as f64 * 0.157 + 0.01, PI)?;
+                let pieces = sp.shape(o);
+                for i in 0..2000 {
+                    let rho = PI * (i as f64 + 0.5) / 2000.0;
+                    let hit = o
+                        .intersect(x, sp.direction(rho), 0.0, f64::INFINITY)
+                        .is_some();
+                    if let Some(expected) = inside(&pieces, rho, 1e-9) {
+                        assert_eq!(expected, hit, "{o:?} spoke {s} rho {rho}: {pieces:?}");
+                        seen += usize::from(hit);
+                    }
+                }
+            }
+        }
+        assert!(seen > 10_000, "only {seen} hits");
+        Ok(())
+    }
+
+    /// A cone's pieces agree with the angle test, for cones narrow, wide,
+    /// past a right angle and tiny, and the half-space with `w . n >= 0`.
+    #[test]
+    fn cone_pieces_are_the_directions_within_the_angle() -> Result<(), QuadError> {
+        let c = Vec3::new(0.2, -0.7, 0.4).normalize();
+        for beta in [1e-6, 0.3, 1.2, PI / 2.0, 2.5] {
+            for s in 0..60 {
+                let a = Vec3::new(0.1, -0.5, 0.6).normalize();
+                let sp = spoke(a, s as f64 * 0.105, 2.9)?;
+                let pieces = sp.cone(c, beta);
+                for i in 0..5000 {
+                    let rho = 2.9 * (i as f64 + 0.5) / 5000.0;
+                    let angle = sp.direction(rho).dot(&c).clamp(-1.0, 1.0).acos();
+                    if let Some(expected) = inside(&pieces, rho, 1e-9) {
+                        if (angle - beta).abs() > 1e-9 {
+                            assert_eq!(expected, angle < beta, "beta {beta} spoke {s} rho {rho}");
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A spoke through the middle of a tiny cone meets it over its whole
+    /// width `2 beta`, to the rounding of the angles (1e-16 absolute).
+    #[test]
+    fn a_tiny_cone_has_its_width() -> Result<(), QuadError> {
+        let c = Vec3::new(0.0, 0.6, 0.8);
+        let beta = 1e-9;
+        let sp = Spoke {
+            x: Vec3::zeros(),
+            a: Vec3::z(),
+            b: Vec3::y(),
+            reach: PI,
+        };
+        let pieces = sp.cone(c, beta);
+        assert_eq!(pieces.len(), 1);
+        let (lo, hi) = pieces[0];
+        assert!((hi - lo - 2.0 * beta).abs() < 1e-15, "{pieces:?}");
+        assert!(((lo + hi) / 2.0 - 0.6_f64.atan2(0.8)).abs() < 1e-15);
+        Ok(())
+    }
+
+    #[test]
+    fn intersect_and_subtract_are_set_operations() {
+        let a = vec![(0.0, 1.0), (2.0, 3.0)];
+        let b = vec![(0.5, 2.5)];
+        assert_eq!(intersect(&a, &b), vec![(0.5, 1.0), (2.0, 2.5)]);
+        assert_eq!(subtract(&a, &b), vec![(0.0, 0.5), (2.5, 3.0)]);
+        assert_eq!(subtract(&b, &a), vec![(1.0, 2.0)]);
+        assert_eq!(subtract(&a, &[]), a);
+        assert!(intersect(&a, &[]).is_empty());
+    }
+}
