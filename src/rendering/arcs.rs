@@ -17,8 +17,9 @@
 //!   m`), the circle comes no nearer `c` than `|gamma|` and no farther than
 //!   `pi - |gamma|`; between, the arc about `c`'s projection has half-width
 //!   `delta`, `cos beta = cos gamma cos delta` (the right spherical
-//!   triangle), taken as `sin^2(delta/2) = sin((beta + gamma)/2) sin((beta
-//!   - gamma)/2) / cos gamma` without cancellation for small angles.
+//!   triangle), taken without cancellation for small angles as
+//!   `sin^2(delta/2) = sin((beta + gamma)/2) sin((beta - gamma)/2) / cos
+//!   gamma`.
 //!
 //! Every angle is measured from `a` toward `b`, so an arc's ends are exact
 //! to the rounding of the geometry, and pieces are combined as sorted lists
@@ -26,7 +27,7 @@
 
 use std::f64::consts::PI;
 
-use crate::domain::{Disk, Vec3};
+use crate::domain::{Disk, Frame, Vec3};
 use crate::rendering::occluder::Occluder;
 
 /// Sorted, disjoint closed intervals of the angle `rho` along a spoke.
@@ -207,6 +208,90 @@ impl Spoke {
     }
 }
 
+/// The spokes about a unit axis: the polar map `w(rho, phi) = cos rho a +
+/// sin rho (cos phi s + sin phi t)` of the directions from `x` out to
+/// `reach`, with the frame `(s, t, a)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fan {
+    /// The apex.
+    pub x: Vec3,
+    /// `s`, `t` and the axis `a` as `n`.
+    pub frame: Frame,
+    /// The largest `rho`, at most `pi`.
+    pub reach: f64,
+}
+
+impl Fan {
+    /// The spoke at azimuth `phi`.
+    pub fn spoke(&self, phi: f64) -> Spoke {
+        let f = self.frame;
+        Spoke {
+            x: self.x,
+            a: f.n,
+            b: f.s * phi.cos() + f.t * phi.sin(),
+            reach: self.reach,
+        }
+    }
+
+    /// The azimuths in `[0, 2 pi)` where a spoke's pieces of the shape `o`
+    /// change how they vary: the corners of a polygon (where an edge lies in
+    /// a plane through the axis, the pieces jump there), the spokes tangent
+    /// to a sphere's cone. Elsewhere they vary smoothly, but for tangents to
+    /// a disk's rim, which bisection finds.
+    pub fn breaks(&self, o: &Occluder) -> Vec<f64> {
+        match o {
+            Occluder::Sphere(s) => {
+                let to = s.centre - self.x;
+                let d = to.norm();
+                if d <= s.radius {
+                    return Vec::new();
+                }
+                self.cone_breaks(to / d, (s.radius / d).min(1.0).asin())
+            }
+            Occluder::Disk(_) => Vec::new(),
+            Occluder::Rectangle(r) => {
+                let (o, e1, e2) = (r.origin(), r.edge_u(), r.edge_v());
+                self.azimuths(&[o, o + e1, o + e1 + e2, o + e2])
+            }
+            Occluder::Triangle(t) => self.azimuths(&t.vertices()),
+        }
+    }
+
+    /// The azimuths of the points `p` (seen from `x`), those on the axis
+    /// left out.
+    fn azimuths(&self, points: &[Vec3]) -> Vec<f64> {
+        points
+            .iter()
+            .filter_map(|p| {
+                let w = p - self.x;
+                let (u, v) = (w.dot(&self.frame.s), w.dot(&self.frame.t));
+                (u != 0.0 || v != 0.0).then(|| v.atan2(u).rem_euclid(2.0 * PI))
+            })
+            .collect()
+    }
+
+    /// The azimuths of the spokes whose great circles are tangent to the
+    /// cone of half-angle `beta` about unit `c` (`|c . m| = sin beta` with
+    /// `c . m(phi) = K cos(phi - tau)`, `K = |c x a|`), and `tau`, `tau +
+    /// pi` (where a half-space's plane holds the axis, its boundary is the
+    /// spoke there and the pieces jump).
+    pub fn cone_breaks(&self, c: Vec3, beta: f64) -> Vec<f64> {
+        let q = c.cross(&self.frame.n);
+        let k = q.norm();
+        if k == 0.0 {
+            return Vec::new();
+        }
+        let tau = q.dot(&self.frame.t).atan2(q.dot(&self.frame.s));
+        let mut out = vec![tau, tau + PI];
+        let sb = beta.sin();
+        if sb < k {
+            let h = (sb / k).acos();
+            out.extend([tau + h, tau - h, tau + PI + h, tau + PI - h]);
+        }
+        out.into_iter().map(|p| p.rem_euclid(2.0 * PI)).collect()
+    }
+}
+
 /// Sorted intervals with overlapping or touching ones joined.
 fn merge(sorted: Pieces) -> Pieces {
     let mut out: Pieces = Vec::with_capacity(sorted.len());
@@ -343,10 +428,10 @@ mod tests {
                 for i in 0..5000 {
                     let rho = 2.9 * (i as f64 + 0.5) / 5000.0;
                     let angle = sp.direction(rho).dot(&c).clamp(-1.0, 1.0).acos();
-                    if let Some(expected) = inside(&pieces, rho, 1e-9) {
-                        if (angle - beta).abs() > 1e-9 {
-                            assert_eq!(expected, angle < beta, "beta {beta} spoke {s} rho {rho}");
-                        }
+                    if let Some(expected) = inside(&pieces, rho, 1e-9)
+                        && (angle - beta).abs() > 1e-9
+                    {
+                        assert_eq!(expected, angle < beta, "beta {beta} spoke {s} rho {rho}");
                     }
                 }
             }

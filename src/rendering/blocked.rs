@@ -22,12 +22,34 @@
 //! blocker's bounding cone instead, Genz–Malik converged to 0.0750 for a
 //! triangle hiding 0.0795 of a sky: its corners, in boxes whose nodes all
 //! missed them, were lost.)
+//!
+//! Where every blocker stands wholly in front of the light or wholly
+//! behind it ([`crate::rendering::order`]), the hidden part is integrated
+//! between exact outlines instead ([`hidden_by_arcs`]): in polar directions
+//! about each blocker, every spoke is cut where the blocker's, the light's,
+//! the horizon's, the lobe clamp's and the earlier blockers' outlines cross
+//! it ([`crate::rendering::arcs`]), so no piece holds a jump and no
+//! visibility test is made. Checked against an independent contour
+//! integral (Stokes on the sphere of directions, tests/rendering_contour.rs)
+//! to 3e-12: a sphere light hiding part of a rectangle light, where the
+//! evaluation over the blocker's cone with a visibility test was 7.3e-5
+//! off while its change between budgets said 5.6e-8.
 
-use crate::domain::Vec3;
+use std::cell::Cell;
+use std::f64::consts::PI;
+
+use crate::domain::{Frame, Vec3};
 use crate::error::QuadError;
+use crate::estimate::Estimate;
+use crate::quadrature::Rule;
+use crate::quadrature::gauss_kronrod::GaussKronrod;
+use crate::quadrature::product::WithError;
+use crate::rendering::arcs::{self, Fan, Pieces, Spoke};
+use crate::rendering::cap::Cap;
 use crate::rendering::emitter::{AnyEmitter, Emitter, LightDomain, bounding_cone};
 use crate::rendering::forms::{Kernel, emitter_at};
 use crate::rendering::occluder::Occluder;
+use crate::rendering::order;
 use crate::rendering::receiver::Receiver;
 use crate::rendering::scene::Scene;
 
@@ -240,4 +262,295 @@ pub fn hidden_along<'a, K: Kernel>(
 ) -> Result<impl Fn(Vec3) -> f64 + 'a, QuadError> {
     let h = Hidden::new(scene, receiver, kernel, k, j)?;
     Ok(move |w: Vec3| h.direction(w))
+}
+
+/// The directions of an emitter's light from `x`, as [`Spoke`] pieces take
+/// them.
+#[derive(Debug, Clone, Copy)]
+enum Seen {
+    /// Every direction (the environment).
+    All,
+    /// The directions within an angle of a unit axis (a cap light).
+    Cone(Vec3, f64),
+    /// The directions that meet a shape (a sphere light from outside, a
+    /// planar light from its emitting side).
+    Shape(Occluder),
+    /// None: `x` behind a planar light or in its plane.
+    Dark,
+}
+
+impl Seen {
+    /// What `e` covers from `x`; `None` for `x` inside a sphere light.
+    fn of(e: &AnyEmitter<f64>, x: Vec3) -> Option<Seen> {
+        Some(match e {
+            AnyEmitter::Environment(_) => Seen::All,
+            AnyEmitter::Cap(c) => Seen::Cone(c.cap().axis(), half_angle(c.cap().one_minus_cos())),
+            AnyEmitter::Sphere(s) => {
+                let shape = s.shape();
+                if (shape.centre - x).norm() <= shape.radius {
+                    return None;
+                }
+                Seen::Shape(Occluder::Sphere(*shape))
+            }
+            AnyEmitter::Rectangle(_) | AnyEmitter::Triangle(_) | AnyEmitter::Disk(_) => {
+                let shape = e.occluder()?;
+                let (p, _) = shape.bounding_sphere();
+                if e.normal_at(p).dot(&(x - p)) > 0.0 {
+                    Seen::Shape(shape)
+                } else {
+                    Seen::Dark
+                }
+            }
+        })
+    }
+
+    fn pieces(&self, spoke: &Spoke) -> Pieces {
+        match self {
+            Seen::All => spoke.all(),
+            Seen::Cone(c, beta) => spoke.cone(*c, *beta),
+            Seen::Shape(o) => spoke.shape(o),
+            Seen::Dark => Vec::new(),
+        }
+    }
+
+    fn breaks(&self, fan: &Fan) -> Vec<f64> {
+        match self {
+            Seen::Cone(c, beta) => fan.cone_breaks(*c, *beta),
+            Seen::Shape(o) => fan.breaks(o),
+            Seen::All | Seen::Dark => Vec::new(),
+        }
+    }
+}
+
+/// The half-angle `2 asin(sqrt(k/2))` of a cone with `1 - cos = k`.
+fn half_angle(one_minus_cos: f64) -> f64 {
+    2.0 * (one_minus_cos / 2.0).sqrt().min(1.0).asin()
+}
+
+/// Budgets of [`hidden_by_arcs`] per blocker: Gauss–Kronrod over the
+/// azimuth between its breaks (bisecting at each kink left, where an
+/// outline enters or leaves the spokes) and along each piece of a spoke
+/// (smooth: 15 to 45 evaluations but for a peaked lobe).
+const AZIMUTH_BUDGET: usize = 60_015;
+const PIECE_BUDGET: usize = 3_015;
+
+/// What the blockers hide of emitter `k`, integrated piece by piece where
+/// the integrand is smooth: `sum_j int_0^(2 pi) int_(I_j(phi)) K(w) cos
+/// theta L_k sin rho d rho d phi` in polar directions `w(rho, phi)` about
+/// the direction to blocker `j`'s bounding sphere ([`Fan`]), `I_j(phi)` the
+/// exact arcs ([`arcs`]) of the spoke at azimuth `phi` that meet `j` and
+/// the light, lie above the horizon (and inside the lobe's clamp,
+/// [`Kernel::clamp`]), and meet no blocker `i < j`: every hidden direction
+/// counted once. On them `L_k` is the light's uniform radiance: no ray is
+/// cast, and no outline cuts a piece. The azimuth is split where the
+/// pieces can jump or kink ([`Fan::breaks`]). Nested adaptive
+/// Gauss–Kronrod; the error is the outer estimates plus the pieces'
+/// integrated with the value.
+///
+/// This holds where every blocker is wholly in front of the light or
+/// wholly behind it along the rays that meet both ([`order`]), so that a
+/// direction is hidden exactly when it meets a blocker in front. `Ok(None)`
+/// where that is not known (a blocker straddling a planar light's plane,
+/// one interpenetrating a sphere light) or `x` is inside a sphere light:
+/// the caller falls back on [`hidden`].
+pub fn hidden_by_arcs<K: Kernel>(
+    scene: &Scene<f64>,
+    receiver: &Receiver,
+    kernel: &K,
+    k: usize,
+) -> Result<Option<Estimate<f64>>, QuadError> {
+    let emitter = emitter_at(scene, k)?;
+    let x = receiver.point();
+    let zero = Ok(Some(Estimate::deterministic(0.0, 0.0, 0)));
+    let light = match Seen::of(emitter, x) {
+        None => return Ok(None),
+        Some(Seen::Dark) => return zero,
+        Some(seen) => seen,
+    };
+    // The blockers in front of the light where both are seen.
+    let mut front = Vec::new();
+    for o in blockers(scene, k) {
+        let Some(body) = emitter.occluder() else {
+            front.push(o);
+            continue;
+        };
+        match order::first(&o, &body, x) {
+            Some(true) => front.push(o),
+            Some(false) => {}
+            None if order::apart(&o, &body, x) => {}
+            None => return Ok(None),
+        }
+    }
+    let mut total = Estimate::zero();
+    for (j, blocker) in front.iter().enumerate() {
+        let part = hidden_by(receiver, kernel, emitter, &light, blocker, &front[..j])?;
+        total = total.combine(part);
+    }
+    Ok(Some(total))
+}
+
+/// [`hidden_by_arcs`]' term of `blocker`, less the directions of `before`.
+fn hidden_by<K: Kernel>(
+    receiver: &Receiver,
+    kernel: &K,
+    emitter: &AnyEmitter<f64>,
+    light: &Seen,
+    blocker: &Occluder,
+    before: &[Occluder],
+) -> Result<Estimate<f64>, QuadError> {
+    let x = receiver.point();
+    let (centre, radius) = blocker.bounding_sphere();
+    let to = centre - x;
+    let d = to.norm();
+    let axis = if d > 0.0 { to / d } else { receiver.normal() };
+    let reach = if d > radius {
+        (radius / d).min(1.0).asin()
+    } else {
+        PI
+    };
+    let fan = Fan {
+        x,
+        frame: Frame::from_normal(axis)?,
+        reach,
+    };
+    let mut breaks = fan.breaks(blocker);
+    for o in before {
+        breaks.extend(fan.breaks(o));
+    }
+    let on = |sp: &Spoke| -> Pieces {
+        let mut set = sp.shape(blocker);
+        for o in before {
+            set = arcs::subtract(&set, &sp.shape(o));
+        }
+        set
+    };
+    over_fan(receiver, kernel, emitter, light, &fan, breaks, on)
+}
+
+/// An emitter's light with nothing in the way over its exact cone of
+/// directions `cone` (a sphere's, a cap light's, the environment's
+/// hemisphere, a disk's from its axis), `int K(w) cos theta L d w` above the
+/// horizon (and inside the lobe's clamp), by [`over_fan`] about the cone's
+/// axis out to its half-angle: exact pieces, where a rule over the cone
+/// ends at one box for a flat kernel (the integrand is a low polynomial in
+/// the cone's map) and cannot vouch for it.
+pub fn over_cone<K: Kernel>(
+    receiver: &Receiver,
+    kernel: &K,
+    emitter: &AnyEmitter<f64>,
+    cone: &Cap,
+) -> Result<Estimate<f64>, QuadError> {
+    let fan = Fan {
+        x: receiver.point(),
+        frame: Frame::from_normal(cone.axis())?,
+        reach: half_angle(cone.one_minus_cos()),
+    };
+    over_fan(
+        receiver,
+        kernel,
+        emitter,
+        &Seen::All,
+        &fan,
+        Vec::new(),
+        |sp: &Spoke| sp.all(),
+    )
+}
+
+/// `int_0^(2 pi) int_(I(phi)) K(w) cos theta L sin rho d rho d phi` over
+/// `fan`, `I(phi)` the pieces `on` gives of the spoke at `phi` met with the
+/// light's, the horizon's and the lobe clamp's; the azimuth split at
+/// `breaks` and wherever those outlines make the pieces jump or kink.
+fn over_fan<K: Kernel>(
+    receiver: &Receiver,
+    kernel: &K,
+    emitter: &AnyEmitter<f64>,
+    light: &Seen,
+    fan: &Fan,
+    mut breaks: Vec<f64>,
+    on: impl Fn(&Spoke) -> Pieces,
+) -> Result<Estimate<f64>, QuadError> {
+    let (normal, clamp, radiance) = (receiver.normal(), kernel.clamp(), emitter.radiance());
+    let on = |sp: &Spoke| -> Pieces {
+        let mut set = arcs::intersect(&on(sp), &sp.half_space(normal));
+        set = arcs::intersect(&set, &light.pieces(sp));
+        if let Some(r) = clamp {
+            set = arcs::intersect(&set, &sp.half_space(r));
+        }
+        set
+    };
+    // The azimuths where the pieces jump or kink, as the ends of panels.
+    breaks.extend(light.breaks(fan));
+    breaks.extend(fan.cone_breaks(normal, PI / 2.0));
+    if let Some(r) = clamp {
+        breaks.extend(fan.cone_breaks(r, PI / 2.0));
+    }
+    breaks.push(0.0);
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup();
+    breaks.push(2.0 * PI);
+    let panels: Vec<(f64, f64)> = breaks
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .filter(|(a, b)| b > a)
+        .collect();
+    let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
+    let mut inner_rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(1);
+    let (evaluations, reliable) = (Cell::new(0_u64), Cell::new(true));
+    let along = GaussKronrod {
+        abs_tol: 0.0,
+        rel_tol: 2e-14,
+    };
+    // g(phi) on a panel, with the pieces' error estimates.
+    let mut g = |lo: f64, hi: f64, u: f64| -> Result<WithError<f64>, QuadError> {
+        let sp = fan.spoke(lo + (hi - lo) * u);
+        let (mut value, mut error) = (0.0, 0.0);
+        for (a, b) in on(&sp) {
+            let piece = along.try_integrate::<1, f64, _, _>(PIECE_BUDGET, &mut inner_rng, |v| {
+                let rho = a + (b - a) * v[0];
+                let w = sp.direction(rho);
+                let cos = receiver.cos_theta(w);
+                Ok(if cos > 0.0 {
+                    kernel.weight(w) * cos * radiance * rho.sin() * (b - a)
+                } else {
+                    0.0
+                })
+            })?;
+            evaluations.set(evaluations.get() + piece.evaluations);
+            reliable.set(reliable.get() && piece.reliable);
+            value += piece.value * (hi - lo);
+            error += piece.error * (hi - lo);
+        }
+        Ok(WithError { value, error })
+    };
+    // A pilot of one Kronrod panel each sets the absolute tolerance, so that
+    // a panel where nothing is seen stops at once.
+    let pilot = GaussKronrod::default();
+    let mut scale = 0.0;
+    for &(lo, hi) in &panels {
+        let p =
+            pilot.try_integrate::<1, WithError<f64>, _, _>(15, &mut rng, |u| g(lo, hi, u[0]))?;
+        scale += p.value.value.abs();
+    }
+    let around = GaussKronrod {
+        abs_tol: 1e-15 * scale / panels.len() as f64,
+        rel_tol: 1e-13,
+    };
+    let per = (AZIMUTH_BUDGET / panels.len()).max(1_515);
+    let mut total = Estimate::zero();
+    for &(lo, hi) in &panels {
+        let p =
+            around.try_integrate::<1, WithError<f64>, _, _>(per, &mut rng, |u| g(lo, hi, u[0]))?;
+        total = total.combine(Estimate {
+            value: p.value.value,
+            error: p.error.value + p.value.error.abs(),
+            evaluations: 0,
+            kind: p.kind,
+            reliable: p.reliable,
+        });
+    }
+    Ok(Estimate {
+        evaluations: evaluations.get(),
+        reliable: total.reliable && reliable.get(),
+        ..total
+    })
 }

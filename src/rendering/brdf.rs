@@ -98,6 +98,15 @@ pub trait Brdf {
     /// reaches `wi` (`pdf(wo, wi) > 0`, below the horizon included), else
     /// `None`.
     fn invert(&self, wo: Vec3, wi: Vec3) -> Option<[f64; 2]>;
+
+    /// The unit normal (shading frame) of the plane through the origin
+    /// beyond which the lobe for `wo` is clamped to zero with a kink, where
+    /// it has one inside the hemisphere: Phong's `max(0, cos alpha)` about
+    /// the mirror direction. An integration that splits there sees a
+    /// smooth integrand on each side.
+    fn clamp(&self, _wo: Vec3) -> Option<Vec3> {
+        None
+    }
 }
 
 /// True for a finite vector of unit length within [`UNIT_TOL`].
@@ -358,6 +367,11 @@ impl Brdf for Phong {
     fn invert(&self, wo: Vec3, wi: Vec3) -> Option<[f64; 2]> {
         self.lobe.invert(wo, wi)
     }
+
+    /// The plane normal to the mirror direction `(-x_o, -y_o, z_o)`.
+    fn clamp(&self, wo: Vec3) -> Option<Vec3> {
+        Some(Vec3::new(-wo.x, -wo.y, wo.z))
+    }
 }
 
 /// The energy-normalised Phong lobe: `f = k_s (n+2)/(2 pi) max(0, cos
@@ -416,6 +430,11 @@ impl Brdf for NormalizedPhong {
 
     fn invert(&self, wo: Vec3, wi: Vec3) -> Option<[f64; 2]> {
         self.lobe.invert(wo, wi)
+    }
+
+    /// The plane normal to the mirror direction `(-x_o, -y_o, z_o)`.
+    fn clamp(&self, wo: Vec3) -> Option<Vec3> {
+        Some(Vec3::new(-wo.x, -wo.y, wo.z))
     }
 }
 

@@ -496,6 +496,9 @@ impl Brdf for AnyBrdf {
     fn invert(&self, wo: Vec3, wi: Vec3) -> Option<[f64; 2]> {
         forward_brdf!(self, b => b.invert(wo, wi))
     }
+    fn clamp(&self, wo: Vec3) -> Option<Vec3> {
+        forward_brdf!(self, b => b.clamp(wo))
+    }
 }
 
 impl Reach for AnyBrdf {
@@ -1059,7 +1062,11 @@ fn converged_by_emitter<K: Kernel>(
                 None => by_lobe(lobe, &mut rng)?,
             },
             _ => {
-                let own = if exact_cone(e, receiver) {
+                let own = if exact_cone(e, receiver) && lobe.is_none() {
+                    // A flat kernel over an exact cone: exact pieces (a rule
+                    // over the cone ends at one box and cannot vouch for it).
+                    blocked::over_cone(receiver, kernel, e, &e.cone(receiver)?)?
+                } else if exact_cone(e, receiver) {
                     integrate_over(&rule, &e.cone(receiver)?, budget, &mut rng, along())?
                 } else if let Some(lit) = &lit {
                     // Split at the shadow boundaries: smooth on every piece.
@@ -1088,8 +1095,18 @@ fn converged_by_emitter<K: Kernel>(
             }
         };
         let part = if split {
-            let mut hidden = Estimate::zero();
-            for (j, o) in blocked::blockers(scene, k).iter().enumerate() {
+            // Where each blocker is wholly in front of the light or behind
+            // it, piece by piece between the exact outlines; else over each
+            // blocker's domain with a visibility test, trusted only where
+            // nothing cuts it.
+            let exact = blocked::hidden_by_arcs(scene, receiver, kernel, k)?;
+            let mut hidden = exact.unwrap_or_else(Estimate::zero);
+            let fallback = if exact.is_some() {
+                Vec::new()
+            } else {
+                blocked::blockers(scene, k)
+            };
+            for (j, o) in fallback.iter().enumerate() {
                 let h = blocked::hidden(scene, receiver, kernel, k, j)?;
                 let domain = blocked::domain(o, receiver.point())?;
                 let own = integrate_over(&rule, &domain, budget, &mut rng, &h)?;

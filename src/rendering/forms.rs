@@ -78,6 +78,13 @@ use crate::value::Value;
 pub trait Kernel {
     /// The weight of the unit world direction `wi`.
     fn weight(&self, wi: Vec3) -> f64;
+
+    /// The unit world normal of the plane through the receiver beyond which
+    /// the weight is clamped to zero with a kink ([`Brdf::clamp`]); `None`
+    /// where the weight has no such clamp.
+    fn clamp(&self) -> Option<Vec3> {
+        None
+    }
 }
 
 /// The kernel of irradiance, `E = int L_i cos theta d w`: weight 1.
@@ -142,6 +149,10 @@ impl<B: Brdf> Kernel for Reflected<'_, B> {
     /// `f_r(wi, wo)` (R-H).
     fn weight(&self, wi: Vec3) -> f64 {
         self.brdf.eval(self.frame.to_local(wi), self.wo)
+    }
+
+    fn clamp(&self) -> Option<Vec3> {
+        self.brdf.clamp(self.wo).map(|r| self.frame.to_world(r))
     }
 }
 

@@ -7,6 +7,7 @@
 //! | [`brdf`] | `f_r` with sampling, pdf and inverse (Lambert, Phong, normalised Phong, GGX) |
 //! | [`emitter`] | Lambertian rectangle, disk, triangle and sphere lights, a uniform environment, a cap light; ray hits, surface maps, light sampling |
 //! | [`occluder`] | opaque spheres, disks, rectangles, triangles and their ray intersection |
+//! | [`order`] | which of two shapes every ray from a point meets first, where that holds for all rays |
 //! | [`receiver`] | the point `x` with its normal where `E` and `L_r` are evaluated |
 //! | [`scene`] | incident radiance `L_i(x, w)` and visibility `V(x, y)` |
 //! | [`forms`] | R-H and R-A integrands for any rule, over the hemisphere, a BRDF-sampled map, emitter cones and emitter surfaces |
@@ -31,5 +32,6 @@ pub mod forms;
 pub mod furnace;
 pub mod mis;
 pub mod occluder;
+pub mod order;
 pub mod receiver;
 pub mod scene;
