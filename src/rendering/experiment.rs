@@ -111,6 +111,7 @@ use super::emitter::{
 use super::forms::{self, BrdfSampled, Irradiance, Kernel, Reach, Reflected};
 use super::mis::{Heuristic, mis};
 use super::occluder::Occluder;
+use super::order;
 use super::receiver::Receiver;
 use super::scene::Scene;
 use crate::domain::{HemisphereMap, Triangle, Vec3, integrate_over};
@@ -987,6 +988,17 @@ fn exact_cone(e: &AnyEmitter<f64>, receiver: &Receiver) -> bool {
     }
 }
 
+/// True when the receiver's horizon or the kernel's lobe clamp
+/// ([`Kernel::clamp`]) cuts a finite emitter: the plane through the
+/// receiver has points of the light strictly on both sides.
+fn crosses<K: Kernel>(e: &AnyEmitter<f64>, receiver: &Receiver, kernel: &K) -> bool {
+    let x = receiver.point();
+    e.occluder().is_some_and(|o| {
+        order::straddles(&o, x, receiver.normal())
+            || kernel.clamp().is_some_and(|r| order::straddles(&o, x, r))
+    })
+}
+
 /// The height of `x` above the plane of a disk light (signed: positive on
 /// its emitting side), when `x` is on the disk's axis (lateral offset at
 /// most `1e-14 (|h| + R)`, as [`DiskLight`]'s cone takes it) and off its
@@ -1068,6 +1080,13 @@ fn converged_by_emitter<K: Kernel>(
                     blocked::over_cone(receiver, kernel, e, &e.cone(receiver)?)?
                 } else if exact_cone(e, receiver) {
                     integrate_over(&rule, &e.cone(receiver)?, budget, &mut rng, along())?
+                } else if crosses(e, receiver, kernel)
+                    && (split || !scene.has_blockers(Some(k)))
+                    && let Some(own) = blocked::over_shape(receiver, kernel, e)?
+                {
+                    // Cut where the horizon or the lobe's clamp crosses the
+                    // light: over its surface the integrand kinks there.
+                    own
                 } else if let Some(lit) = &lit {
                     // Split at the shadow boundaries: smooth on every piece.
                     let g = forms::area_integrand_with(scene, receiver, kernel, k, |_| true)?;

@@ -110,6 +110,14 @@ fn side(a: &Occluder, b: &Occluder, x: Vec3, tol: f64) -> Option<bool> {
     }
 }
 
+/// True when the shape has points strictly on both sides of the plane
+/// through `p` with unit normal `n`.
+pub fn straddles(o: &Occluder, p: Vec3, n: Vec3) -> bool {
+    let (lo, hi) = span(o, n);
+    let at = n.dot(&p);
+    lo < at && hi > at
+}
+
 /// `Some(true)` when every ray from `x` that meets both `a` and `b` meets
 /// `a` first, `Some(false)` when `b` first, `None` when neither condition
 /// of the module holds.
