@@ -62,6 +62,21 @@
 //! smaller error estimate is kept, its error widened to their difference
 //! where they disagree beyond ten times their estimates.
 //!
+//! Where the integrand would kink or jump inside those domains, the
+//! converged reference integrates between exact outlines instead, in polar
+//! directions with nested adaptive Gauss–Kronrod
+//! ([`crate::rendering::blocked`], [`crate::rendering::arcs`]): a flat
+//! kernel over an exact cone; a planar light cut by the horizon or the
+//! lobe's clamp; and, where something can block a light and its shadow is
+//! not a polygon the scene can cut out exactly, the light with nothing in
+//! the way less what each blocker hides, cut at the blocker's, the light's,
+//! the horizon's, the clamp's and the other blockers' outlines. That needs
+//! every blocker wholly in front of the light or wholly behind it
+//! ([`crate::rendering::order`]); where one straddles it (a sphere through
+//! the plane of a rectangle light) the hidden part is taken over the
+//! blocker's domain with a visibility test, and the reference says
+//! "unverified" instead of converged.
+//!
 //! **Terms left out.** R-A's visibility is evaluated only where something
 //! can block an emitter ([`crate::rendering::scene::Scene::has_blockers`]):
 //! without occluders, and with no other finite emitter, no shadow ray is
