@@ -35,7 +35,8 @@ if [ "${1:-}" = "--ci" ]; then
   trap 'rm -rf "$scratch"' EXIT
   (cd reference && .venv/bin/python -m lqref --quick --out "$scratch" \
     ../experiments/mitsuba-tau-constant-sphere.json ../experiments/v-l-single-scattering.json \
-    ../experiments/r-h-vs-a-tilted-rectangle.json ../experiments/mitsuba-r-furnace-bounces.json)
+    ../experiments/r-h-vs-a-tilted-rectangle.json ../experiments/mitsuba-r-furnace-bounces.json \
+    ../experiments/w-ss-edge-coverage.json)
   LIGHTQUAD_REFERENCE_VALUES="$scratch" cargo test --release --test mitsuba
 else
   # Every experiment that has a committed values file (Mitsuba cannot express

@@ -4,7 +4,8 @@
 //! values within 4 standard errors plus a float32 floor, and must have been made
 //! from the experiment file as it is now (a stale hash fails the test). Every
 //! family the harness knows is compared: volume (V-tau, V-L), rendering
-//! (irradiance and Lambertian reflected radiance, R-H and R-A) and the furnace.
+//! (irradiance and Lambertian reflected radiance, R-H and R-A), the furnace and
+//! Whitted's pixel coverage (W-SS).
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +17,7 @@ use lightquad::rendering::closed::Furnace;
 use lightquad::rendering::experiment::Rendering;
 use lightquad::volume::experiment::{Built, Volume, VolumeQuantity as Quantity};
 use lightquad::volume::{DepthScheme, ShadowMethod, evaluate};
+use lightquad::whitted::experiment::Whitted;
 use rand::SeedableRng;
 use serde_json::Value;
 
@@ -93,6 +95,7 @@ fn lightquad(file: &Path, name: &str) -> (f64, f64) {
         Some("volume") => lightquad_value(file, quantity(name)),
         Some("rendering") => (converged::<Rendering>(file, name), f64::NAN),
         Some("furnace") => (converged::<Furnace>(file, name), f64::NAN),
+        Some("whitted") => (converged::<Whitted>(file, name), f64::NAN),
         other => panic!("{}: no comparison for family {other:?}", file.display()),
     }
 }
@@ -165,8 +168,8 @@ fn lightquad_agrees_with_mitsuba_within_four_standard_errors() {
     assert!(compared >= 2, "only {compared} values compared");
     // Both families' CI regeneration (scripts/reference.sh --ci) and the
     // committed values cover V-tau, V-L, irradiance, reflected radiance and
-    // the furnace.
-    for kind in ["tau", "I_L", "E_area", "L_area", "L"] {
+    // the furnace, and pixel coverage.
+    for kind in ["tau", "I_L", "E_area", "L_area", "L", "coverage"] {
         assert!(kinds.contains(kind), "no {kind} compared: {kinds:?}");
     }
 }

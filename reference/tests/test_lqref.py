@@ -14,7 +14,7 @@ import pytest
 from lqref import fnv1a64, file_hash
 from lqref import mitsuba3, runner, spec
 from lqref.__main__ import main
-from lqref.families import FAMILIES, furnace, rendering, volume
+from lqref.families import FAMILIES, furnace, rendering, volume, whitted
 
 REPO = Path(__file__).resolve().parents[2]
 LIGHTQUAD = REPO / "target" / "release" / "lightquad"
@@ -246,7 +246,7 @@ SPHERE_SCENE = {
 
 
 def test_every_family_module_has_the_interface():
-    assert list(FAMILIES) == ["volume", "rendering", "furnace"]
+    assert list(FAMILIES) == ["volume", "rendering", "furnace", "whitted"]
     for module in FAMILIES.values():
         assert module.QUANTITIES
         for name in ("Settings", "read_scene", "require_expressible", "unsupported_reason",
@@ -641,3 +641,119 @@ def test_furnace_reflections_past_the_cap_are_refused(tmp_path):
         with pytest.raises(spec.SpecError) as err:
             spec.load(write_furnace(tmp_path, "x", scene, ["L"]))
         assert err.value.path == path
+
+
+# ----------------------------------------------------------------------------
+# whitted: pixel coverage
+
+
+def write_whitted(tmp_path, name, scene, quantities=("coverage",)):
+    doc = {"name": name, "family": "whitted", "description": "test", "equations": ["W-SS"],
+           "scene": scene, "quantities": list(quantities),
+           "rules": [{"rule": "grid"}], "budgets": [4], "reference": {"type": "closed-form"}}
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps(doc, indent=2))
+    return path
+
+
+def clipped_area(poly, x0, y0):
+    """The area of convex polygon ``poly`` (film points) inside the pixel
+    square ``[x0, x0 + 1] x [y0, y0 + 1]`` (Sutherland-Hodgman, shoelace)."""
+    for axis, bound, keep_above in ((0, x0, True), (0, x0 + 1, False),
+                                    (1, y0, True), (1, y0 + 1, False)):
+        out = []
+        for i, p in enumerate(poly):
+            q = poly[(i + 1) % len(poly)]
+            pin = (p[axis] >= bound) == keep_above
+            qin = (q[axis] >= bound) == keep_above
+            if pin:
+                out.append(p)
+            if pin != qin:
+                t = (bound - p[axis]) / (q[axis] - p[axis])
+                out.append(p + t * (q - p))
+        poly = out
+        if not poly:
+            return 0.0
+    return 0.5 * abs(sum(poly[i][0] * poly[(i + 1) % len(poly)][1]
+                         - poly[(i + 1) % len(poly)][0] * poly[i][1] for i in range(len(poly))))
+
+
+def film_points(scene):
+    """The triangle's corners on lightquad's film: ``x`` right from the left
+    edge, ``y`` down from the top, in pixels (README, W-SS)."""
+    forward = (scene.look_at - scene.eye) / np.linalg.norm(scene.look_at - scene.eye)
+    right = np.cross(forward, scene.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    t = math.tan(math.radians(scene.fov_y) / 2.0)
+    w, h = scene.width, scene.height
+    pts = []
+    for p in scene.corners:
+        v = p - scene.eye
+        z = v @ forward
+        sx, sy = (v @ right) / z, (v @ up) / z
+        pts.append(np.array([(sx / (t * w / h) + 1.0) * w / 2.0, (1.0 - sy / t) * h / 2.0]))
+    return pts
+
+
+def test_whitted_every_pixel_of_mitsubas_image_is_the_covered_fraction(tmp_path):
+    """The whole 8 x 6 film of the bundled edge-coverage scene (uncropped)
+    against the polygon-clipped area of the projected triangle in each pixel:
+    Mitsuba's camera, film orientation and box filter are lightquad's."""
+    mi, _ = mitsuba3.require_mitsuba()
+    exp = spec.load(REPO / "experiments" / "w-ss-edge-coverage.json")
+    spp = 1 << 14
+    scene = whitted.build_scene(exp, tmp_path, crop=False, spp=spp)
+    img = np.asarray(mi.render(scene, spp=spp, seed=3), dtype=np.float64)[:, :, 0]
+    pts = film_points(exp.scene)
+    partial = 0
+    for j in range(exp.scene.height):
+        for i in range(exp.scene.width):
+            c = clipped_area(pts, i, j)
+            se = max(math.sqrt(c * (1.0 - c) / spp), 1e-6)
+            assert abs(img[j, i] - c) < 5.0 * se, (i, j, img[j, i], c)
+            partial += 0.0 < c < 1.0
+    assert partial >= 8
+    # The file's closed form, as its description quotes it.
+    assert abs(clipped_area(pts, 3, 2) - 0.70627136950266) < 1e-12
+
+
+def test_whitted_cropped_coverage_of_a_corner_triangle(tmp_path):
+    """A small triangle inside one pixel of a 4 x 4 film: its cropped render
+    is the triangle's area in pixels."""
+    path = write_whitted(tmp_path, "corner", {
+        "camera": {"eye": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 60.0,
+                   "width": 4, "height": 4},
+        "objects": [{"type": "triangle", "a": [0.02, 0.03, -1.0], "b": [0.25, 0.05, -1.0],
+                     "c": [0.05, 0.27, -1.0], "material": {"k_a": 1.0}}],
+        "pixel": [2, 1]})
+    exp = spec.load(path)
+    want = clipped_area(film_points(exp.scene), 2, 1)
+    assert 0.05 < want < 0.95
+    res = whitted.compute(exp, "coverage", whitted.Settings(quick=True))
+    assert abs(res["value"] - want) < 4.0 * res["std_error"] + res["float32_error"], (res, want)
+
+
+@pytest.mark.parametrize("change, path", [
+    (lambda s: s["objects"].append(dict(s["objects"][0])), "scene.objects"),
+    (lambda s: s["objects"][0].update(type="sphere"), "scene.objects"),
+    (lambda s: s.update(objects="none"), "scene.objects"),
+    (lambda s: s["objects"][0].update(c=[0.6, 0.0, -1.0]), "scene.objects[0]"),
+    (lambda s: s["objects"][0].update(b="x"), "scene.objects[0].b"),
+    (lambda s: s.update(pixel=[4, 0]), "scene.pixel[0]"),
+    (lambda s: s["camera"].update(fov_y=0.0), "scene.camera.fov_y"),
+    (lambda s: s["camera"].update(up=[0, 0, -1]), "scene.camera.up"),
+    (lambda s: s["camera"].update(width=True), "scene.camera.width"),
+])
+def test_whitted_bad_scenes_are_named(tmp_path, change, path):
+    scene = {"camera": {"eye": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0],
+                        "fov_y": 60.0, "width": 4, "height": 4},
+             "objects": [{"type": "triangle", "a": [0.0, 0.0, -1.0], "b": [0.3, 0.0, -1.0],
+                          "c": [0.0, 0.3, -1.0], "material": {"k_a": 1.0}}],
+             "pixel": [1, 1]}
+    change(scene)
+    bad = write_whitted(tmp_path, "bad", scene)
+    with pytest.raises(spec.SpecError) as err:
+        runner.compute(bad, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
+    assert err.value.path == path
+    assert not (tmp_path / "v" / "bad.json").exists()

@@ -16,6 +16,6 @@ A family module provides
   ``value``, ``std_error``, ``samples``, ``method`` and details.
 """
 
-from . import furnace, rendering, volume
+from . import furnace, rendering, volume, whitted
 
-FAMILIES = {"volume": volume, "rendering": rendering, "furnace": furnace}
+FAMILIES = {"volume": volume, "rendering": rendering, "furnace": furnace, "whitted": whitted}
