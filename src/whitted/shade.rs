@@ -10,8 +10,10 @@
 //!
 //! with `C` the material's colour, `R_q = 2 (N . L_q) N - L_q` the
 //! reflection of `L_q`, `S_q` the shadow ray's verdict (1 when no object
-//! lies between `P` and the light; a light below the surface, `N . L_q <=
-//! 0`, adds nothing and casts no shadow ray), `I_r` the intensity seen along
+//! lies between `P` and the light, 0 otherwise: a transparent object casts
+//! as black a shadow as an opaque one, as in Whitted's model, which traces
+//! no light through refracting surfaces; a light below the surface, `N .
+//! L_q <= 0`, adds nothing and casts no shadow ray), `I_r` the intensity seen along
 //! the mirror direction `R = D - 2 (D . N) N` of the incoming direction `D`,
 //! and `I_t` the intensity along the refracted direction (Snell's law,
 //! `eta_1 sin theta_1 = eta_2 sin theta_2`):
