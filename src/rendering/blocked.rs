@@ -44,7 +44,7 @@ use crate::estimate::Estimate;
 use crate::quadrature::Rule;
 use crate::quadrature::gauss_kronrod::GaussKronrod;
 use crate::quadrature::product::WithError;
-use crate::rendering::arcs::{self, Fan, Pieces, Spoke};
+use crate::rendering::arcs::{self, Fan, Outline, Pieces, Spoke};
 use crate::rendering::cap::Cap;
 use crate::rendering::emitter::{AnyEmitter, Emitter, LightDomain, bounding_cone};
 use crate::rendering::forms::{Kernel, emitter_at};
@@ -313,6 +313,14 @@ impl Seen {
         }
     }
 
+    fn outlines(&self, x: Vec3) -> Vec<Outline> {
+        match self {
+            Seen::Cone(c, beta) => vec![Outline::Circle(*c, beta.cos())],
+            Seen::Shape(o) => Outline::of(o, x),
+            Seen::All | Seen::Dark => Vec::new(),
+        }
+    }
+
     fn breaks(&self, fan: &Fan) -> Vec<f64> {
         match self {
             Seen::Cone(c, beta) => fan.cone_breaks(*c, *beta),
@@ -414,8 +422,10 @@ fn hidden_by<K: Kernel>(
         reach,
     };
     let mut breaks = fan.breaks(blocker);
+    let mut outlines = Outline::of(blocker, x);
     for o in before {
         breaks.extend(fan.breaks(o));
+        outlines.extend(Outline::of(o, x));
     }
     let on = |sp: &Spoke| -> Pieces {
         let mut set = sp.shape(blocker);
@@ -424,7 +434,15 @@ fn hidden_by<K: Kernel>(
         }
         set
     };
-    over_fan(receiver, kernel, emitter, light, &fan, breaks, on)
+    over_fan(
+        receiver,
+        kernel,
+        emitter,
+        light,
+        &fan,
+        (breaks, outlines),
+        on,
+    )
 }
 
 /// An emitter's light with nothing in the way over its exact cone of
@@ -451,7 +469,10 @@ pub fn over_cone<K: Kernel>(
         emitter,
         &Seen::All,
         &fan,
-        Vec::new(),
+        (
+            Vec::new(),
+            vec![Outline::Circle(cone.axis(), fan.reach.cos())],
+        ),
         |sp: &Spoke| sp.all(),
     )
 }
@@ -486,14 +507,14 @@ pub fn over_shape<K: Kernel>(
             PI
         },
     };
-    let breaks = fan.breaks(&shape);
+    let (breaks, outlines) = (fan.breaks(&shape), Outline::of(&shape, x));
     over_fan(
         receiver,
         kernel,
         emitter,
         &Seen::All,
         &fan,
-        breaks,
+        (breaks, outlines),
         |sp: &Spoke| sp.shape(&shape),
     )
     .map(Some)
@@ -502,14 +523,16 @@ pub fn over_shape<K: Kernel>(
 /// `int_0^(2 pi) int_(I(phi)) K(w) cos theta L sin rho d rho d phi` over
 /// `fan`, `I(phi)` the pieces `on` gives of the spoke at `phi` met with the
 /// light's, the horizon's and the lobe clamp's; the azimuth split at
-/// `breaks` and wherever those outlines make the pieces jump or kink.
+/// `breaks` and wherever the light's, the horizon's and the clamp's
+/// outlines make the pieces jump or kink, and where any two of those and
+/// `outlines` (the outlines `on` cuts at) cross.
 fn over_fan<K: Kernel>(
     receiver: &Receiver,
     kernel: &K,
     emitter: &AnyEmitter<f64>,
     light: &Seen,
     fan: &Fan,
-    mut breaks: Vec<f64>,
+    (mut breaks, mut outlines): (Vec<f64>, Vec<Outline>),
     on: impl Fn(&Spoke) -> Pieces,
 ) -> Result<Estimate<f64>, QuadError> {
     let (normal, clamp, radiance) = (receiver.normal(), kernel.clamp(), emitter.radiance());
@@ -526,7 +549,11 @@ fn over_fan<K: Kernel>(
     breaks.extend(fan.cone_breaks(normal, PI / 2.0));
     if let Some(r) = clamp {
         breaks.extend(fan.cone_breaks(r, PI / 2.0));
+        outlines.push(Outline::Circle(r, 0.0));
     }
+    outlines.extend(light.outlines(fan.x));
+    outlines.push(Outline::Circle(normal, 0.0));
+    breaks.extend(fan.crossing_breaks(&outlines));
     breaks.push(0.0);
     breaks.sort_by(f64::total_cmp);
     breaks.dedup();

@@ -1058,7 +1058,13 @@ fn converged_by_emitter<K: Kernel>(
     let (scene, receiver) = (&built.scene, &built.receiver);
     let mut total = Estimate::zero();
     for (k, e) in scene.emitters().iter().enumerate() {
-        let lit = lit_triangles(scene, receiver.point(), k);
+        // Under a peaked lobe the lit polygons' area integrand holds the
+        // lobe's peak where the lobe is narrower than them; the blockers'
+        // exact arcs with adaptive pieces resolve it instead.
+        let lit = match lobe {
+            None => lit_triangles(scene, receiver.point(), k),
+            Some(_) => None,
+        };
         // Where something can stand in the way and the shadow boundaries are
         // not computed, the light is taken with nothing in the way, and what
         // each blocker hides is subtracted over the blocker's own cone (an
