@@ -380,14 +380,15 @@ impl Outline {
         let g = c1.dot(&c2);
         let axis = c1.cross(&c2);
         let s2 = axis.norm_squared();
-        if !(s2 > 1e-24) {
+        // Parallel circles (or a NaN) have no crossing worth a break.
+        if s2.is_nan() || s2 <= 1e-24 {
             return Vec::new();
         }
         let a = (k1 - g * k2) / s2;
         let b = (k2 - g * k1) / s2;
         let base = c1 * a + c2 * b;
         let left = 1.0 - base.norm_squared();
-        if !(left >= 0.0) {
+        if left.is_nan() || left < 0.0 {
             return Vec::new();
         }
         let t = (left / s2).sqrt();
