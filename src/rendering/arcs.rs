@@ -566,6 +566,37 @@ mod tests {
         Ok(())
     }
 
+    /// Crossings lie on both outlines: a cap's circle with the horizon
+    /// (two points), a polygon edge with the horizon (one, where the edge
+    /// dips below it), and none for an edge wholly above it.
+    #[test]
+    fn crossings_lie_on_both_outlines() {
+        let horizon = Outline::Circle(Vec3::z(), 0.0);
+        let c = Vec3::new(0.6, 0.0, 0.1).normalize();
+        let cap = Outline::Circle(c, 0.3_f64.cos());
+        let points = cap.crossings(&horizon);
+        assert_eq!(points.len(), 2);
+        for w in &points {
+            assert!((w.norm() - 1.0).abs() < 1e-15 && w.z.abs() < 1e-15, "{w:?}");
+            assert!((w.dot(&c) - 0.3_f64.cos()).abs() < 1e-15, "{w:?}");
+        }
+        let edge = Outline::Arc(
+            Vec3::new(1.0, 0.2, 0.5).normalize(),
+            Vec3::new(1.0, -0.4, -0.3).normalize(),
+        );
+        let points = edge.crossings(&horizon);
+        assert_eq!(points.len(), 1);
+        let w = points[0];
+        assert!(w.z.abs() < 1e-15 && w.x > 0.0, "{w:?}");
+        let m = Vec3::new(1.0, 0.2, 0.5).cross(&Vec3::new(1.0, -0.4, -0.3));
+        assert!(w.dot(&m).abs() < 1e-15, "{w:?}");
+        let above = Outline::Arc(
+            Vec3::new(1.0, 0.2, 0.5).normalize(),
+            Vec3::new(1.0, -0.4, 0.3).normalize(),
+        );
+        assert!(above.crossings(&horizon).is_empty());
+    }
+
     #[test]
     fn intersect_and_subtract_are_set_operations() {
         let a = vec![(0.0, 1.0), (2.0, 3.0)];
