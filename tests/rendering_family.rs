@@ -1098,3 +1098,58 @@ fn the_mitsuba_table_shows_the_three_lights_value_verified() {
         "{rows:?}"
     );
 }
+
+/// Hostile probe of session 26: a rectangle occluder lying in a rectangle
+/// light's own plane (inside it, or the light's own rectangle) ties in
+/// depth with the light. The reference took it as in front (0.5214 or 0,
+/// "converged to 6e-13", one side of a 31% jump); it is unverified now.
+/// A receiver resting on a ball (on its surface, to rounding) sees the ball
+/// fill the half-space under its tangent plane: the reference was ~0
+/// (the ball taken as around it); a ball under the receiver hides nothing
+/// of a light above (Lambert's contour formula for the rectangle, written
+/// here), one beside it hides exactly half (the rectangle is symmetric
+/// about the ball's tangent plane).
+#[test]
+fn a_blocker_in_the_lights_plane_is_unverified_and_a_ball_under_the_receiver_hides_its_half() {
+    let receiver = json!({"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]});
+    let light = json!({"type": "rectangle", "origin": [-1.0, -1.0, 2.0], "edge_u": [0.0, 2.0, 0.0],
+                       "edge_v": [2.0, 0.0, 0.0], "radiance": 1.0});
+    let corners = [
+        v3(-1.0, -1.0, 2.0),
+        v3(-1.0, 1.0, 2.0),
+        v3(1.0, 1.0, 2.0),
+        v3(1.0, -1.0, 2.0),
+    ];
+    let full = PI * contour(Vec3::zeros(), Vec3::z(), &corners);
+    for occluder in [
+        json!({"type": "rectangle", "origin": [-0.5, -0.5, 2.0], "edge_u": [0.0, 1.0, 0.0],
+               "edge_v": [1.0, 0.0, 0.0]}),
+        json!({"type": "rectangle", "origin": [-1.0, -1.0, 2.0], "edge_u": [2.0, 0.0, 0.0],
+               "edge_v": [0.0, 2.0, 0.0]}),
+    ] {
+        let exp = with_scene(
+            json!({"receiver": receiver, "emitters": [light], "occluders": [occluder]}),
+            &["E_area"],
+        );
+        let out = Rendering::converged(&exp.scene, 400, &[Q::EArea]).expect("converges");
+        assert!(
+            out[&Q::EArea]
+                .flags
+                .contains(&lightquad::family::Flag::UnreliableEstimate),
+            "{occluder}: {:?}",
+            out[&Q::EArea]
+        );
+    }
+    for (centre, want) in [([0.0, 0.0, -0.5], full), ([0.5, 0.0, 0.0], full / 2.0)] {
+        let exp = with_scene(
+            json!({"receiver": receiver, "emitters": [light],
+                   "occluders": [{"type": "sphere", "centre": centre, "radius": 0.5}]}),
+            &["E_area"],
+        );
+        let (got, error) = converged(&exp, Q::EArea);
+        assert!(
+            rel(got, want) < 1e-11,
+            "{centre:?}: {got} vs {want} (+- {error:e})"
+        );
+    }
+}

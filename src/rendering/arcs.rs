@@ -114,15 +114,10 @@ impl Spoke {
     /// The directions from `x` that meet the occluder shape `o`.
     pub fn shape(&self, o: &Occluder) -> Pieces {
         match o {
-            Occluder::Sphere(s) => {
-                let to = s.centre - self.x;
-                let d = to.norm();
-                if d <= s.radius {
-                    self.all()
-                } else {
-                    self.cone(to / d, (s.radius / d).min(1.0).asin())
-                }
-            }
+            Occluder::Sphere(s) => match sphere_seen(s.centre - self.x, s.radius) {
+                SphereSeen::Around => self.all(),
+                SphereSeen::From(c, beta) => self.cone(c, beta),
+            },
             Occluder::Disk(d) => self.disk(d),
             Occluder::Rectangle(r) => {
                 let (o, e1, e2) = (r.origin(), r.edge_u(), r.edge_v());
@@ -240,14 +235,10 @@ impl Fan {
     /// a disk's rim, which bisection finds.
     pub fn breaks(&self, o: &Occluder) -> Vec<f64> {
         match o {
-            Occluder::Sphere(s) => {
-                let to = s.centre - self.x;
-                let d = to.norm();
-                if d <= s.radius {
-                    return Vec::new();
-                }
-                self.cone_breaks(to / d, (s.radius / d).min(1.0).asin())
-            }
+            Occluder::Sphere(s) => match sphere_seen(s.centre - self.x, s.radius) {
+                SphereSeen::Around => Vec::new(),
+                SphereSeen::From(c, beta) => self.cone_breaks(c, beta),
+            },
             Occluder::Disk(_) => Vec::new(),
             Occluder::Rectangle(r) => {
                 let (o, e1, e2) = (r.origin(), r.edge_u(), r.edge_v());
@@ -263,9 +254,16 @@ impl Fan {
     /// horizon was 1.7e-11 off, 170 times the estimate, without them).
     pub fn crossing_breaks(&self, outlines: &[Outline]) -> Vec<f64> {
         let mut points = Vec::new();
+        // Only crossings within the fan's reach cut its spokes.
+        let within = self.reach.cos() - 1e-12;
         for (i, a) in outlines.iter().enumerate() {
             for b in &outlines[i + 1..] {
-                points.extend(a.crossings(b).into_iter().map(|w| self.x + w));
+                points.extend(
+                    a.crossings(b)
+                        .into_iter()
+                        .filter(|w| w.dot(&self.frame.n) >= within)
+                        .map(|w| self.x + w),
+                );
             }
         }
         self.azimuths(&points)
@@ -335,15 +333,10 @@ impl Outline {
                 .collect()
         };
         match o {
-            Occluder::Sphere(s) => {
-                let to = s.centre - x;
-                let d = to.norm();
-                if d <= s.radius {
-                    return Vec::new();
-                }
-                let sin = s.radius / d;
-                vec![Outline::Circle(to / d, ((1.0 - sin) * (1.0 + sin)).sqrt())]
-            }
+            Occluder::Sphere(s) => match sphere_seen(s.centre - x, s.radius) {
+                SphereSeen::Around => Vec::new(),
+                SphereSeen::From(c, beta) => vec![Outline::Circle(c, beta.cos())],
+            },
             Occluder::Disk(_) => Vec::new(),
             Occluder::Rectangle(r) => {
                 let (o, e1, e2) = (r.origin(), r.edge_u(), r.edge_v());
@@ -396,6 +389,28 @@ impl Outline {
             .into_iter()
             .filter(|w| self.holds(*w) && other.holds(*w))
             .collect()
+    }
+}
+
+/// How a sphere is seen from a point: all around it (inside), or as the
+/// cone about unit `c` of half-angle `beta` (`sin beta = R / d` outside;
+/// `beta = pi/2` on the surface, to 1e-12 of `R`, where the sphere fills
+/// the half-space under its tangent plane: a receiver resting on a ball).
+enum SphereSeen {
+    Around,
+    From(Vec3, f64),
+}
+
+/// [`SphereSeen`] of the sphere of radius `r` whose centre is `to` from
+/// the point.
+fn sphere_seen(to: Vec3, r: f64) -> SphereSeen {
+    let d = to.norm();
+    if d < r * (1.0 - 1e-12) || d == 0.0 {
+        SphereSeen::Around
+    } else if d <= r * (1.0 + 1e-12) {
+        SphereSeen::From(to / d, PI / 2.0)
+    } else {
+        SphereSeen::From(to / d, (r / d).min(1.0).asin())
     }
 }
 

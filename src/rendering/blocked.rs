@@ -605,7 +605,7 @@ fn over_fan<K: Kernel>(
         abs_tol: 1e-15 * scale / panels.len() as f64,
         rel_tol: 1e-13,
     };
-    let per = (AZIMUTH_BUDGET / panels.len()).max(1_515);
+    let per = (AZIMUTH_BUDGET / panels.len()).max(255);
     let mut total = Estimate::zero();
     for &(lo, hi) in &panels {
         let p =

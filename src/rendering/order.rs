@@ -87,7 +87,9 @@ fn distances(o: &Occluder, x: Vec3) -> (f64, f64) {
 
 /// Whether `a` lies wholly on `x`'s side of `b`'s plane (`Some(true)`),
 /// wholly beyond it (`Some(false)`), or neither; `None` too for `b` not
-/// planar or `x` in its plane. Contact within `tol` counts as a side.
+/// planar or `x` in its plane. Contact within `tol` counts as a side; `a`
+/// lying within `tol` of the plane (a blocker in a light's plane, the
+/// light's own rectangle) is a tie and `None`.
 fn side(a: &Occluder, b: &Occluder, x: Vec3, tol: f64) -> Option<bool> {
     let (p, n) = plane(b)?;
     let offset = n.dot(&p);
@@ -101,7 +103,10 @@ fn side(a: &Occluder, b: &Occluder, x: Vec3, tol: f64) -> Option<bool> {
     } else {
         (offset - hi, offset - lo)
     };
-    if lo >= -tol {
+    if lo.abs() <= tol && hi.abs() <= tol {
+        // `a` lies in `b`'s plane: a tie of depth, neither in front.
+        None
+    } else if lo >= -tol {
         Some(true)
     } else if hi <= tol {
         Some(false)
