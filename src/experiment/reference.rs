@@ -784,9 +784,15 @@ pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
         } else {
             " (unverified: across outlines it does not split at)"
         };
+        // A colour or an image has no single number to show.
+        let lightquad = if r.lightquad.is_finite() {
+            format!("{:.10e}{unverified}", r.lightquad)
+        } else {
+            "— (not one number: a colour or an image)".to_string()
+        };
         md.push_str(&format!(
-            "| {} | {} | {:.10e}{unverified} | {mitsuba} | {closed} | {agreement} |\n",
-            r.experiment, r.quantity, r.lightquad
+            "| {} | {} | {lightquad} | {mitsuba} | {closed} | {agreement} |\n",
+            r.experiment, r.quantity
         ));
     }
     md
