@@ -28,6 +28,7 @@
 use std::f64::consts::PI;
 
 use crate::domain::{Disk, Frame, Vec3};
+use crate::error::QuadError;
 use crate::rendering::occluder::Occluder;
 
 /// Sorted, disjoint closed intervals of the angle `rho` along a spoke.
@@ -217,6 +218,24 @@ pub struct Fan {
 }
 
 impl Fan {
+    /// The fan from `x` about the direction to `o`'s bounding sphere, out to
+    /// the sphere's cone (all around, `pi`, for `x` inside it); about
+    /// `fallback` (unit) for `x` at its centre.
+    pub fn about(o: &Occluder, x: Vec3, fallback: Vec3) -> Result<Fan, QuadError> {
+        let (centre, radius) = o.bounding_sphere();
+        let to = centre - x;
+        let d = to.norm();
+        Ok(Fan {
+            x,
+            frame: Frame::from_normal(if d > 0.0 { to / d } else { fallback })?,
+            reach: if d > radius {
+                (radius / d).min(1.0).asin()
+            } else {
+                PI
+            },
+        })
+    }
+
     /// The spoke at azimuth `phi`.
     pub fn spoke(&self, phi: f64) -> Spoke {
         let f = self.frame;

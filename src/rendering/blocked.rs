@@ -407,20 +407,7 @@ fn hidden_by<K: Kernel>(
     before: &[Occluder],
 ) -> Result<Estimate<f64>, QuadError> {
     let x = receiver.point();
-    let (centre, radius) = blocker.bounding_sphere();
-    let to = centre - x;
-    let d = to.norm();
-    let axis = if d > 0.0 { to / d } else { receiver.normal() };
-    let reach = if d > radius {
-        (radius / d).min(1.0).asin()
-    } else {
-        PI
-    };
-    let fan = Fan {
-        x,
-        frame: Frame::from_normal(axis)?,
-        reach,
-    };
+    let fan = Fan::about(blocker, x, receiver.normal())?;
     let mut breaks = fan.breaks(blocker);
     let mut outlines = Outline::of(blocker, x);
     for o in before {
@@ -495,18 +482,7 @@ pub fn over_shape<K: Kernel>(
         Some(Seen::Dark) => return Ok(Some(Estimate::deterministic(0.0, 0.0, 0))),
         _ => return Ok(None),
     };
-    let (centre, radius) = shape.bounding_sphere();
-    let to = centre - x;
-    let d = to.norm();
-    let fan = Fan {
-        x,
-        frame: Frame::from_normal(if d > 0.0 { to / d } else { receiver.normal() })?,
-        reach: if d > radius {
-            (radius / d).min(1.0).asin()
-        } else {
-            PI
-        },
-    };
+    let fan = Fan::about(&shape, x, receiver.normal())?;
     let (breaks, outlines) = (fan.breaks(&shape), Outline::of(&shape, x));
     over_fan(
         receiver,
