@@ -491,7 +491,9 @@ fn a_converged_n_beyond_its_range_names_the_range_first() {
 }
 
 /// `render` refuses an image whose memory would not fit, before it renders
-/// (16384 x 16384 ran out of memory; 8192 x 8192 peaked at 3.2 GB).
+/// (16384 x 16384 ran out of memory; 8192 x 8192 peaked at 3.2 GB). A small
+/// scene, so that the cost limit (which the test scene meets first) does not
+/// answer.
 #[test]
 fn render_refuses_an_image_that_would_not_fit_in_memory() {
     let dir = scratch("bigrender");
@@ -508,7 +510,7 @@ fn render_refuses_an_image_that_would_not_fit_in_memory() {
             "--png",
         ])
         .arg(&png)
-        .arg(root().join("experiments/w-grey-test-scene.json"))
+        .arg(root().join("experiments/w-corner-image.json"))
         .output()
         .expect("runs");
     refused(
