@@ -1,6 +1,6 @@
 //! Rays per second of the Whitted renderer on the bundled test scene
 //! (`experiments/w-grey-test-scene.json`: spheres, a plane, a mirror and a
-//! glass sphere, two lights) at 256 x 256 pixels:
+//! glass sphere, one point light) at 256 x 256 pixels:
 //!
 //! - `whitted/primary/*`: one ray through each pixel centre, the primary
 //!   rays' cost (each with its shadow, reflection and refraction rays);
