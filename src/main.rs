@@ -306,6 +306,22 @@ fn run(command: Command) -> Result<(), Failure> {
                     .into());
                 }
             }
+            // An output that is the input would replace the experiment file
+            // with image bytes.
+            if let Some(f) = &file {
+                for (flag, path) in
+                    std::iter::once(("--png", &png)).chain(pfm.as_ref().map(|p| ("--pfm", p)))
+                {
+                    if same_file(path, f) {
+                        return Err(format!(
+                            "invalid {flag} = {}: it is the experiment file being rendered; \
+                             expected another file",
+                            path.display()
+                        )
+                        .into());
+                    }
+                }
+            }
             let source = match file {
                 Some(f) => Source::File(f),
                 None => Source::Bundled("w-grey-test-scene.json"),
@@ -325,21 +341,36 @@ fn run(command: Command) -> Result<(), Failure> {
                     short_numbers(&w.to_string())
                 );
             }
-            // The PFM first: one that cannot be written leaves the PNG as it
-            // was (a PNG already there was removed), and no PNG is left
-            // without its PFM.
-            if let Some(p) = &pfm {
+            // Both files or neither: each is encoded, then written beside
+            // its place under a temporary name, and only when both are
+            // written are they renamed into place.
+            let mut files = vec![(
+                "PNG",
+                png.clone(),
                 image
-                    .write_pfm(p)
-                    .map_err(|e| format!("cannot write the PFM: {e} (the PNG was not written)"))?;
+                    .png()
+                    .map_err(|e| format!("cannot encode the PNG: {e}"))?,
+            )];
+            if let Some(p) = &pfm {
+                files.push((
+                    "PFM",
+                    p.clone(),
+                    image
+                        .pfm()
+                        .map_err(|e| format!("cannot encode the PFM: {e}"))?,
+                ));
             }
-            image.write_png(&png).map_err(|e| {
-                let pfm = if pfm.is_some() {
-                    " (the PFM was written)"
-                } else {
-                    ""
-                };
-                format!("cannot write the PNG: {e}{pfm}")
+            experiment::run::write_all_or_none(
+                files
+                    .iter()
+                    .map(|(_, path, bytes)| (path.as_path(), bytes.as_slice())),
+            )
+            .map_err(|(k, e)| {
+                format!(
+                    "cannot write the {} {}: {e} (no file was written)",
+                    files[k].0,
+                    files[k].1.display()
+                )
             })?;
             writeln!(
                 out,

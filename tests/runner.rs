@@ -2538,7 +2538,7 @@ fn the_largest_channel_error_and_the_8_bit_values_off_are_counted() {
         quantize: lightquad::whitted::image::grey,
     };
     let reference = [0.2, 0.4];
-    let table = rows(&rules, &jobs, "I", &reference, Some(&display));
+    let table = rows(&rules, &jobs, "I", &reference, Some((&display, &[])));
     assert_eq!(table.len(), 1, "{table:?}");
     let row = &table[0];
     // Scale: rms(0.2, 0.4) = sqrt(0.1); worst channel 0.03 (second repeat).
@@ -2549,6 +2549,16 @@ fn the_largest_channel_error_and_the_8_bit_values_off_are_counted() {
     assert!((row.rel_error - rms / scale).abs() < 1e-12, "{row:?}");
     // One value off in each repeat.
     assert_eq!(row.display_off, Some(1.0), "{row:?}");
+    // A channel whose reference display is in doubt is not counted: both
+    // repeats' one value off is in channel 1.
+    let unsure = rows(
+        &rules,
+        &jobs,
+        "I",
+        &reference,
+        Some((&display, &[false, true])),
+    );
+    assert_eq!(unsure[0].display_off, Some(0.0), "{unsure:?}");
     // Without a display nothing is counted.
     let plain = rows(&rules, &jobs, "I", &reference, None);
     assert_eq!(plain[0].display_off, None);

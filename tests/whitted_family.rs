@@ -583,7 +583,7 @@ fn bad_scenes_are_refused_with_the_path_and_what_is_accepted() {
     refused(
         &broken("/scene/lights/0/intensity", json!([1.0, -1.0, 0.0])),
         "scene.lights[0].intensity",
-        &[">= 0"],
+        &["in [0, 1e20]"],
     );
     refused(
         &broken("/scene/ambient", json!([1e200, 0.0, 0.0])),
@@ -893,4 +893,56 @@ fn a_render_that_fails_leaves_an_existing_png_as_it_was() {
     );
     assert_eq!(fs::read_to_string(&png).expect("kept"), "precious");
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// The hostile probe of session 27: an intensity 32-bit images cannot hold
+/// (1e100 wrote infinities into the PFM) is refused at its path; a sphere of
+/// radius 1e100 around the eye (the job failed with "NaN" in the report) is
+/// a warning at its path; a triangle whose `b` is `a` blames `b`; a
+/// parallel `up` is echoed as given, not normalised.
+#[test]
+fn what_images_cannot_hold_and_what_f64_cannot_resolve_are_named_at_their_paths() {
+    refused(
+        &broken("/scene/lights/0/intensity", json!([1e21, 1.0, 1.0])),
+        "scene.lights[0].intensity",
+        &["[0, 1e20]", "32-bit"],
+    );
+    refused(
+        &broken("/scene/ambient", json!([0.1, 1e100, 0.1])),
+        "scene.ambient",
+        &["[0, 1e20]"],
+    );
+    // The eye is 5 from look_at: 1e100 is 2e99 times that, beyond 1e12.
+    let o = checked(&broken("/scene/objects/0/radius", json!(1e100)));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let msg = stderr(&o);
+    assert!(
+        msg.contains("warning") && msg.contains("at `scene.objects[0]`") && msg.contains("2.0e99"),
+        "{msg}"
+    );
+    // A sphere of radius 1e12 around a scene 5 across is quiet (2e11).
+    let o = checked(&broken("/scene/objects/0/radius", json!(1e12)));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+
+    let triangle = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+        broken(
+            "/scene/objects/0",
+            json!({"type": "triangle", "a": a, "b": b, "c": c, "material": {"k_a": 1.0}}),
+        )
+    };
+    refused(
+        &triangle([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        "scene.objects[0].b",
+        &["other than a"],
+    );
+    refused(
+        &triangle([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]),
+        "scene.objects[0].c",
+        &["off the line through a and b"],
+    );
+    refused(
+        &broken("/scene/camera/up", json!([0.0, 0.0, -6.0])),
+        "scene.camera.up",
+        &["[0.0, 0.0, -6.0]", "not parallel"],
+    );
 }

@@ -460,3 +460,24 @@ fn the_parallel_render_is_the_serial_render() {
     assert_eq!(one.image.values, three.image.values);
     assert_eq!(one.rays, three.rays);
 }
+
+/// W-SS's grid and W-Corner's trapezoid sum a pixel's rays with
+/// compensation: a 64 x 64 grid over a pixel whose left quarter shows 0.4
+/// (1024 of 4096 rays) is 0.1 exactly (1024 * 0.4 / 4096 is a power-of-two
+/// scaling of 0.4, so exact in f64), which W-Grey shows as 26 (25.5 rounded
+/// up). A plain running sum gave 0.09999999999999849, shown as 25 (the
+/// independent check's grid that was "1 off" the reference at n = 4096).
+#[test]
+fn a_pixels_rays_sum_to_their_exact_mean() {
+    use lightquad::whitted::image::grey;
+    let quarter = |p: [f64; 2]| if p[0] < 0.25 { 0.4 } else { 0.0 };
+    let pixel = Pixel::new(0.0, 0.0, 1.0, 1.0).expect("pixel");
+    let v: f64 = grid(&pixel, 64, quarter);
+    assert_eq!(v, 0.1);
+    assert_eq!(grey(v), 26);
+    // The trapezoid rule on the corner lattice: 65 x 65 points with
+    // weights 1/2 on the pixel's edges; x < 0.25 holds the columns 0..=15,
+    // so the sum is 0.4 * 64 * (1/2 + 15) / 4096 = 0.096875 exactly.
+    let image: Vec<f64> = corner_image([0.0, 0.0], 1, 1, 64, quarter);
+    assert_eq!(image[0], 0.4 * 64.0 * 15.5 / 4096.0);
+}

@@ -409,6 +409,7 @@ pub fn run_sources(
     for (exp, _, _) in &loaded {
         experiment_folder(&opts.out.join(exp.name()))?;
     }
+    run::clear_reports(&opts.out, loaded.iter().map(|(e, _, _)| e.name()));
     let total: usize = loaded
         .iter()
         .map(|(e, _, _)| e.jobs(opts.shard).len())
@@ -637,6 +638,7 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
     drop(reading);
     let _lock = lock_output(out, None)?;
     run::remove_stale_temporaries(out);
+    run::clear_reports(out, by_name.keys().map(String::as_str));
     let mut missing = Vec::new();
     let mut done = Vec::new();
     for (name, g) in by_name {

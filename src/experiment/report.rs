@@ -227,7 +227,7 @@ pub fn rows(
     results: &[JobResult],
     q: &str,
     reference: &[f64],
-    display: Option<&Display>,
+    display: Option<(&Display, &[bool])>,
 ) -> Vec<Row> {
     let mut groups: BTreeMap<(usize, usize), Vec<&JobResult>> = BTreeMap::new();
     for r in results {
@@ -239,10 +239,10 @@ pub fn rows(
         .map(|((rule_index, budget), jobs)| {
             let random = rules.get(rule_index).is_some_and(|r| r.is_random);
             let mut row = row(rule_index, budget, &jobs, q, reference, scale, random);
-            if let Some(d) = display
+            if let Some((d, doubt)) = display
                 && !row.value.is_empty()
             {
-                row.display_off = Some(display_off(d, &jobs, q, reference));
+                row.display_off = Some(display_off(d, doubt, &jobs, q, reference));
             }
             row
         })
@@ -414,11 +414,21 @@ fn row(
 }
 
 /// Mean over the repeats of the channels whose displayed value differs from
-/// the reference's (a missing channel counts as differing).
-fn display_off(d: &Display, jobs: &[&JobResult], q: &str, reference: &[f64]) -> f64 {
+/// the reference's (a missing channel counts as differing), among those whose
+/// displayed value the reference fixes (`doubt[c]` false or absent): a
+/// reference within its accuracy of a step boundary would count a rule off,
+/// or not, by its own rounding.
+fn display_off(
+    d: &Display,
+    doubt: &[bool],
+    jobs: &[&JobResult],
+    q: &str,
+    reference: &[f64],
+) -> f64 {
     let measured: Vec<&Measured> = jobs.iter().filter_map(|j| j.quantities.get(q)).collect();
     let off = |m: &Measured| {
         (0..reference.len().max(m.value.len()))
+            .filter(|&c| !doubt.get(c).copied().unwrap_or(false))
             .filter(|&c| match (m.value.get(c), reference.get(c)) {
                 (Some(&v), Some(&r)) => (d.quantize)(v) != (d.quantize)(r),
                 _ => true,
@@ -695,7 +705,17 @@ pub fn sections(page: &Page, results: &[JobResult]) -> Result<Vec<Section>, Stri
             continue;
         };
         let display = page.displays.get(i).copied().flatten();
-        let mut rows = rows(&page.rules, results, q, reference, display.as_ref());
+        let doubt = display
+            .as_ref()
+            .map(|d| in_doubt(d, q, reference, page))
+            .unwrap_or_default();
+        let mut rows = rows(
+            &page.rules,
+            results,
+            q,
+            reference,
+            display.as_ref().map(|d| (d, doubt.as_slice())),
+        );
         let accuracy = page.reference.accuracy_of(q);
         for r in rows.iter_mut() {
             if accuracy > 0.0 && r.rel_error <= accuracy {
@@ -744,6 +764,7 @@ fn pictures(
     let reference_image = image(reference)?;
     let base = format!("{}-{q}", page.name);
     let png = |i: &Image| i.png().map_err(|e| e.to_string());
+    let pfm = |i: &Image| i.pfm().map_err(|e| e.to_string());
     let mut out = vec![Picture {
         caption: "the reference".into(),
         width,
@@ -752,7 +773,7 @@ fn pictures(
         error_png: None,
         files: vec![
             (format!("{base}-reference.png"), png(&reference_image)?),
-            (format!("{base}-reference.pfm"), reference_image.pfm()),
+            (format!("{base}-reference.pfm"), pfm(&reference_image)?),
         ],
     }];
     // Each rule's row at its largest budget whose value is a whole image.
@@ -803,7 +824,7 @@ fn pictures(
             error_png: Some(format!("{stem}-error.png")),
             files: vec![
                 (format!("{stem}.png"), png(img)?),
-                (format!("{stem}.pfm"), img.pfm()),
+                (format!("{stem}.pfm"), pfm(img)?),
                 (format!("{stem}-error.png"), png(&errors)?),
             ],
         });
@@ -1120,32 +1141,26 @@ pub fn display_line(
     page: &Page,
 ) -> String {
     let scale = scale_of(reference);
-    // A reference value within its accuracy of a step boundary may display
-    // either way.
-    let overall = page.reference.accuracy_of(q) * scale;
-    let each = page.reference.channel_accuracy.get(q);
-    let unsure = reference
+    let unsure = in_doubt(display, q, reference, page)
         .iter()
-        .enumerate()
-        .filter(|&(c, &r)| {
-            let a = each.and_then(|e| e.get(c)).copied().unwrap_or(overall);
-            (display.quantize)(r - a) != (display.quantize)(r + a)
-        })
+        .filter(|&&d| d)
         .count();
-    let unsure = if overall > 0.0 || each.is_some() {
-        let how = if each.is_some() {
-            "Each channel's accuracy (its last change or own error estimate, the larger, \
+    let unsure =
+        if page.reference.accuracy_of(q) > 0.0 || page.reference.channel_accuracy.contains_key(q) {
+            let how = if page.reference.channel_accuracy.contains_key(q) {
+                "Each channel's accuracy (its last change or own error estimate, the larger, \
              and at least 1e-13 of its value)"
+            } else {
+                "The reference's accuracy"
+            };
+            format!(
+                " {how} leaves {unsure} of the reference's own displayed values in doubt (within \
+             it of a step boundary, such as a constant background of 0.3, 76.5 steps): those \
+             channels are not counted, in the column or here."
+            )
         } else {
-            "The reference's accuracy"
+            String::new()
         };
-        format!(
-            " {how} leaves {unsure} of the reference's own displayed values in doubt (within \
-             it of a step boundary): counts up to about {unsure} are not resolved."
-        )
-    } else {
-        String::new()
-    };
     let mut settled = Vec::new();
     for (i, rule) in page.rules.iter().enumerate() {
         let mine: Vec<&Row> = rows.iter().filter(|r| r.rule_index == i).collect();
@@ -1177,6 +1192,23 @@ pub fn display_line(
         rel = display.half_step / scale,
         list = settled.join("; ")
     )
+}
+
+/// Per channel of quantity `q`'s reference, whether its displayed value is
+/// in doubt: within its accuracy (the channel's own where the reference knows
+/// it, the quantity's otherwise) of a step boundary, where it may display
+/// either way.
+fn in_doubt(display: &Display, q: &str, reference: &[f64], page: &Page) -> Vec<bool> {
+    let overall = page.reference.accuracy_of(q) * scale_of(reference);
+    let each = page.reference.channel_accuracy.get(q);
+    reference
+        .iter()
+        .enumerate()
+        .map(|(c, &r)| {
+            let a = each.and_then(|e| e.get(c)).copied().unwrap_or(overall);
+            (display.quantize)(r - a) != (display.quantize)(r + a)
+        })
+        .collect()
 }
 
 /// A line saying why evaluations exceed the budget, where a row's do (its

@@ -438,6 +438,78 @@ pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
     written
 }
 
+/// Writes every `(path, bytes)` or none. A regular file (or one not there
+/// yet) is written to a temporary file beside it, renamed into place only
+/// when every file is written; a link is followed to the file it names. A
+/// path that is not a regular file (`/dev/full`, a pipe) is written in
+/// place, never renamed over, after the temporary files and before the
+/// renames. On failure the temporary files are removed (and any renamed
+/// already), and the error comes with the index of the file it concerns.
+pub fn write_all_or_none<'a>(
+    files: impl IntoIterator<Item = (&'a Path, &'a [u8])>,
+) -> Result<(), (usize, std::io::Error)> {
+    let files: Vec<(PathBuf, &[u8])> = files
+        .into_iter()
+        .map(|(path, bytes)| {
+            let linked = fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+            let path = match linked.then(|| fs::canonicalize(path)) {
+                Some(Ok(target)) => target,
+                _ => path.to_path_buf(),
+            };
+            (path, bytes)
+        })
+        .collect();
+    let special = |path: &Path| fs::metadata(path).is_ok_and(|m| !m.is_file());
+    let mut temporary: Vec<(usize, PathBuf)> = Vec::with_capacity(files.len());
+    let clean = |temporary: &[(usize, PathBuf)]| {
+        for (_, t) in temporary {
+            let _ = fs::remove_file(t);
+        }
+    };
+    for (k, (path, bytes)) in files.iter().enumerate() {
+        if special(path) {
+            continue;
+        }
+        let name = path
+            .file_name()
+            .map_or("out".into(), |n| n.to_string_lossy().to_string());
+        // The final name is in the temporary one, so that a name the
+        // folder refuses (too long) fails here, before any rename.
+        let tmp = path.with_file_name(format!(".{name}.{}.{k}.tmp", std::process::id()));
+        let written = File::create(&tmp).and_then(|mut f| {
+            f.write_all(bytes)?;
+            f.sync_all()
+        });
+        temporary.push((k, tmp));
+        if let Err(e) = written {
+            clean(&temporary);
+            return Err((k, e));
+        }
+    }
+    for (k, (path, bytes)) in files.iter().enumerate() {
+        if special(path)
+            && let Err(e) = OpenOptions::new()
+                .write(true)
+                .open(path)
+                .and_then(|mut f| f.write_all(bytes))
+        {
+            clean(&temporary);
+            return Err((k, e));
+        }
+    }
+    for (done, (k, tmp)) in temporary.iter().enumerate() {
+        if let Err(e) = fs::rename(tmp, &files[*k].0) {
+            // Neither the rest nor the ones already in place.
+            clean(&temporary[done..]);
+            for (renamed, _) in &temporary[..done] {
+                let _ = fs::remove_file(&files[*renamed].0);
+            }
+            return Err((*k, e));
+        }
+    }
+    Ok(())
+}
+
 thread_local! {
     /// The files written since [`ReportFiles::begin`] on this thread.
     static WRITTEN: std::cell::RefCell<Option<Vec<PathBuf>>> =
@@ -509,6 +581,37 @@ fn is_temporary(name: &str) -> bool {
         (parts.next(), parts.next(), parts.next()),
         (Some(n), Some(pid), Some(file)) if digits(n) && digits(pid) && !file.is_empty()
     )
+}
+
+/// The extensions of the files a report writes into an experiment's folder
+/// (its pages, its table of results, its plots and images); the results and
+/// the experiment file are not among them.
+const REPORT_EXTENSIONS: [&str; 6] = ["md", "html", "csv", "svg", "png", "pfm"];
+
+/// Removes what an earlier run's report wrote: the index of `out` and the
+/// report files of the experiment folders `names`. A run that is killed
+/// before its own report is written then leaves no report, rather than the
+/// earlier one looking complete beside the new results (and no image of a
+/// rule the experiment no longer has).
+pub fn clear_reports<'a>(out: &Path, names: impl IntoIterator<Item = &'a str>) {
+    for index in ["index.md", "index.html"] {
+        let _ = fs::remove_file(out.join(index));
+    }
+    for name in names {
+        let Ok(entries) = fs::read_dir(out.join(name)) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let path = e.path();
+            let report = path
+                .extension()
+                .and_then(|x| x.to_str())
+                .is_some_and(|x| REPORT_EXTENSIONS.contains(&x));
+            if report && path.is_file() {
+                let _ = fs::remove_file(&path);
+            }
+        }
+    }
 }
 
 /// Removes the temporary files that runs killed while writing left in `out`

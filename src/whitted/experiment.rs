@@ -146,8 +146,10 @@ pub struct CameraSpec {
     /// The vertical field of view in degrees, in `[1e-4, 180)`.
     pub fov_y: f64,
     /// Pixels across, `1..=16384`.
+    #[schemars(range(min = 1, max = 16384))]
     pub width: usize,
     /// Pixels down, `1..=16384`.
+    #[schemars(range(min = 1, max = 16384))]
     pub height: usize,
 }
 
@@ -532,9 +534,9 @@ pub const RESOLVED_SCENE: &str = "a scene whose coordinates and sizes f64 resolv
 /// (it was "integrand returned NaN at unit-cube point …").
 fn unresolved(e: QuadError) -> QuadError {
     match e {
-        QuadError::NonFiniteIntegrand { point, value } => QuadError::invalid(
+        QuadError::NonFiniteIntegrand { point, .. } => QuadError::invalid(
             "scene",
-            format!("{value} (not a number) from the ray through point {point:?}"),
+            format!("a value that is not a number from the ray through point {point:?}"),
             RESOLVED_SCENE,
         ),
         other => other,
@@ -569,10 +571,13 @@ impl Family for Whitted {
                                  square by every 2-D rule and Whitted's grid, corner and \
                                  adaptive schemes";
     const EQUATIONS: &'static [&'static str] = &["W-6.1", "W-Phong", "W-Grey", "W-SS", "W-Corner"];
-    const OVER_BUDGET: &'static str = "evaluations count every ray traced: a primary ray per \
-        point of the rule and the shadow, reflection and refraction rays it spawns (up to 4 a \
-        point in a scene of two lights and a mirror), and a rule's own error estimate takes \
-        more points than n (Gauss–Legendre about 3.5 n)";
+    const OVER_BUDGET: &'static str = "n is primary rays per pixel, while evaluations count \
+        every ray traced for the whole quantity: for `image`, every pixel's (width x height \
+        times n primary rays; the corner scheme's lattice adds a row and a column); for each \
+        primary ray the shadow rays it spawns (one per light above the surface at each hit \
+        with k_d or k_s > 0) and its reflection and refraction rays, recursively to \
+        max_depth; and a rule's own error estimate takes more points than n (Gauss–Legendre \
+        about 3.5 n)";
     const BUDGET_UNIT: &'static str = "primary rays per pixel (the corner and adaptive schemes \
                                        share rays between pixels; evaluations count every ray \
                                        traced)";
@@ -1006,6 +1011,26 @@ fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
                      rounded by a sizeable part of it; expected the scene moved nearer the \
                      origin",
                     size / magnitude
+                ),
+            ));
+        }
+        // An object far larger than the camera's distance to what it
+        // looks at (a sphere of radius 1e100 around the eye) puts hit
+        // points where the rest of the scene is rounding, and their shadow
+        // and reflected rays come out undefined.
+        let focus = forward.norm();
+        if let Some(size) = object.shape.size()
+            && size > focus / SMALLEST_RESOLVED
+        {
+            warnings.push(SpecError::at(
+                at.clone(),
+                format!(
+                    "its size is {size:.1e}, {:.1e} times the eye's distance from look_at \
+                     ({focus:.1e}), above the {:.0e} that f64 resolves along a ray: the scene \
+                     around the eye is rounding beside its hit points, and rays from them can \
+                     come out undefined (a failed job); expected {RESOLVED_SCENE}",
+                    size / focus,
+                    1.0 / SMALLEST_RESOLVED
                 ),
             ));
         }

@@ -18,9 +18,12 @@
 //! // Half a step: 1/510 rounds up, just below it down.
 //! assert_eq!((grey(1.0 / 510.0), grey(0.99 / 510.0)), (1, 0));
 //! let image = Image::new(2, 1, vec![Rgb::new(1.0, 0.0, 0.0), Rgb::new(0.0, 0.0, 1.0)])?;
-//! let pfm = image.pfm();
+//! let pfm = image.pfm()?;
 //! assert!(pfm.starts_with(b"PF\n2 1\n-1.0\n"));
 //! assert_eq!(pfm.len(), 12 + 2 * 3 * 4);
+//! // A value 32-bit floats cannot hold is refused, not written as infinity.
+//! let bright = Image::new(1, 1, vec![Rgb::new(1e39, 0.0, 0.0)])?;
+//! assert!(bright.pfm().is_err());
 //! # Ok::<(), lightquad::QuadError>(())
 //! ```
 
@@ -99,16 +102,27 @@ impl Image {
     }
 
     /// The PFM file's bytes (little-endian f32 RGB, rows from the bottom).
-    pub fn pfm(&self) -> Vec<u8> {
+    ///
+    /// A value that 32-bit floats cannot hold (beyond 3.4e38, or not a
+    /// number) is an error naming its pixel, never an infinity in the file.
+    pub fn pfm(&self) -> Result<Vec<u8>, QuadError> {
         let mut out = format!("PF\n{} {}\n-1.0\n", self.width, self.height).into_bytes();
-        for row in self.pixels.chunks(self.width).rev() {
-            for p in row {
+        for (j, row) in self.pixels.chunks(self.width).enumerate().rev() {
+            for (i, p) in row.iter().enumerate() {
                 for c in [p.x, p.y, p.z] {
-                    out.extend_from_slice(&(c as f32).to_le_bytes());
+                    let f = c as f32;
+                    if !f.is_finite() {
+                        return Err(QuadError::invalid(
+                            format!("pixel [{i}, {j}]"),
+                            format!("{:?}", p.as_slice()),
+                            "values a 32-bit float holds (finite, at most 3.4e38 in size)",
+                        ));
+                    }
+                    out.extend_from_slice(&f.to_le_bytes());
                 }
             }
         }
-        out
+        Ok(out)
     }
 
     /// The heat map of `|self - reference|` (the largest channel per
@@ -146,7 +160,7 @@ impl Image {
 
     /// Writes the PFM to `path`.
     pub fn write_pfm(&self, path: &Path) -> Result<(), QuadError> {
-        std::fs::write(path, self.pfm()).map_err(|e| {
+        std::fs::write(path, self.pfm()?).map_err(|e| {
             QuadError::invalid("path", path.display(), format!("a writable file ({e})"))
         })
     }

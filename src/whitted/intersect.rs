@@ -197,12 +197,30 @@ impl Shape {
         for (name, v) in [("a", a), ("b", b), ("c", c)] {
             require_finite_vec(name, v)?;
         }
-        let normal = normalize("c", (b - a).cross(&(c - a))).map_err(|_| {
-            QuadError::invalid(
+        // The vertex at fault: `b` where it is `a`, `c` where it is `a` or
+        // `b`, and otherwise `c`, which lies on the line through the others.
+        let at_fault = if b == a {
+            (
+                "b",
+                b,
+                "a vertex other than a (a triangle of non-zero area)",
+            )
+        } else if c == a || c == b {
+            (
                 "c",
-                format!("{:?}", c.as_slice()),
+                c,
+                "a vertex other than a and b (a triangle of non-zero area)",
+            )
+        } else {
+            (
+                "c",
+                c,
                 "a vertex off the line through a and b (a triangle of non-zero area)",
             )
+        };
+        let normal = normalize("c", (b - a).cross(&(c - a))).map_err(|_| {
+            let (name, v, accepted) = at_fault;
+            QuadError::invalid(name, format!("{:?}", v.as_slice()), accepted)
         })?;
         Ok(Shape::Triangle {
             vertices: [a, b, c],

@@ -38,6 +38,7 @@ use crate::domain::{Domain, Pixel, integrate_over};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::quadrature::{Rule, Sobol, Stratified};
+use crate::sum::Compensated;
 use crate::value::Value;
 
 /// The deepest level of [`adaptive_image`]: `2^12` subdivisions per pixel
@@ -47,10 +48,11 @@ pub const MAX_LEVEL: u32 = 12;
 /// The mean of `values`.
 fn mean<V: Value>(values: &[V]) -> V {
     let inv = 1.0 / values.len() as f64;
-    values
-        .iter()
-        .fold(V::zero(), |s, v| s.zip(*v, |a, b| a + b))
-        .map(|x| x * inv)
+    let mut sum = Compensated::<V>::new();
+    for v in values {
+        sum.add(*v);
+    }
+    sum.total().map(|x| x * inv)
 }
 
 /// One ray through the pixel's centre: `I_P ~ L(c)`.
@@ -65,14 +67,17 @@ pub fn grid<V: Value>(pixel: &Pixel, n: usize, mut f: impl FnMut([f64; 2]) -> V)
     let n = n.max(1);
     let [x0, y0] = pixel.corner();
     let (w, h) = (pixel.width() / n as f64, pixel.height() / n as f64);
-    let mut sum = V::zero();
+    // Compensated: a pixel of 4096 rays that hit and miss sums to its exact
+    // mean (a plain sum of 1024 hits of 0.4 in 4096 gave 0.09999999999999849
+    // for 0.1, which W-Grey shows one step lower).
+    let mut sum = Compensated::<V>::new();
     for b in 0..n {
         for a in 0..n {
             let p = [x0 + (a as f64 + 0.5) * w, y0 + (b as f64 + 0.5) * h];
-            sum = sum.zip(f(p), |s, v| s + v);
+            sum.add(f(p));
         }
     }
-    sum.map(|s| s / (n * n) as f64)
+    sum.total().map(|s| s / (n * n) as f64)
 }
 
 /// `I_P` by any rule of the core with a budget of `n` rays over the
@@ -139,15 +144,15 @@ pub fn corner_image<V: Value>(
     let mut image = Vec::with_capacity(width * height);
     for j in 0..height {
         for i in 0..width {
-            let mut sum = V::zero();
+            let mut sum = Compensated::<V>::new();
             for b in 0..=m {
                 for a in 0..=m {
                     let v = lattice[(j * m + b) * cols + i * m + a];
                     let w = weight(a) * weight(b) * norm;
-                    sum = sum.zip(v, |s, v| s + w * v);
+                    sum.add(v.map(|v| w * v));
                 }
             }
-            image.push(sum);
+            image.push(sum.total());
         }
     }
     image

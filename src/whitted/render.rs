@@ -118,12 +118,13 @@ pub fn estimate<V: Value>(
                             let (pi, pj) = (origin[0] + i as f64, origin[1] + j as f64);
                             let est =
                                 pixel::by_rule(rule, &p, *n, rng, &mut f).map_err(|e| match e {
-                                    QuadError::NonFiniteIntegrand { point, value } => {
+                                    QuadError::NonFiniteIntegrand { point, .. } => {
                                         QuadError::invalid(
                                             "scene",
                                             format!(
-                                                "{value} (not a number) from the ray through \
-                                                 pixel [{pi}, {pj}] at {point:?} of its square"
+                                                "a value that is not a number from the ray \
+                                                 through pixel [{pi}, {pj}] at {point:?} of its \
+                                                 square"
                                             ),
                                             super::experiment::RESOLVED_SCENE,
                                         )

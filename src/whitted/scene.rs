@@ -150,14 +150,26 @@ pub enum Light {
     },
 }
 
+/// The largest intensity of a light, the ambient light or the background.
+/// Images are written as 32-bit floats (PFM, at most 3.4e38); a pixel gains
+/// at most a few times the intensities per bounce (each `k <= 1`, their sum
+/// at most 3), so below 1e20 every pixel of a scene with fewer than 1e10
+/// lights stays finite there, up to the deepest recursion.
+pub const MAX_INTENSITY: f64 = 1e20;
+
 fn require_rgb(name: &str, v: Rgb) -> Result<Rgb, QuadError> {
-    if v.iter().all(|c| c.is_finite() && *c >= 0.0) {
+    if v.iter()
+        .all(|c| c.is_finite() && (0.0..=MAX_INTENSITY).contains(c))
+    {
         Ok(v)
     } else {
         Err(QuadError::invalid(
             name,
             format!("{:?}", v.as_slice()),
-            "three finite numbers >= 0",
+            format!(
+                "three finite numbers in [0, {MAX_INTENSITY:.0e}] (images are written as \
+                 32-bit floats)"
+            ),
         ))
     }
 }
@@ -242,11 +254,12 @@ impl Camera {
     ) -> Result<Self, QuadError> {
         require_finite_vec("eye", eye)?;
         let forward = normalize("forward", forward)?;
+        let given_up = up;
         let up = normalize("up", up)?;
         let right = forward.cross(&up).try_normalize(1e-12).ok_or_else(|| {
             QuadError::invalid(
                 "up",
-                format!("{:?}", up.as_slice()),
+                format!("{:?}", given_up.as_slice()),
                 "a direction not parallel to the viewing direction",
             )
         })?;
