@@ -65,6 +65,68 @@ impl<V: Value> Compensated<V> {
     }
 }
 
+/// Independent running sums a long sum is spread over, term `i` into lane
+/// `i mod LANES`.
+pub const LANES: usize = 4;
+
+/// A compensated sum of products `w_i y_i` kept in [`LANES`] lanes. One
+/// running sum is a chain of dependent additions, one addition's latency
+/// (about four cycles) per term, longer than the rest of a cheap term's
+/// work; four chains overlap. The lanes' sums and carries are combined,
+/// compensated, at the end.
+#[derive(Debug, Clone, Copy)]
+pub struct Lanes<V: Value> {
+    lanes: [Compensated<V>; LANES],
+}
+
+impl<V: Value> Default for Lanes<V> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<V: Value> Lanes<V> {
+    /// An empty sum.
+    pub fn new() -> Self {
+        Self {
+            lanes: [Compensated::new(); LANES],
+        }
+    }
+
+    /// Adds `w_i y_i` for every `i` of `ys` and `ws` (of equal length): each
+    /// group of [`LANES`] terms one per lane, the terms after the last whole
+    /// group into lane 0 (every lane index a constant, so the lanes can stay
+    /// in registers).
+    #[inline(always)]
+    pub fn add_products(&mut self, ys: &[V], ws: &[f64]) {
+        // A local copy, which the compiler keeps in registers.
+        let mut lanes = self.lanes;
+        let mut y4 = ys.chunks_exact(LANES);
+        let mut w4 = ws.chunks_exact(LANES);
+        for (y, w) in (&mut y4).zip(&mut w4) {
+            for k in 0..LANES {
+                lanes[k].add(y[k].map(|v| v * w[k]));
+            }
+        }
+        for (y, w) in y4.remainder().iter().zip(w4.remainder()) {
+            lanes[0].add(y.map(|v| v * w));
+        }
+        self.lanes = lanes;
+    }
+
+    /// The compensated total of every lane.
+    pub fn total(&self) -> V {
+        let mut all = Compensated::new();
+        for lane in &self.lanes {
+            all.add(lane.sum);
+        }
+        for lane in &self.lanes {
+            all.add(lane.carry);
+        }
+        all.total()
+    }
+}
+
 /// Compensated sum of an iterator of `f64`.
 pub fn sum_f64(values: impl IntoIterator<Item = f64>) -> f64 {
     let mut acc = Compensated::<f64>::new();
