@@ -761,11 +761,15 @@ pub fn run_experiment_in_lanes(
     }
     write_atomic(&path, text.as_bytes())?;
     let done: BTreeSet<_> = kept.iter().map(JobResult::key).collect();
-    let pending: Vec<_> = exp
+    let mut pending: Vec<_> = exp
         .jobs(opts.shard)
         .into_iter()
         .filter(|j| !done.contains(j))
         .collect();
+    // The largest budgets first, one job a task: a large job started last
+    // left the other threads idle while it ran (the longest-first order
+    // balances the threads best; the results are sorted after).
+    pending.sort_by_key(|&(rule, budget, repeat)| (std::cmp::Reverse(budget), rule, repeat));
     progress.inc((exp.jobs(opts.shard).len() - pending.len()) as u64);
     let file = Mutex::new(OpenOptions::new().append(true).open(&path)?);
     let run = |&key: &JobKey| {
@@ -781,7 +785,7 @@ pub fn run_experiment_in_lanes(
         Ok(result)
     };
     let fresh: Vec<std::io::Result<JobResult>> = if lanes >= rayon::current_num_threads() {
-        pending.par_iter().map(run).collect()
+        pending.par_iter().with_max_len(1).map(run).collect()
     } else {
         let lanes = lanes.max(1);
         (0..lanes)
