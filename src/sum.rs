@@ -74,6 +74,21 @@ pub const LANES: usize = 4;
 /// (about four cycles) per term, longer than the rest of a cheap term's
 /// work; four chains overlap. The lanes' sums and carries are combined,
 /// compensated, at the end.
+///
+/// ```
+/// use lightquad::sum::Lanes;
+///
+/// // Each term in its own lane: the lanes hold 1e16, 1, -1e16 and 1, and
+/// // their compensated total is the exact 2 (a plain sum gives 0 or 2
+/// // depending on order).
+/// let mut s = Lanes::<f64>::new();
+/// s.add_products(&[1e16, 1.0, -1e16, 1.0], &[1.0; 4]);
+/// assert_eq!(s.total(), 2.0);
+/// // Cancellation inside one lane too: 1e16 and -1e16 both land in lane 0.
+/// let mut t = Lanes::<f64>::new();
+/// t.add_products(&[1e16, 0.5, 0.25, 0.125, -1e16, 1.0], &[1.0; 6]);
+/// assert_eq!(t.total(), 1.875);
+/// ```
 #[derive(Debug, Clone, Copy)]
 pub struct Lanes<V: Value> {
     lanes: [Compensated<V>; LANES],

@@ -173,8 +173,9 @@ const BLOCK: usize = 64;
 /// nodes first, then the block is summed: an integrand that calls a
 /// function (`cos`) clobbers every floating-point register, so the running
 /// sums, carried across its calls, were stored and reloaded at every node
-/// (a third of the time of `cos(50 x)` at a million nodes). Summed apart,
-/// they stay in registers, in [`LANES`] independent lanes.
+/// (the sum took 1.13 to 1.18 times the bare evaluations of `cos(50 x)`,
+/// 1.10 to 1.12 now). Summed apart, they stay in registers, in [`LANES`]
+/// independent lanes.
 fn line_sum<V: Value>(
     a: &UnitNodes,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
