@@ -500,16 +500,7 @@ pub fn evaluate_counted(
         return Ok((measured(&est, rays.total()), rays));
     }
     let out = render::render_block(scene, corner, w, h, &scheme, rng).map_err(unresolved)?;
-    // Whitted's own schemes average rays without a rule's check: a pixel
-    // that is not a number is named here.
-    if let Some(k) = out.image.values.iter().position(|v| !v.all_finite()) {
-        let (i, j) = (corner[0] + k % w.max(1), corner[1] + k / w.max(1));
-        return Err(QuadError::invalid(
-            "scene",
-            format!("pixel [{i}, {j}] came out not a number"),
-            RESOLVED_SCENE,
-        ));
-    }
+    defined(&out.image.values, corner, w)?;
     Ok((measured(&out.image, out.rays.total()), out.rays))
 }
 
@@ -530,26 +521,27 @@ fn image_by_pixels(built: &Built, scheme: &Render) -> Result<Measured, QuadError
         })
         .collect::<Result<Vec<_>, _>>()
         .map_err(unresolved)?;
-    let mut rays = RayCount::default();
-    let mut image = Estimated {
-        values: Vec::with_capacity(parts.len()),
-        errors: Vec::with_capacity(parts.len()),
-        reliable: true,
-    };
-    for part in parts {
-        rays.add(part.rays);
-        image.values.extend(part.image.values);
-        image.errors.extend(part.image.errors);
-        image.reliable &= part.image.reliable;
-    }
-    if let Some(k) = image.values.iter().position(|v| !v.all_finite()) {
-        return Err(QuadError::invalid(
+    let out = render::Rendered::joined(parts);
+    defined(&out.image.values, [0, 0], width)?;
+    Ok(measured(&out.image, out.rays.total()))
+}
+
+/// Whitted's own schemes average rays without a rule's check: the first
+/// pixel of a block (at `corner`, `width` across) that is not a number is
+/// named as a fault of the scene.
+fn defined(values: &[Rgb], corner: [usize; 2], width: usize) -> Result<(), QuadError> {
+    match values.iter().position(|v| !v.all_finite()) {
+        Some(k) => Err(QuadError::invalid(
             "scene",
-            format!("pixel [{}, {}] came out not a number", k % width, k / width),
+            format!(
+                "pixel [{}, {}] came out not a number",
+                corner[0] + k % width.max(1),
+                corner[1] + k / width.max(1)
+            ),
             RESOLVED_SCENE,
-        ));
+        )),
+        None => Ok(()),
     }
-    Ok(measured(&image, rays.total()))
 }
 
 /// The least size of an object beside its distance from the eye that f64

@@ -210,19 +210,28 @@ pub fn render_parallel(scene: &Scene, scheme: &Scheme, seed: u64) -> Result<Rend
             render_block(scene, [0, b * BAND], width, rows, scheme, &mut rng)
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut rays = RayCount::default();
-    let mut image = Estimated {
-        values: Vec::with_capacity(width * height),
-        errors: Vec::with_capacity(width * height),
-        reliable: true,
-    };
-    for part in parts {
-        rays.add(part.rays);
-        image.values.extend(part.image.values);
-        image.errors.extend(part.image.errors);
-        image.reliable &= part.image.reliable;
+    Ok(Rendered::joined(parts))
+}
+
+impl Rendered {
+    /// The blocks of an image, in order, as one: their pixels one after
+    /// another, their rays added, reliable when every block is.
+    pub fn joined(parts: Vec<Rendered>) -> Rendered {
+        let pixels = parts.iter().map(|p| p.image.values.len()).sum();
+        let mut rays = RayCount::default();
+        let mut image = Estimated {
+            values: Vec::with_capacity(pixels),
+            errors: Vec::with_capacity(pixels),
+            reliable: true,
+        };
+        for part in parts {
+            rays.add(part.rays);
+            image.values.extend(part.image.values);
+            image.errors.extend(part.image.errors);
+            image.reliable &= part.image.reliable;
+        }
+        Rendered { image, rays }
     }
-    Ok(Rendered { image, rays })
 }
 
 /// The fraction of the block's pixels covered by some object (1 where the
