@@ -303,8 +303,15 @@ fn walks_that_all_agree_are_flagged_and_their_error_is_not_zero() {
             "{}: {alike}/{R} runs all alike, coverage {covered}/{R}",
             tracker.name()
         );
-        // Most runs are degenerate here (P(no walk through) = (1 - tau)^16 = 0.90).
-        assert!(alike > R * 8 / 10, "{}: {alike}", tracker.name());
+        match tracker {
+            // Most runs are degenerate here (P(no walk through) = (1 - tau)^16 = 0.90).
+            Tracker::Delta => assert!(alike > R * 8 / 10, "delta: {alike}"),
+            // Ratio tracking at the rate 10 sigma (D = 5: ratio_rate_factor)
+            // scores 0.9^K for K ~ Poisson(50) collisions, never all alike; at
+            // the bound itself (before 2026-11-24) every weight was 1 - sigma /
+            // (sigma (1 + 8 eps)) ~ 0 and every run was degenerate.
+            _ => assert_eq!(alike, 0, "ratio: {alike} runs all alike"),
+        }
         // The bound is conservative here: coverage must not fall below 95%.
         assert_at_least_95(covered, tracker.name());
     }

@@ -10,8 +10,8 @@ use lightquad::geometry::Ray;
 use lightquad::quadrature::{GaussLegendre, Trapezoid};
 use lightquad::volume::tracking::{Extinction, Tracker, transmittance};
 use lightquad::volume::{
-    DepthScheme, EmissionMap, GaussianBlob, GaussianBlobs, Medium, ShadowMethod, VolumeScene,
-    evaluate,
+    ConstantSphere, DepthScheme, EmissionMap, GaussianBlob, GaussianBlobs, Medium, ShadowMethod,
+    VolumeScene, evaluate,
 };
 use proptest::prelude::*;
 use statrs::distribution::{Binomial, DiscreteCDF};
@@ -189,6 +189,39 @@ fn ratio_tracking_has_lower_variance_than_delta_tracking() {
     };
     let (delta, ratio) = (se(Tracker::Delta), se(Tracker::Ratio));
     assert!(ratio < delta, "ratio {ratio} vs delta {delta}");
+}
+
+#[test]
+fn ratio_tracking_variance_is_campbells_at_its_rate() {
+    // A constant sigma = 1 over the diameter L = 2 of a unit sphere: one
+    // span's bound is sigma (1 + 8 eps), D = 2, so ratio tracking draws at
+    // mu = k sigma with k = min(2 D, 256 / D) = 4. A walk's weight
+    // (1 - 1/k)^K, K ~ Poisson(k D), has the relative variance
+    // exp(sigma^2 L / mu) - 1 = exp(1/2) - 1 = 0.6487 (Campbell; at the
+    // bound itself, k = 1, it would be e^2 - 1 = 6.39), and the mean e^-2.
+    let sphere = ConstantSphere::new(Vec3::zeros(), 1.0, 1.0).expect("valid");
+    let sigma = Extinction {
+        medium: &sphere,
+        lambda: 1.0,
+    };
+    let ray = Ray::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::x()).expect("valid");
+    let n = 200_000;
+    let t = transmittance(Tracker::Ratio, sigma, &ray, 0.0, 10.0, n, &mut rng(11)).expect("finite");
+    let tau = (-2.0f64).exp();
+    let relative_variance = (t.error / t.value).powi(2) * n as f64;
+    let exact = 0.5f64.exp() - 1.0;
+    assert!(
+        (relative_variance / exact - 1.0).abs() < 0.05,
+        "relative variance {relative_variance} vs {exact}"
+    );
+    assert!(
+        (t.value - tau).abs() < 4.0 * t.error,
+        "{} vs {tau}",
+        t.value
+    );
+    // About k D = 8 look-ups a walk (Poisson mean).
+    let per_walk = t.evaluations as f64 / n as f64;
+    assert!((per_walk - 8.0).abs() < 0.05, "{per_walk} look-ups a walk");
 }
 
 proptest! {

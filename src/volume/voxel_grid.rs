@@ -70,6 +70,16 @@ pub struct VoxelGrid {
     data_max: f64,
 }
 
+/// `floor(u)`, exact for `|u| < 2^63` (beyond it, the nearest of
+/// `+-2^63`; NaN gives 0): the truncation toward zero, one less where that
+/// rounded a negative number up. x86-64's baseline has no rounding
+/// instruction, so `f64::floor` is a libm call: it was 9% of a
+/// ratio-tracking walk through a voxel grid.
+fn floor(u: f64) -> f64 {
+    let t = (u as i64) as f64;
+    if t > u { t - 1.0 } else { t }
+}
+
 impl VoxelGrid {
     /// True when `p` is in the closed box.
     fn contains(&self, p: Vec3) -> bool {
@@ -199,7 +209,7 @@ impl VoxelGrid {
     /// `clamp(floor(u), 0, n - 1)` as an index.
     fn clamp_index(u: f64, n: usize) -> usize {
         // In range after the clamp, so the cast is exact.
-        u.floor().clamp(0.0, (n - 1) as f64) as usize
+        floor(u).clamp(0.0, (n - 1) as f64) as usize
     }
 
     /// The ray–box chord inside `[t_min, t_max]` by the slab method. An axis
@@ -256,21 +266,29 @@ impl Medium for VoxelGrid {
         if !self.contains(p) {
             return 0.0;
         }
-        // Per axis: the two clamped indices and the weight of the upper one.
+        // Per axis: the offsets into `data` of the two clamped indices
+        // around `u` and the weight of the upper one. Integer floors: one
+        // float-to-integer conversion per axis (it was 40 ns a look-up with
+        // `floor` and a clamped conversion per index).
+        let [nx, ny, _] = self.resolution;
+        let stride = [1, nx, nx * ny];
         let mut lower = [0usize; 3];
         let mut upper = [0usize; 3];
         let mut w = [0.0f64; 3];
         for k in 0..3 {
-            let n = self.resolution[k];
+            let last = self.resolution[k] as i64 - 1;
             let u = self.lattice(p, k);
-            let f = u.floor();
-            w[k] = u - f;
-            lower[k] = Self::clamp_index(u, n);
-            upper[k] = Self::clamp_index(f + 1.0, n);
+            // Inside the box `u` is in [-1/2, n - 1/2]: the cast is exact
+            // and `floor(u)` is the truncation, one less where it rounded up.
+            let t = u as i64;
+            let f = t - i64::from(t as f64 > u);
+            w[k] = u - f as f64;
+            lower[k] = f.clamp(0, last) as usize * stride[k];
+            upper[k] = (f + 1).clamp(0, last) as usize * stride[k];
         }
+        let at = |x: usize, y: usize, z: usize| self.data.get(x + y + z).copied().unwrap_or(0.0);
         let lerp = |a: f64, b: f64, t: f64| (1.0 - t) * a + t * b;
-        let row =
-            |y: usize, z: usize| lerp(self.value(lower[0], y, z), self.value(upper[0], y, z), w[0]);
+        let row = |y: usize, z: usize| lerp(at(lower[0], y, z), at(upper[0], y, z), w[0]);
         let plane = |z: usize| lerp(row(lower[1], z), row(upper[1], z), w[1]);
         lerp(plane(lower[2]), plane(upper[2]), w[2])
     }

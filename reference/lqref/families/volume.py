@@ -457,7 +457,31 @@ def light_single_scattering(exp, settings):
     ``volpath`` (max_depth 2: emitters seen directly, which a delta light never
     is, plus one scattering event with next-event estimation) with a
     ``directional`` emitter, read by a 1x1 ``radiancemeter`` with a box filter
-    looking along the eye ray; no background, no other emitter.
+    looking along the eye ray (:func:`single_scattering_scene`); no background,
+    no other emitter."""
+    built = single_scattering_scene(exp, settings.spp)
+    if built is None:
+        return _no_chord(0.0, "I_L = 0")
+    scene, (t_n, t_f), skipped, residual = built
+    value, std_error = mean_of_renders(scene, settings.passes, settings.spp, exp.seed)
+    return {
+        "value": value,
+        "std_error": std_error,
+        "samples": int(settings.passes * settings.spp),
+        "method": f"Mitsuba volpath, max_depth 2 (single scattering), directional emitter "
+                  f"(irradiance = I_p), 1x1 radiancemeter inside the medium at the ray's "
+                  f"entry, box filter; float64 mean of {settings.passes} renders of "
+                  f"{settings.spp} spp, standard error over renders",
+        "chord": [t_n, t_f],
+        "sensor_start_offset": skipped,  # distance past t_n where the sensor ray starts
+        "sensor_origin_residual": residual,
+    }
+
+
+def single_scattering_scene(exp, spp):
+    """The Mitsuba scene of :func:`light_single_scattering` with ``spp`` samples
+    per render, with the chord, how far past its entry the sensor ray starts
+    and the sensor origin's residual; None where the eye ray misses the medium.
 
     The radiancemeter starts at the eye ray's entry into the medium, inside it
     (its ``medium`` is the scene's medium): the part of the ray before the
@@ -480,12 +504,12 @@ def light_single_scattering(exp, settings):
     full_chord = medium_chord(scene, exp, clip=False)
     chord = medium_chord(scene, exp)
     if chord is None:
-        return _no_chord(0.0, "I_L = 0")
+        return None
     if chord != full_chord:
         raise SpecError("scene.t_min" if chord[0] != full_chord[0] else "scene.t_max",
                         "Mitsuba's sensor ray cannot be cut inside the medium: "
                         "I_L with t_min/t_max inside the chord is not expressible")
-    t_n, t_f = chord
+    t_n, _ = chord
     o, d = np.asarray(exp.scene.origin), np.asarray(exp.scene.direction)
     start, skipped = _inside_start(scene, o, d, t_n)
 
@@ -504,21 +528,9 @@ def light_single_scattering(exp, settings):
         "sensor": {"type": "radiancemeter", "origin": origin.tolist(),
                    "direction": d.tolist(), "medium": {"type": "ref", "id": "medium"},
                    "film": film,
-                   "sampler": {"type": "independent", "sample_count": settings.spp}},
+                   "sampler": {"type": "independent", "sample_count": spp}},
     })
-    value, std_error = mean_of_renders(scene, settings.passes, settings.spp, exp.seed)
-    return {
-        "value": value,
-        "std_error": std_error,
-        "samples": int(settings.passes * settings.spp),
-        "method": f"Mitsuba volpath, max_depth 2 (single scattering), directional emitter "
-                  f"(irradiance = I_p), 1x1 radiancemeter inside the medium at the ray's "
-                  f"entry, box filter; float64 mean of {settings.passes} renders of "
-                  f"{settings.spp} spp, standard error over renders",
-        "chord": [t_n, t_f],
-        "sensor_start_offset": skipped,  # distance past t_n where the sensor ray starts
-        "sensor_origin_residual": residual,
-    }
+    return scene, chord, skipped, residual
 
 
 def _inside_start(scene, o, d, t_n):
