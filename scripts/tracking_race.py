@@ -7,8 +7,11 @@ standard error of 1e-3 (issue 13, target 3).
 
 Run it from anywhere with reference/.venv's Python, or with plain python3:
 it re-executes itself under reference/.venv/bin/python when Mitsuba is not
-importable. Needs Debian's libllvm19 (``apt-get install libllvm19``) for the
-``llvm_ad_rgb`` variant; DRJIT_LIBLLVM_PATH defaults to its library.
+importable (``python3 -m venv reference/.venv &&
+reference/.venv/bin/pip install -r reference/requirements.txt`` makes it).
+Needs Debian's libllvm19 (``apt-get install libllvm19``) for the
+``llvm_ad_rgb`` variant; DRJIT_LIBLLVM_PATH defaults to its library. Builds
+the example ``tracking_race`` (lightquad's side) with cargo.
 
 The races, each lightquad's estimator against Mitsuba's own counterpart:
 
@@ -63,8 +66,9 @@ def reexec_in_venv():
         in_venv = Path(sys.prefix).resolve() == VENV_PYTHON.parent.parent.resolve()
         if VENV_PYTHON.exists() and not in_venv:
             os.execv(str(VENV_PYTHON), [str(VENV_PYTHON), __file__, *sys.argv[1:]])
-        sys.exit("tracking_race.py: Mitsuba 3 is not installed; run scripts/reference.sh "
-                 "(it makes reference/.venv) first")
+        sys.exit("tracking_race.py: Mitsuba 3 is not installed; make reference/.venv first:\n"
+                 "    python3 -m venv reference/.venv && "
+                 "reference/.venv/bin/pip install -r reference/requirements.txt")
 
 
 # ----------------------------------------------------------------------------
@@ -261,6 +265,30 @@ def race(name, lq, mts, target, repeats, pilot):
     }
 
 
+def table(rows, args):
+    """The rows as a Markdown table, with the agreement of the two estimates
+    (their difference over its standard error)."""
+    lines = [
+        f"Time to a relative standard error of {args.target:g}, {args.threads} thread(s) "
+        f"each, median of {args.repeats} runs; ratio = lightquad / Mitsuba (< 1: lightquad "
+        "faster).",
+        "",
+        "| estimator | lightquad walks | look-ups a walk | lightquad | Mitsuba walks "
+        "| look-ups a walk | Mitsuba | ratio | estimates differ by |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in rows:
+        lq, m = r["lightquad"], r["mitsuba"]
+        se = math.hypot(lq["rel_se"] * lq["value"], m["rel_se"] * m["value"])
+        z = (lq["value"] - m["value"]) / se
+        m_lookups = "-" if m["lookups_per_walk"] is None else f"{m['lookups_per_walk']:.2f}"
+        lines.append(
+            f"| {r['race']} | {lq['walks']:,} | {lq['lookups_per_walk']:.2f} | "
+            f"{lq['seconds'] * 1e3:.1f} ms | {m['walks']:,} | {m_lookups} | "
+            f"{m['seconds'] * 1e3:.1f} ms | {r['ratio']:.2f} | {z:+.1f} SE |")
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--target", type=float, default=1e-3, help="relative standard error")
@@ -326,7 +354,7 @@ def main():
         race("V-L, free-flight single scattering", lq_side("free-flight-light"), light_side(),
              args.target, args.repeats, pilot),
     ]
-    print(json.dumps(rows, indent=1))
+    print(table(rows, args))
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
 

@@ -66,6 +66,17 @@ pub trait Medium: std::fmt::Debug + Send + Sync {
     /// fields that never vanish; the medium says which in its docs).
     fn support(&self, ray: &Ray, t_min: f64, t_max: f64) -> Vec<Segment>;
 
+    /// The ends `(start, end)` of the pieces of [`Medium::support`], without
+    /// the cuts inside them: what tracking needs, which draws collisions,
+    /// not nodes. Media whose cuts cost more than their ends (a voxel grid
+    /// sorts a crossing per voxel-centre plane) answer it directly.
+    fn extent(&self, ray: &Ray, t_min: f64, t_max: f64) -> Vec<(f64, f64)> {
+        self.support(ray, t_min, t_max)
+            .iter()
+            .map(|p| (p.start(), p.end()))
+            .collect()
+    }
+
     /// An upper bound of the density on `[t0, t1]` along `ray` (a majorant for
     /// delta and ratio tracking).
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64;

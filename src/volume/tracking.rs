@@ -16,8 +16,9 @@
 //!   tentative collisions drawn against the residual majorant
 //!   `sigma_r = max(sigma_bar - sigma_c, sigma_c) >= |sigma - sigma_c|`.
 //!
-//! Every smooth piece is cut into 16 spans, each with its own majorant (and
-//! control); the per-walk scores of the spans multiply, and a free flight
+//! Every piece of the medium along the ray is cut into 16 spans (4 on a
+//! shadow ray, whose one walk pays for their set-up), each with its own
+//! majorant (and control); the per-walk scores of the spans multiply, and a free flight
 //! that leaves a span carries its unused optical depth into the next.
 //!
 //! [`radiance`] extends delta tracking from `tau` to V-E, V-B, V-L and V-I
@@ -297,28 +298,35 @@ fn check(lambda: f64, t0: f64, t1: f64, n: usize) -> Result<(), QuadError> {
     Ok(())
 }
 
-/// The spans of `[t0, t1]` along `ray`: each smooth piece is cut into SPANS
-/// equal spans with a majorant of their own (tight majorants mean few
-/// tentative collisions); residual ratio tracking also gets a control
-/// extinction per span, the span's mean from a 4-point Gauss–Legendre rule,
-/// computed once for all walks (its evaluations are added to `evaluations`).
+/// Spans per piece of the eye ray: its walks share them, so tight majorants
+/// (few tentative collisions) are worth their set-up.
+const SPANS: usize = 16;
+
+/// Spans per piece of a shadow ray: one walk uses them, so their set-up (a
+/// majorant each) is most of its cost.
+const SHADOW_SPANS: usize = 4;
+
+/// The spans of `[t0, t1]` along `ray`: each piece of the medium's extent is
+/// cut into `per_piece` equal spans with a majorant of their own (tight
+/// majorants mean few tentative collisions); residual ratio tracking also
+/// gets a control extinction per span, the span's mean from a 4-point
+/// Gauss–Legendre rule, computed once for all walks (its evaluations are
+/// added to `evaluations`).
 fn spans(
     tracker: Tracker,
     sigma: Extinction,
     ray: &Ray,
-    t0: f64,
-    t1: f64,
+    (t0, t1): (f64, f64),
+    per_piece: usize,
     evaluations: &mut u64,
 ) -> Result<Vec<Span>, QuadError> {
-    const SPANS: usize = 16;
     let Extinction { medium, lambda } = sigma;
     let mut spans: Vec<Span> = Vec::new();
-    for piece in medium.support(ray, t0, t1) {
-        let (a, b) = (piece.start(), piece.end());
-        let width = (b - a) / SPANS as f64;
-        for i in 0..SPANS {
+    for (a, b) in medium.extent(ray, t0, t1) {
+        let width = (b - a) / per_piece as f64;
+        for i in 0..per_piece {
             let s0 = a + width * i as f64;
-            let s1 = if i + 1 == SPANS { b } else { s0 + width };
+            let s1 = if i + 1 == per_piece { b } else { s0 + width };
             let v_bar = medium.max_density(ray, s0, s1);
             let bar = lambda * v_bar;
             if !bar.is_finite() {
@@ -489,7 +497,7 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
 ) -> Result<Tracked, QuadError> {
     check(sigma.lambda, t0, t1, n)?;
     let mut evaluations = 0u64;
-    let spans = spans(tracker, sigma, ray, t0, t1, &mut evaluations)?;
+    let spans = spans(tracker, sigma, ray, (t0, t1), SPANS, &mut evaluations)?;
     // A majorant of 0 everywhere: no collision is possible, every walk scores
     // 1, and tau = 1 is exact (no Wilson bound, no flag).
     if spans.iter().all(|s| s.bar == 0.0) {
@@ -646,7 +654,14 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
     };
     let sigma = Extinction { medium, lambda };
     let mut evaluations = 0u64;
-    let spans = spans(Tracker::Delta, sigma, &ray, t0, t1, &mut evaluations)?;
+    let spans = spans(
+        Tracker::Delta,
+        sigma,
+        &ray,
+        (t0, t1),
+        SPANS,
+        &mut evaluations,
+    )?;
     let scoring = emission.is_some() || light.is_some();
 
     // The largest score one tentative collision can add on a span, for the
@@ -818,12 +833,13 @@ fn spans_of_shadow(
     shadow_ray: &Ray,
     evaluations: &mut u64,
 ) -> Result<Vec<Span>, QuadError> {
+    let whole = (0.0, f64::INFINITY);
     spans(
         Tracker::Ratio,
         sigma,
         shadow_ray,
-        0.0,
-        f64::INFINITY,
+        whole,
+        SHADOW_SPANS,
         evaluations,
     )
 }

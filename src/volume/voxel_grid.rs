@@ -68,7 +68,14 @@ pub struct VoxelGrid {
     cell: Vec3,
     /// The largest value in `data`.
     data_max: f64,
+    /// The largest value of each block of `BLOCK^3` voxels (fewer at the
+    /// grid's far faces), x fastest, and the blocks per axis.
+    block_max: Vec<f64>,
+    blocks: [usize; 3],
 }
+
+/// Voxels per block edge of [`VoxelGrid`]'s block maxima.
+const BLOCK: usize = 4;
 
 /// `floor(u)`, exact for `|u| < 2^63` (beyond it, the nearest of
 /// `+-2^63`; NaN gives 0): the truncation toward zero, one less where that
@@ -160,6 +167,19 @@ impl VoxelGrid {
             }
             data_max = data_max.max(v);
         }
+        let blocks = resolution.map(|n| n.div_ceil(BLOCK));
+        let mut block_max = vec![0.0f64; blocks.iter().product()];
+        for (i, &v) in data.iter().enumerate() {
+            let (x, y, z) = (
+                i % resolution[0],
+                i / resolution[0] % resolution[1],
+                i / (resolution[0] * resolution[1]),
+            );
+            let b = ((z / BLOCK) * blocks[1] + y / BLOCK) * blocks[0] + x / BLOCK;
+            if let Some(m) = block_max.get_mut(b) {
+                *m = m.max(v);
+            }
+        }
         Ok(VoxelGrid {
             min,
             max,
@@ -167,6 +187,8 @@ impl VoxelGrid {
             data,
             cell,
             data_max,
+            block_max,
+            blocks,
         })
     }
 
@@ -319,15 +341,21 @@ impl Medium for VoxelGrid {
             .collect()
     }
 
-    /// The largest value over the voxels whose interpolation stencils the
-    /// chord inside `[t0, t1]` can reach: the index box spanned by the chord's
-    /// end points (each widened to the neighbouring centre), not the global
-    /// maximum. Times `1 + 8 eps` for the rounding of the interpolation
-    /// weights; 0 where the ray misses the box.
+    /// The chord: one piece, whose cuts tracking does not need.
+    fn extent(&self, ray: &Ray, t_min: f64, t_max: f64) -> Vec<(f64, f64)> {
+        self.chord(ray, t_min, t_max).into_iter().collect()
+    }
+
     fn centre(&self) -> Option<Vec3> {
         Some((self.min + self.max) * 0.5)
     }
 
+    /// The largest value over the voxels whose interpolation stencils the
+    /// chord inside `[t0, t1]` can reach: the index box spanned by the chord's
+    /// end points (each widened to the neighbouring centre), not the global
+    /// maximum; over the blocks of 4^3 voxels holding the box where it has
+    /// more than 64 voxels. Times `1 + 8 eps` for the rounding of the
+    /// interpolation weights; 0 where the ray misses the box.
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
         let Some((a, b)) = self.chord(ray, t0, t1) else {
             return 0.0;
@@ -342,8 +370,25 @@ impl Medium for VoxelGrid {
             hi[k] = Self::clamp_index(ua.max(ub) + LATTICE_SLACK + 1.0, n);
         }
         let whole = (0..3).all(|k| lo[k] == 0 && hi[k] + 1 == self.resolution[k]);
+        let voxels: usize = (0..3).map(|k| hi[k] + 1 - lo[k]).product();
         let peak = if whole {
             self.data_max
+        } else if voxels > BLOCK * BLOCK * BLOCK {
+            // Many voxels (a long span, a shadow ray's): the maxima of the
+            // blocks that hold them, a few reads instead of hundreds, and a
+            // bound no less safe (it may take in voxels just outside the
+            // box, so it is looser).
+            let [bx, by, _] = self.blocks;
+            let mut m: f64 = 0.0;
+            for z in lo[2] / BLOCK..=hi[2] / BLOCK {
+                for y in lo[1] / BLOCK..=hi[1] / BLOCK {
+                    for x in lo[0] / BLOCK..=hi[0] / BLOCK {
+                        let b = (z * by + y) * bx + x;
+                        m = m.max(self.block_max.get(b).copied().unwrap_or(f64::INFINITY));
+                    }
+                }
+            }
+            m
         } else {
             let mut m: f64 = 0.0;
             for z in lo[2]..=hi[2] {

@@ -264,20 +264,31 @@ def medium_chord(scene, exp, clip=True):
     si = scene.ray_intersect(mi.Ray3f(point(o), vector(d)))
     if not si.is_valid():
         return None
-    if float(np.dot(np.asarray(si.n), d)) > 0.0:
-        t_n, t_f = 0.0, float(si.t)  # the origin is inside: the first hit is the exit
+    if float(np.dot(_flat(si.n), d)) > 0.0:
+        t_n, t_f = 0.0, _scalar(si.t)  # the origin is inside: the first hit is the exit
     else:
-        t_n = float(si.t)
+        t_n = _scalar(si.t)
         bb = scene.bbox()
-        span = float(np.linalg.norm(np.asarray(bb.max) - np.asarray(bb.min)))
+        span = float(np.linalg.norm(_flat(bb.max) - _flat(bb.min)))
         far = t_n + 1.5 * span
         back = scene.ray_intersect(mi.Ray3f(point(o + far * d), vector(-d)))
-        if not back.is_valid() or float(np.dot(np.asarray(back.n), -d)) > 0.0:
+        if not back.is_valid() or float(np.dot(_flat(back.n), -d)) > 0.0:
             raise RuntimeError("could not find the exit of the eye ray from the medium")
-        t_f = far - float(back.t)
+        t_f = far - _scalar(back.t)
     if clip:
         t_n, t_f = max(t_n, exp.scene.t_min), min(t_f, exp.scene.t_max)
     return (t_n, t_f) if t_n < t_f else None
+
+
+def _flat(v):
+    """A Mitsuba vector or point as a float64 array of its three components
+    (in a vectorised variant such as ``llvm_ad_rgb`` each is an array of one)."""
+    return np.asarray(v, dtype=np.float64).reshape(-1)
+
+
+def _scalar(x):
+    """A Mitsuba number as a float (an array of one in a vectorised variant)."""
+    return float(np.asarray(x, dtype=np.float64).reshape(-1)[0])
 
 
 def medium_interaction(p=(0.0, 0.0, 0.0)):
@@ -544,7 +555,7 @@ def _inside_start(scene, o, d, t_n):
     for _ in range(20):
         p = o + (t_n + eta) * d
         si = scene.ray_intersect(mi.Ray3f(point(p), vector(d)))
-        if si.is_valid() and float(np.dot(np.asarray(si.n), d)) > 0.0 and float(si.t) > eta:
+        if si.is_valid() and float(np.dot(_flat(si.n), d)) > 0.0 and _scalar(si.t) > eta:
             return p, eta
         eta *= 2.0
     raise RuntimeError("could not place the sensor inside the medium")
@@ -561,7 +572,7 @@ def _sensor_origin(start, d, film):
         sensor = mi.load_dict({"type": "radiancemeter", "origin": origin.tolist(),
                                "direction": d.tolist(), "film": film})
         ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f(0.5, 0.5), mi.Point2f(0.5, 0.5))
-        return np.asarray(ray.o, dtype=np.float64)
+        return _flat(ray.o)
 
     origin = start - (ray_origin(start) - start)
     residual = float(np.linalg.norm(ray_origin(origin) - start))
