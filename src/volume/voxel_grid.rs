@@ -66,6 +66,8 @@ pub struct VoxelGrid {
     data: Vec<f64>,
     /// Voxel size `h_k` per axis.
     cell: Vec3,
+    /// `1 / h_k` per axis.
+    per_cell: Vec3,
     /// The largest value in `data`.
     data_max: f64,
     /// The largest value of each block of `BLOCK^3` voxels (fewer at the
@@ -186,6 +188,7 @@ impl VoxelGrid {
             resolution,
             data,
             cell,
+            per_cell: cell.map(|h| 1.0 / h),
             data_max,
             block_max,
             blocks,
@@ -223,9 +226,12 @@ impl VoxelGrid {
         self.data.get((z * ny + y) * nx + x).copied().unwrap_or(0.0)
     }
 
-    /// The lattice coordinate `u_k = (x_k - min_k) / h_k - 1/2`.
+    /// The lattice coordinate `u_k = (x_k - min_k) / h_k - 1/2` (times the
+    /// stored `1 / h_k`: a division was a fifth of a look-up; the product is
+    /// within an ulp or two of the quotient, and the interpolation is
+    /// continuous across the voxel-centre planes where `floor(u)` changes).
     fn lattice(&self, p: Vec3, k: usize) -> f64 {
-        (p[k] - self.min[k]) / self.cell[k] - 0.5
+        (p[k] - self.min[k]) * self.per_cell[k] - 0.5
     }
 
     /// `clamp(floor(u), 0, n - 1)` as an index.
