@@ -45,8 +45,8 @@ fn number(v: &Value, path: &str) -> Result<f64, String> {
 }
 
 /// The volume scene of the experiment file `text`: its voxel grid, ray,
-/// lambda and light (if any).
-fn scene(text: &str) -> Result<VolumeScene, String> {
+/// lambda and, when `light`, its light.
+fn scene(text: &str, light: bool) -> Result<VolumeScene, String> {
     let v: Value = serde_json::from_str(text).map_err(|e| e.to_string())?;
     let m = "/scene/medium";
     if v.pointer(&format!("{m}/type")).and_then(Value::as_str) != Some("voxel-grid") {
@@ -80,7 +80,7 @@ fn scene(text: &str) -> Result<VolumeScene, String> {
     scene.lambda = v
         .pointer("/scene/lambda")
         .map_or(Ok(1.0), |_| number(&v, "/scene/lambda"))?;
-    if v.pointer("/scene/light").is_some() {
+    if light {
         let albedo = number(&v, "/scene/light/albedo")?;
         scene.light = Some(
             DirectionalLight::new(
@@ -159,27 +159,42 @@ fn race(
     })
 }
 
+/// The estimators this example races.
+const ESTIMATORS: &str =
+    "delta-tracking, ratio-tracking, residual-ratio-tracking or free-flight-light";
+
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [file, estimator, n, seed, threads] = args.as_slice() else {
         return Err("usage: tracking_race FILE ESTIMATOR WALKS SEED THREADS".into());
     };
     let text = std::fs::read_to_string(file).map_err(|e| format!("{file}: {e}"))?;
-    let scene = scene(&text)?;
-    let estimator = match estimator.as_str() {
-        "free-flight-light" if scene.light.is_some() => Estimator::Light,
-        "free-flight-light" => return Err("free-flight-light: the scene has no light".into()),
-        name => Estimator::Tau(
-            serde_json::from_value(serde_json::json!({ "rule": name }))
-                .map_err(|e| format!("ESTIMATOR: {e}"))?,
-        ),
+    let light = estimator == "free-flight-light";
+    let scene = scene(&text, light).map_err(|e| format!("{file}: {e}"))?;
+    let estimator = if light {
+        Estimator::Light
+    } else {
+        Estimator::Tau(
+            serde_json::from_value(serde_json::json!({ "rule": estimator }))
+                .map_err(|_| format!("ESTIMATOR {estimator:?}: expected {ESTIMATORS}"))?,
+        )
     };
     let parse = |s: &str, what: &str| s.parse::<usize>().map_err(|e| format!("{what}: {e}"));
     let (n, seed, threads) = (
         parse(n, "WALKS")?,
         parse(seed, "SEED")? as u64,
-        parse(threads, "THREADS")?.max(1),
+        parse(threads, "THREADS")?,
     );
+    // Every thread's share needs two walks for a standard error.
+    if !(1..=MAX_THREADS).contains(&threads) {
+        return Err(format!("THREADS = {threads}: expected 1 to {MAX_THREADS}"));
+    }
+    if n < 2 * threads {
+        return Err(format!(
+            "WALKS = {n}: expected at least 2 a thread, {} for THREADS = {threads}",
+            2 * threads
+        ));
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -198,3 +213,6 @@ fn main() -> Result<(), String> {
     );
     Ok(())
 }
+
+/// More threads than this machine kind ever has only adds start-up time.
+const MAX_THREADS: usize = 256;
