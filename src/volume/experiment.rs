@@ -378,7 +378,10 @@ impl family::Estimator for Tracker {
                  renderer does (emission and light at tentative collisions, shadow rays by ratio \
                  tracking); standard error (Wilson for tau)"
             }
-            Tracker::Ratio => "ratio tracking of tau (and I_B), per-span majorants; standard error",
+            Tracker::Ratio => {
+                "ratio tracking of tau (and I_B), per-span majorants, tentative collisions at \
+                 up to 2D times them (less variance); standard error"
+            }
             Tracker::ResidualRatio => {
                 "residual ratio tracking of tau (and I_B) with a per-span control extinction; \
                  standard error"
