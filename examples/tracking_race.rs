@@ -1,5 +1,6 @@
-//! Times lightquad's tracking estimators of V-tau through a voxel grid, for
-//! `scripts/tracking_race.py`, which races them against Mitsuba 3.
+//! Times lightquad's tracking estimators of V-tau and its free-flight
+//! estimator of V-L through a voxel grid, for `scripts/tracking_race.py`,
+//! which races them against Mitsuba 3.
 //!
 //! `cargo run --release --example tracking_race -- FILE ESTIMATOR WALKS SEED THREADS`
 //!
@@ -109,7 +110,7 @@ fn walks(
     seed: u64,
     stream: u128,
 ) -> Result<Tracked, QuadError> {
-    let mut rng = rand_pcg::Pcg64::new(seed as u128, 2 * stream + 1);
+    let mut rng = rand_pcg::Pcg64::new(seed as u128, stream);
     match (estimator, scene.medium.as_deref()) {
         (Estimator::Tau(tracker), Some(medium)) => {
             let sigma = Extinction {
@@ -185,10 +186,10 @@ fn main() -> Result<(), String> {
         parse(seed, "SEED")? as u64,
         parse(threads, "THREADS")?,
     );
-    // Every thread's share needs two walks for a standard error.
     if !(1..=MAX_THREADS).contains(&threads) {
         return Err(format!("THREADS = {threads}: expected 1 to {MAX_THREADS}"));
     }
+    // Every thread's share needs two walks for a standard error.
     if n < 2 * threads {
         return Err(format!(
             "WALKS = {n}: expected at least 2 a thread, {} for THREADS = {threads}",

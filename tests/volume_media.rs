@@ -576,6 +576,60 @@ fn voxel_grid_majorant_bounds_the_density_and_is_local() {
     }
 }
 
+#[test]
+fn voxel_grid_block_majorants_bound_the_density_and_extent_is_the_support() {
+    // 33 x 30 x 17 voxels, sides not multiples of the 4-voxel blocks, with
+    // sparse spikes: long sub-chords (index boxes of more than 64 voxels)
+    // take the blocks' maxima, short ones the voxels'. The bound must hold
+    // at every sampled point, stay below the global peak, and be local (a
+    // short sub-chord far from every spike gets less than the peak).
+    let res = [33usize, 30, 17];
+    let (lo, hi) = (Vec3::new(-1.0, -2.0, 0.5), Vec3::new(2.3, 1.0, 2.2));
+    let mut r = rng(9);
+    let data: Vec<f64> = (0..res.iter().product::<usize>())
+        .map(|i| {
+            if i % 997 == 3 {
+                50.0
+            } else {
+                r.random::<f64>()
+            }
+        })
+        .collect();
+    let grid = VoxelGrid::new(lo, hi, res, data).expect("valid grid");
+    let span = hi - lo;
+    let (mut long, mut short, mut below_peak) = (0, 0, 0);
+    for _ in 0..400 {
+        let o = lo + span.component_mul(&Vec3::new(r.random(), r.random(), r.random()));
+        let ray = Ray::new(o, random_unit(&mut r)).expect("valid");
+        let (a, b) = grid.chord(&ray, 0.0, f64::INFINITY).expect("inside");
+        // extent: the chord, the ends of the support's one piece.
+        let support = grid.support(&ray, 0.0, f64::INFINITY);
+        let ends: Vec<(f64, f64)> = support.iter().map(|p| (p.start(), p.end())).collect();
+        assert_eq!(grid.extent(&ray, 0.0, f64::INFINITY), ends);
+        let frac = if r.random::<bool>() { 1.0 } else { 0.05 };
+        let s = a + (b - a) * (1.0 - frac) * r.random::<f64>();
+        let e = s + (b - a) * frac;
+        let bar = grid.max_density(&ray, s, e);
+        if frac == 1.0 {
+            long += 1
+        } else {
+            short += 1
+        }
+        below_peak += usize::from(bar < 50.0);
+        assert!(bar <= 50.0 * (1.0 + 1e-14));
+        for j in 0..=400 {
+            let t = s + (e - s) * j as f64 / 400.0;
+            let v = grid.density(ray.at(t));
+            assert!(v <= bar, "density {v} above the bound {bar} at t = {t}");
+        }
+    }
+    assert!(long > 150 && short > 150);
+    assert!(
+        below_peak > 50,
+        "{below_peak} sub-chords got less than the peak"
+    );
+}
+
 // ---------------------------------------------------------------- bad input
 
 #[test]

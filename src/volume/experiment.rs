@@ -380,7 +380,7 @@ impl family::Estimator for Tracker {
             }
             Tracker::Ratio => {
                 "ratio tracking of tau (and I_B), per-span majorants, tentative collisions at \
-                 up to 2D times them (less variance); standard error"
+                 max(1, min(2D, 256/D)) times them (less variance); standard error"
             }
             Tracker::ResidualRatio => {
                 "residual ratio tracking of tau (and I_B) with a per-span control extinction; \

@@ -79,9 +79,9 @@ use crate::error::QuadError;
 use crate::geometry::Ray;
 use crate::quadrature::monte_carlo::{Welford, power_of_two_above};
 
-/// One span of a smooth piece with its majorant `bar >= sigma`, the control
-/// extinction (residual ratio tracking) and the rate tentative collisions are
-/// drawn at.
+/// One span of a piece of the medium's extent with its majorant
+/// `bar >= sigma`, the control extinction (residual ratio tracking) and the
+/// rate tentative collisions are drawn at.
 struct Span {
     a: f64,
     b: f64,
@@ -90,7 +90,8 @@ struct Span {
     /// The medium's density bound on the span (`bar / lambda`).
     v_bar: f64,
     control: f64,
-    /// The rate tentative collisions are drawn at.
+    /// The rate `walk` draws tentative collisions at (`radiance`, where it is
+    /// 0, draws at `1 / (b - a)` to score emission and light).
     majorant: f64,
 }
 
@@ -365,7 +366,9 @@ fn spans(
             };
             // Ratio tracking crosses the whole span: about `majorant * length`
             // tentative collisions per walk, known before the first walk.
-            // Refuse now instead of spinning up to the cap on every walk.
+            // Refuse now instead of spinning up to the cap on every walk. (The
+            // rate ratio tracking then draws at is k times this, with k > 1
+            // only where k D <= 256: ratio_rate_factor.)
             if tracker != Tracker::Delta && majorant * (s1 - s0) > (MAX_COLLISIONS / 2) as f64 {
                 return Err(too_deep(&span));
             }
@@ -396,9 +399,10 @@ const RATIO_COLLISIONS: f64 = 256.0;
 /// (Campbell's theorem for the Poisson process of rate `mu`), so its relative
 /// variance is `exp(int sigma^2 / mu) - 1`: it falls as the rate rises while
 /// the cost, `int mu` look-ups, rises linearly. At `mu = k sigma_bar` the
-/// product of the two is at most `k D (exp(D/k) - 1)`, which falls toward its
-/// floor `D^2` as `k` grows: at `k = 1` it is `D (e^D - 1)` (26x the floor
-/// at `D = 2.6`), at `k = 2 D` within 30% of it. The cap keeps a walk at
+/// product of the two is at most `k D (exp(D/k) - 1)`, which falls toward
+/// `D^2` as `k` grows: at `k = 1` it is `D (e^D - 1)` (4.8x `D^2` at
+/// `D = 2.6`), at `k = 2 D` within 30% of it. (For any rate the product is at
+/// least `(int sigma)^2`, by Cauchy–Schwarz.) The cap keeps a walk at
 /// about 256 look-ups (or `D`, where the bound alone needs more): past a
 /// depth of about 11 the variance is large for every affordable `k`.
 /// Scores stay in `[0, 1]` since `mu >= sigma`.

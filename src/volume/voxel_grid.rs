@@ -306,8 +306,9 @@ impl Medium for VoxelGrid {
         for k in 0..3 {
             let last = self.resolution[k] as i64 - 1;
             let u = self.lattice(p, k);
-            // Inside the box `u` is in [-1/2, n - 1/2]: the cast is exact
-            // and `floor(u)` is the truncation, one less where it rounded up.
+            // Inside the box `u` is in [-1/2, n - 1/2], in range of the
+            // cast, and `floor(u)` is the truncation, one less where it
+            // rounded up (as in `floor`, but kept as an integer).
             let t = u as i64;
             let f = t - i64::from(t as f64 > u);
             w[k] = u - f as f64;
@@ -407,5 +408,36 @@ impl Medium for VoxelGrid {
             m
         };
         peak * (1.0 + 8.0 * f64::EPSILON)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::floor;
+
+    #[test]
+    fn floor_is_the_librarys_in_range_and_saturates_beyond() {
+        let big = 2f64.powi(62) + 2048.0;
+        for u in [
+            -1.5,
+            -1.0,
+            -0.5,
+            -1e-300,
+            -0.0,
+            0.0,
+            1e-300,
+            0.5,
+            1.0,
+            2.999,
+            1e15 + 0.5,
+            -1e15 - 0.5,
+            big,
+            -big,
+        ] {
+            assert_eq!(floor(u), u.floor(), "floor({u})");
+        }
+        assert_eq!(floor(1e300), 2f64.powi(63));
+        assert_eq!(floor(-1e300), -(2f64.powi(63)));
+        assert_eq!(floor(f64::NAN), 0.0);
     }
 }
