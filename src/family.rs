@@ -480,6 +480,13 @@ pub trait Family: Sized + Send + Sync + 'static {
     /// The quantities `estimator` estimates.
     fn estimates(estimator: &Self::Estimator) -> &'static [Self::Quantity];
 
+    /// Checks the estimator's own parameters, as a quadrature rule's `check`
+    /// does; the error names the parameter, which the validator appends to
+    /// the rule's JSON path (`rules[0].threshold`). Ok by default.
+    fn check_estimator(_estimator: &Self::Estimator) -> Result<(), QuadError> {
+        Ok(())
+    }
+
     /// Why `estimator` cannot estimate `quantity` in this `scene`, though it
     /// estimates it in general ([`Family::estimates`]); checked when an
     /// experiment is validated. None: it can.

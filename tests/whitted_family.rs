@@ -602,8 +602,8 @@ fn bad_scenes_are_refused_with_the_path_and_what_is_accepted() {
     );
     refused(
         &broken("/rules/0", json!({"rule": "adaptive", "threshold": -1.0})),
-        "rules[0]",
-        &["threshold"],
+        "rules[0].threshold",
+        &["-1", "finite spread >= 0"],
     );
     // The one-pixel quantities need scene.pixel.
     let mut v: Value = serde_json::from_str(GOOD).expect("json");

@@ -728,6 +728,7 @@ fn check_methods<F: Family>(spec: &ExperimentSpec<F>, scene: &F::Scene) -> Resul
                 }
             }
             Method::Estimator(e) => {
+                F::check_estimator(e).map_err(|err| SpecError::from_quad(&at, err))?;
                 let can = F::estimates(e);
                 for (k, q) in spec.quantities.iter().enumerate() {
                     if !can.contains(q) {

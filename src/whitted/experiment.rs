@@ -665,15 +665,16 @@ impl Family for Whitted {
     }
 
     /// An adaptive threshold that is negative or not finite.
-    fn refuses(_: &Built, scheme: &Scheme, _: WhittedQuantity) -> Option<String> {
+    fn check_estimator(scheme: &Scheme) -> Result<(), QuadError> {
         match scheme {
             Scheme::Adaptive { threshold } if !(threshold.is_finite() && *threshold >= 0.0) => {
-                Some(format!(
-                    "invalid threshold = {threshold}: expected a finite spread >= 0 of a \
-                     square's corner values"
+                Err(QuadError::invalid(
+                    "threshold",
+                    threshold,
+                    "a finite spread >= 0 of a square's corner values",
                 ))
             }
-            _ => None,
+            _ => Ok(()),
         }
     }
 
