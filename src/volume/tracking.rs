@@ -514,43 +514,32 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
         });
     }
     let (control, crossings) = (control_factor(&spans), Crossing::of(&spans));
+    let mut evaluations_of_walks = 0u64;
+    let mut next = || {
+        let e = &mut evaluations_of_walks;
+        walk(tracker, sigma, ray, control, &crossings, e, rng)
+    };
     if tracker == Tracker::Delta {
         // Scores are 0 or 1: a count of the walks that got through is all
         // the Wilson error needs.
         let mut through = 0u64;
         for _ in 0..n {
-            let score = walk(
-                tracker,
-                sigma,
-                ray,
-                control,
-                &crossings,
-                &mut evaluations,
-                rng,
-            )?;
-            through += u64::from(score > 0.0);
+            through += u64::from(next()? > 0.0);
         }
         let n = n as u64;
         return Ok(Tracked {
             value: through as f64 / n as f64,
             error: wilson_error(through, n)?,
-            evaluations,
+            evaluations: evaluations + evaluations_of_walks,
             walks: n,
             all_alike: through == 0 || through == n,
         });
     }
     let mut scores = Scores::default();
     for _ in 0..n {
-        scores.add(walk(
-            tracker,
-            sigma,
-            ray,
-            control,
-            &crossings,
-            &mut evaluations,
-            rng,
-        )?);
+        scores.add(next()?);
     }
+    evaluations += evaluations_of_walks;
     // Scores in [0, 1] (residual ratio: a heuristic, see Tracked::all_alike).
     Ok(scores.tracked(evaluations, |x| x.max(1.0 - x)))
 }
