@@ -4,6 +4,7 @@
 standard error of 1e-3 (issue 13, target 3).
 
     scripts/tracking_race.py [--target 1e-3] [--threads 2] [--repeats 5] [--quick]
+                             [--only ratio|delta|light ...] [--json FILE]
 
 Run it from anywhere with reference/.venv's Python, or with plain python3:
 it re-executes itself under reference/.venv/bin/python when Mitsuba is not
@@ -330,6 +331,8 @@ def main():
     ap.add_argument("--repeats", type=int, default=5, help="timed runs, median")
     ap.add_argument("--quick", action="store_true", help="target 1e-2, 2 repeats: a smoke run")
     ap.add_argument("--json", type=Path, help="also write the rows to this file")
+    ap.add_argument("--only", choices=["ratio", "delta", "light"], action="append",
+                    help="race only this estimator (repeatable; default all three)")
     args = ap.parse_args()
     if args.quick:
         args.target, args.repeats = 1e-2, 2
@@ -381,14 +384,16 @@ def main():
         return side
 
     pilot = 2 ** 16
-    rows = [
-        race("V-tau, ratio tracking", lq_side("ratio-tracking"), tracker_side(False),
-             args.target, args.repeats, pilot),
-        race("V-tau, delta tracking", lq_side("delta-tracking"), tracker_side(True),
-             args.target, args.repeats, pilot),
-        race("V-L, free-flight single scattering", lq_side("free-flight-light"), light_side(),
-             args.target, args.repeats, pilot),
-    ]
+    races = {
+        "ratio": lambda: race("V-tau, ratio tracking", lq_side("ratio-tracking"),
+                              tracker_side(False), args.target, args.repeats, pilot),
+        "delta": lambda: race("V-tau, delta tracking", lq_side("delta-tracking"),
+                              tracker_side(True), args.target, args.repeats, pilot),
+        "light": lambda: race("V-L, free-flight single scattering",
+                              lq_side("free-flight-light"), light_side(), args.target,
+                              args.repeats, pilot),
+    }
+    rows = [run() for name, run in races.items() if not args.only or name in args.only]
     print(table(rows, args))
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))

@@ -484,6 +484,48 @@ fn voxel_grid_density_at_centres_is_the_data_and_between_them_trilinear() {
 }
 
 #[test]
+fn voxel_grid_density_is_the_clamped_trilinear_sum_anywhere_in_the_box() {
+    // An independent form of the field: the lattice coordinate clamped to
+    // the outer voxel centres, then the sum over the eight corners of the
+    // data times the product of the hat weights. Points all over the box,
+    // between the outer centres (density's short path) and in the margins
+    // (its path near the faces), and on the faces themselves.
+    let grid = random_grid(11);
+    let data = grid.data();
+    let (lo, hi) = (Vec3::from(LO), Vec3::from(hi()));
+    let n = RES.map(|r| r as f64);
+    let mut r = rng(12);
+    for i in 0..20_000 {
+        let mut p = Vec3::from_fn(|k, _| lo[k] + (hi[k] - lo[k]) * r.random::<f64>());
+        if i % 10 == 0 {
+            p[i % 3] = if i % 20 == 0 { lo[i % 3] } else { hi[i % 3] };
+        }
+        let u: [f64; 3] = std::array::from_fn(|k| {
+            ((p[k] - lo[k]) / (hi[k] - lo[k]) * n[k] - 0.5).clamp(0.0, n[k] - 1.0)
+        });
+        let want: f64 = (0..8)
+            .map(|c: usize| {
+                let (mut weight, mut index, mut stride) = (1.0, 0, 1);
+                for (k, &u) in u.iter().enumerate() {
+                    // The lower corner stays below the last centre, so
+                    // that u = n - 1 is the upper corner at weight 1.
+                    let i = (u.floor() as usize).min(RES[k] - 2) + (c >> k & 1);
+                    weight *= 1.0 - (u - i as f64).abs();
+                    index += i * stride;
+                    stride *= RES[k];
+                }
+                weight * data[index]
+            })
+            .sum();
+        let got = grid.density(p);
+        assert!(
+            (got - want).abs() <= 1e-13 * want.abs().max(1.0),
+            "{p:?}: {got} vs {want}"
+        );
+    }
+}
+
+#[test]
 fn voxel_grid_rays_parallel_to_faces_inside_on_and_outside_the_slab() {
     let grid = linear_grid();
     let m: Arc<dyn Medium> = Arc::new(grid.clone());

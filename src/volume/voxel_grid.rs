@@ -89,6 +89,16 @@ fn floor(u: f64) -> f64 {
     if t > u { t - 1.0 } else { t }
 }
 
+/// The trilinear interpolation of a voxel's eight corner values `v` (x
+/// fastest) at the weights `w` of the upper corner per axis:
+/// `lerp(a, b, t) = (1 - t) a + t b` along x, then y, then z.
+fn trilinear(v: [f64; 8], w: [f64; 3]) -> f64 {
+    let lerp = |a: f64, b: f64, t: f64| (1.0 - t) * a + t * b;
+    let row = |c: usize| lerp(v[c], v[c + 1], w[0]);
+    let plane = |c: usize| lerp(row(c), row(c + 2), w[1]);
+    lerp(plane(0), plane(4), w[2])
+}
+
 impl VoxelGrid {
     /// True when `p` is in the closed box.
     fn contains(&self, p: Vec3) -> bool {
@@ -234,6 +244,36 @@ impl VoxelGrid {
         (p[k] - self.min[k]) * self.per_cell[k] - 0.5
     }
 
+    /// [`Medium::density`] at `p` outside the box of the outer voxel
+    /// centres, `u` its lattice coordinate: out of line, so that the common
+    /// case inside that box is a short call.
+    #[cold]
+    #[inline(never)]
+    fn density_near_faces(&self, p: Vec3, u: [f64; 3]) -> f64 {
+        let [nx, ny, _] = self.resolution;
+        let stride = [1, nx, nx * ny];
+        if !self.contains(p) {
+            return 0.0;
+        }
+        // Near a face: the two indices around `u` clamp to the grid (the
+        // field is constant beyond the outer voxel centres). Inside the box
+        // `u` is in [-1/2, n - 1/2], in range of the cast, and `floor(u)` is
+        // the truncation, one less where it rounded up (as in `floor`, but
+        // kept as an integer).
+        let f = u.map(|u| {
+            let t = u as i64;
+            t - i64::from(t as f64 > u)
+        });
+        let w: [f64; 3] = std::array::from_fn(|k| u[k] - f[k] as f64);
+        let index =
+            |k: usize, i: i64| i.clamp(0, self.resolution[k] as i64 - 1) as usize * stride[k];
+        let pair = |k: usize| [index(k, f[k]), index(k, f[k] + 1)];
+        let [x, y, z] = [pair(0), pair(1), pair(2)];
+        let at = |i: usize| self.data.get(i).copied().unwrap_or(0.0);
+        let v = std::array::from_fn(|c| at(x[c & 1] + y[(c >> 1) & 1] + z[c >> 2]));
+        trilinear(v, w)
+    }
+
     /// `clamp(floor(u), 0, n - 1)` as an index.
     fn clamp_index(u: f64, n: usize) -> usize {
         // In range after the clamp, so the cast is exact.
@@ -291,35 +331,38 @@ impl Medium for VoxelGrid {
     }
 
     fn density(&self, p: Vec3) -> f64 {
-        if !self.contains(p) {
-            return 0.0;
-        }
-        // Per axis: the offsets into `data` of the two clamped indices
-        // around `u` and the weight of the upper one. Integer floors: one
-        // float-to-integer conversion per axis (it was 40 ns a look-up with
-        // `floor` and a clamped conversion per index).
         let [nx, ny, _] = self.resolution;
         let stride = [1, nx, nx * ny];
-        let mut lower = [0usize; 3];
-        let mut upper = [0usize; 3];
-        let mut w = [0.0f64; 3];
-        for k in 0..3 {
-            let last = self.resolution[k] as i64 - 1;
-            let u = self.lattice(p, k);
-            // Inside the box `u` is in [-1/2, n - 1/2], in range of the
-            // cast, and `floor(u)` is the truncation, one less where it
-            // rounded up (as in `floor`, but kept as an integer).
-            let t = u as i64;
-            let f = t - i64::from(t as f64 > u);
-            w[k] = u - f as f64;
-            lower[k] = f.clamp(0, last) as usize * stride[k];
-            upper[k] = (f + 1).clamp(0, last) as usize * stride[k];
+        // Per axis the lattice coordinate `u` (voxel centres at integers).
+        let u: [f64; 3] = std::array::from_fn(|k| self.lattice(p, k));
+        // Between the outer voxel centres on every axis (NaN is not) all
+        // eight neighbours are in the grid: the truncation is the floor, and
+        // the lower and upper planes' two rows are two slices of `data`
+        // from the lower corner, of known length (no more checks).
+        // (Signed integers: x86-64 converts them to and from floats in one
+        // instruction each, unsigned ones in several.)
+        if (0..3).all(|k| 0.0 <= u[k] && u[k] < (self.resolution[k] as i64 - 1) as f64) {
+            let f = u.map(|u| u as i64);
+            let w: [f64; 3] = std::array::from_fn(|k| u[k] - f[k] as f64);
+            let base: usize = (0..3).map(|k| f[k] as usize * stride[k]).sum();
+            let sy = stride[1];
+            let plane = |start: usize| self.data.get(start..)?.get(..sy + 2);
+            let (Some(lo), Some(hi)) = (plane(base), plane(base + stride[2])) else {
+                return 0.0;
+            };
+            let v = [
+                lo[0],
+                lo[1],
+                lo[sy],
+                lo[sy + 1],
+                hi[0],
+                hi[1],
+                hi[sy],
+                hi[sy + 1],
+            ];
+            return trilinear(v, w);
         }
-        let at = |x: usize, y: usize, z: usize| self.data.get(x + y + z).copied().unwrap_or(0.0);
-        let lerp = |a: f64, b: f64, t: f64| (1.0 - t) * a + t * b;
-        let row = |y: usize, z: usize| lerp(at(lower[0], y, z), at(upper[0], y, z), w[0]);
-        let plane = |z: usize| lerp(row(lower[1], z), row(upper[1], z), w[1]);
-        lerp(plane(lower[2]), plane(upper[2]), w[2])
+        self.density_near_faces(p, u)
     }
 
     /// The ray–box chord, cut at every crossing of a voxel-centre plane
