@@ -16,10 +16,11 @@
 //!   tentative collisions drawn against the residual majorant
 //!   `sigma_r = max(sigma_bar - sigma_c, sigma_c) >= |sigma - sigma_c|`.
 //!
-//! Every piece of the medium along the ray is cut into 16 spans (4 on a
-//! shadow ray, whose one walk pays for their set-up), each with its own
-//! majorant (and control); the per-walk scores of the spans multiply, and a free flight
-//! that leaves a span carries its unused optical depth into the next.
+//! Every piece of the medium along the ray is cut into 16 spans (32 for
+//! delta tracking, whose cost is its look-ups; 4 on a shadow ray, whose one
+//! walk pays for their set-up), each with its own majorant (and control);
+//! the per-walk scores of the spans multiply, and a free flight that leaves a
+//! span carries its unused optical depth into the next.
 //!
 //! [`radiance`] extends delta tracking from `tau` to V-E, V-B, V-L and V-I
 //! the way a renderer estimates them (free-flight sampling against the
