@@ -314,7 +314,7 @@ def table(rows, args):
     lines += [
         "",
         "Look-ups: density evaluations at tentative collisions (lightquad's V-L "
-        "also reads its shadow rays' majorants, 4 a shadow ray, which are not counted). "
+        "also reads its shadow rays' majorants, 1 a shadow ray, which are not counted). "
         "Mitsuba's medium has one global majorant (k = 1 for ratio tracking); "
         "lightquad's spans (16, 32 for delta tracking) each have their own, and "
         "ratio tracking draws at "

@@ -17,8 +17,8 @@
 //!   `sigma_r = max(sigma_bar - sigma_c, sigma_c) >= |sigma - sigma_c|`.
 //!
 //! Every piece of the medium along the ray is cut into 16 spans (32 for
-//! delta tracking, whose cost is its look-ups; 4 on a shadow ray, whose one
-//! walk pays for their set-up), each with its own majorant (and control);
+//! delta tracking, whose cost is its look-ups; one on a shadow ray, whose
+//! one walk pays for its set-up), each with its own majorant (and control);
 //! the per-walk scores of the spans multiply, and a free flight that leaves a
 //! span carries its unused optical depth into the next.
 //!
@@ -326,8 +326,12 @@ const SPANS: usize = 16;
 const DELTA_SPANS: usize = 32;
 
 /// Spans per piece of a shadow ray: one walk uses them, so their set-up (a
-/// majorant each) is most of its cost.
-const SHADOW_SPANS: usize = 4;
+/// majorant each, a scan of the voxel grid's blocks) is most of its cost. On
+/// the grid of `scripts/tracking_race.py`, V-L's time times its variance
+/// (400k walks, one thread) was 1.39 with 1 span, 1.45 with 2, 3.11 with 4
+/// and 5.02 with 8: a looser bound's extra look-ups cost less than the
+/// bounds.
+const SHADOW_SPANS: usize = 1;
 
 /// The spans of `[t0, t1]` along `ray`: each piece of the medium's extent is
 /// cut into `per_piece` equal spans with a majorant of their own (tight
