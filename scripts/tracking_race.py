@@ -4,7 +4,7 @@
 standard error of 1e-3 (issue 13, target 3).
 
     scripts/tracking_race.py [--target 1e-3] [--threads 2] [--repeats 5] [--quick]
-                             [--only ratio|delta|light ...] [--json FILE]
+                             [--only ratio|delta|light] ... [--json FILE]
 
 Run it from anywhere with reference/.venv's Python, or with plain python3:
 it re-executes itself under reference/.venv/bin/python when Mitsuba is not
@@ -316,7 +316,8 @@ def table(rows, args):
         "Look-ups: density evaluations at tentative collisions (lightquad's V-L "
         "also reads its shadow rays' majorants, 1 a shadow ray, which are not counted). "
         "Mitsuba's medium has one global majorant (k = 1 for ratio tracking); "
-        "lightquad's spans (16, 32 for delta tracking) each have their own, and "
+        "lightquad's spans (16; 32 for delta tracking of V-tau; one on a shadow ray) each have "
+        "their own, and "
         "ratio tracking draws at "
         "k = min(2D, 256/D) times it (src/volume/tracking.rs). Mitsuba computes in "
         "float32 (an independent check put its ratio tracking 0.1%, 2.3 SE, below "
