@@ -259,13 +259,8 @@ impl VoxelGrid {
         }
         // Near a face: the two indices around `u` clamp to the grid (the
         // field is constant beyond the outer voxel centres). Inside the box
-        // `u` is in [-1/2, n - 1/2], in range of the cast, and `floor(u)` is
-        // the truncation, one less where it rounded up (as in `floor`, but
-        // kept as an integer).
-        let f = u.map(|u| {
-            let t = u as i64;
-            t - i64::from(t as f64 > u)
-        });
+        // `u` is in [-1/2, n - 1/2], so `floor(u)` converts exactly.
+        let f = u.map(|u| floor(u) as i64);
         let w: [f64; 3] = std::array::from_fn(|k| u[k] - f[k] as f64);
         let index =
             |k: usize, i: i64| i.clamp(0, self.resolution[k] as i64 - 1) as usize * stride[k];
