@@ -77,6 +77,7 @@ use std::f64::consts::PI;
 use super::medium::Medium;
 use super::scene::{DirectionalLight, EmissionMap, VolumeScene};
 use super::terms::ShadowMethod;
+use crate::domain::Vec3;
 use crate::error::QuadError;
 use crate::geometry::Ray;
 use crate::quadrature::monte_carlo::{Welford, power_of_two_above};
@@ -563,6 +564,13 @@ impl Course {
 /// exponential is memoryless, so leaving a span costs no draw). A tentative
 /// collision at `t` is real with probability `sigma(t) / sigma_bar`, and ends
 /// the walk.
+///
+/// The walks advance side by side, up to `BATCH` of them, one tentative
+/// collision each per round: the round's look-ups are one call of
+/// [`Medium::densities`] (a walk is one look-up most of the time, and a
+/// dynamic call per look-up, waiting on its loads, was half its cost), and
+/// a walk that ends hands its place to a fresh one. Each walk is still a
+/// walk of its own, drawn from its own variates.
 fn delta_walks<Rg: rand::Rng + ?Sized>(
     sigma: Extinction,
     ray: &Ray,
@@ -571,31 +579,72 @@ fn delta_walks<Rg: rand::Rng + ?Sized>(
     evaluations: &mut u64,
     rng: &mut Rg,
 ) -> Result<u64, QuadError> {
+    /// Walks in flight: their tentative collisions are looked up in one
+    /// batch ([`Medium::densities`]).
+    const BATCH: usize = 64;
+    /// A walk in flight: its accumulated depth, the crossing of its last
+    /// tentative collision and how many it has had there.
+    #[derive(Clone, Copy)]
+    struct Walker {
+        e: f64,
+        at: usize,
+        collisions: u64,
+    }
     let Extinction { medium, lambda } = sigma;
     let course = Course::new(crossings);
     let mut through = 0u64;
-    'walks: for _ in 0..n {
-        let mut e = free_flight(rng);
-        let (mut at, mut collisions) = (0, 0u64);
-        loop {
-            let i = course.find(e);
+    let mut started = 0usize;
+    let mut live: Vec<Walker> = Vec::with_capacity(BATCH);
+    let mut points = [Vec3::zeros(); BATCH];
+    let mut bars = [0.0; BATCH];
+    let mut densities = [0.0; BATCH];
+    while started < n || !live.is_empty() {
+        // Fresh walks fill the batch.
+        while live.len() < BATCH && started < n {
+            live.push(Walker {
+                e: free_flight(rng),
+                at: usize::MAX,
+                collisions: 0,
+            });
+            started += 1;
+        }
+        // Each walk's tentative collision, or its way out past the last
+        // crossing (kept walks are packed to the front).
+        let mut m = 0;
+        for j in 0..live.len() {
+            let mut w = live[j];
+            let i = course.find(w.e);
             let Some(c) = crossings.get(i) else {
                 through += 1;
-                continue 'walks;
+                continue;
             };
-            collisions = if i == at { collisions + 1 } else { 1 };
-            at = i;
-            if collisions > MAX_COLLISIONS {
+            w.collisions = if i == w.at { w.collisions + 1 } else { 1 };
+            w.at = i;
+            if w.collisions > MAX_COLLISIONS {
                 return Err(too_deep(c.span));
             }
-            *evaluations += 1;
             // Rounding must not carry the point past the span's end.
-            let t = (c.span.a + (e - c.start) * c.inverse).min(c.span.b);
-            if rng.random::<f64>() * c.span.bar < lambda * medium.density(ray.at(t)) {
-                continue 'walks;
-            }
-            e += free_flight(rng);
+            let t = (c.span.a + (w.e - c.start) * c.inverse).min(c.span.b);
+            points[m] = ray.at(t);
+            bars[m] = c.span.bar;
+            live[m] = w;
+            m += 1;
         }
+        live.truncate(m);
+        medium.densities(&points[..m], &mut densities[..m]);
+        *evaluations += m as u64;
+        // Real collisions end their walks; the others fly on.
+        let mut kept = 0;
+        for j in 0..m {
+            if rng.random::<f64>() * bars[j] < lambda * densities[j] {
+                continue;
+            }
+            let mut w = live[j];
+            w.e += free_flight(rng);
+            live[kept] = w;
+            kept += 1;
+        }
+        live.truncate(kept);
     }
     Ok(through)
 }
