@@ -374,6 +374,33 @@ fn the_cost_guard_counts_blobs_occluders_and_objects() {
     );
 }
 
+/// The cost guard counts what the walks do: at optical depth 1e5 a
+/// delta-tracking walk stops at its first look-up, so 1e7 walks are about
+/// 2e7 evaluations (the estimate `1 + D` a walk, about 1e12, refused them),
+/// while a ratio-tracking walk crosses the whole sphere, 1e5 look-ups, and
+/// 1e7 of them are still refused.
+#[test]
+fn the_cost_guard_counts_what_the_walks_do() {
+    let stiff = |tracker: &str| {
+        json!({
+            "name": "stiff", "family": "volume",
+            "scene": {"ray": {"origin": [-3.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0]},
+                      "medium": {"type": "constant-sphere", "centre": [0.0, 0.0, 0.0],
+                                 "radius": 1.0, "kappa": 50000.0}},
+            "quantities": ["tau"], "rules": [{"rule": tracker}], "budgets": [10000000],
+            "repeats": 1, "reference": {"type": "closed-form"}
+        })
+        .to_string()
+    };
+    let o = check_text(&stiff("delta-tracking"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    refused(
+        &check_text(&stiff("ratio-tracking")),
+        "budgets",
+        &["ratio-tracking", "e12", "--no-cost-limit"],
+    );
+}
+
 /// The whole experiment is guarded too: 6 rules at 174 budgets, 1000
 /// repeats each (a million jobs), and a 16384 x 16384 image (116 GB of results) passed the
 /// per-job guard.

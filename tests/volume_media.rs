@@ -619,12 +619,13 @@ fn voxel_grid_majorant_bounds_the_density_and_is_local() {
 }
 
 #[test]
-fn voxel_grid_block_majorants_bound_the_density_and_extent_is_the_support() {
+fn voxel_grid_block_bounds_bound_the_density_and_extent_is_the_support() {
     // 33 x 30 x 17 voxels, sides not multiples of the 4-voxel blocks, with
     // sparse spikes: long sub-chords (index boxes of more than 64 voxels)
     // take the blocks' maxima, short ones the voxels'. The bound must hold
     // at every sampled point, stay below the global peak, and be local (a
-    // short sub-chord far from every spike gets less than the peak).
+    // short sub-chord far from every spike gets less than the peak); the
+    // lower bound (blocks' minima likewise) too.
     let res = [33usize, 30, 17];
     let (lo, hi) = (Vec3::new(-1.0, -2.0, 0.5), Vec3::new(2.3, 1.0, 2.2));
     let mut r = rng(9);
@@ -639,7 +640,7 @@ fn voxel_grid_block_majorants_bound_the_density_and_extent_is_the_support() {
         .collect();
     let grid = VoxelGrid::new(lo, hi, res, data).expect("valid grid");
     let span = hi - lo;
-    let (mut long, mut short, mut below_peak) = (0, 0, 0);
+    let (mut long, mut short, mut below_peak, mut positive_low) = (0, 0, 0, 0);
     for _ in 0..400 {
         let o = lo + span.component_mul(&Vec3::new(r.random(), r.random(), r.random()));
         let ray = Ray::new(o, random_unit(&mut r)).expect("valid");
@@ -652,6 +653,11 @@ fn voxel_grid_block_majorants_bound_the_density_and_extent_is_the_support() {
         let s = a + (b - a) * (1.0 - frac) * r.random::<f64>();
         let e = s + (b - a) * frac;
         let bar = grid.max_density(&ray, s, e);
+        // The lower bound (for cost estimates): 0 for a stretch that leaves
+        // the box, and below every sampled density.
+        let low = grid.min_density(&ray, s, e);
+        assert_eq!(grid.min_density(&ray, s, b + 1.0), 0.0);
+        positive_low += usize::from(low > 0.0);
         if frac == 1.0 {
             long += 1
         } else {
@@ -663,9 +669,18 @@ fn voxel_grid_block_majorants_bound_the_density_and_extent_is_the_support() {
             let t = s + (e - s) * j as f64 / 400.0;
             let v = grid.density(ray.at(t));
             assert!(v <= bar, "density {v} above the bound {bar} at t = {t}");
+            // Not at the ends, where the chord meets the faces and rounding
+            // may put the point outside (density 0).
+            if 0 < j && j < 400 {
+                assert!(
+                    v >= low,
+                    "density {v} below the lower bound {low} at t = {t}"
+                );
+            }
         }
     }
     assert!(long > 150 && short > 150);
+    assert!(positive_low > 50, "{positive_low} positive lower bounds");
     assert!(
         below_peak > 50,
         "{below_peak} sub-chords got less than the peak"

@@ -109,6 +109,15 @@ impl Medium for ConstantSphere {
         self.kappa
     }
 
+    /// `kappa` where `[t0, t1]` lies inside the sphere, else 0.
+    fn min_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
+        if self.sphere.clip(ray, t0, t1) == Some((t0, t1)) {
+            self.kappa
+        } else {
+            0.0
+        }
+    }
+
     /// `kappa` times the chord length inside `[t0, t1]`.
     fn density_integral(&self, ray: &Ray, t0: f64, t1: f64) -> Option<f64> {
         Some(

@@ -34,7 +34,9 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::printed::{self, Printed};
-use super::tracking::{Extinction, Tracked, Tracker, Wanted, radiance, transmittance};
+use super::tracking::{
+    Extinction, Tracked, Tracker, Walks, Wanted, expected_lookups, radiance, transmittance,
+};
 use super::{
     ConstantSphere, DepthScheme, DirectionalLight, EmissionMap, GaussianBlob, GaussianBlobs,
     Medium, ShadowMethod, TransferTable, VolumeResult, VolumeScene, evaluate,
@@ -570,7 +572,11 @@ impl Family for Volume {
     /// bundled scenes cost 12 to 80 times the estimate (Gauss–Legendre's
     /// error estimate's rules, 2.5 n more, were not counted either); `n` more where an integral
     /// nests in each node (the nested scheme, shadow rays by quadrature). A
-    /// tracker's walks cost about `1 + D` density lookups each.
+    /// tracker's walk costs 1 plus its expected look-ups
+    /// ([`super::tracking::expected_lookups`]; it was `1 + D` for every
+    /// tracker, which refused delta tracking through dense media, where a
+    /// walk stops at its first look-up, and undercounted ratio tracking,
+    /// which draws at up to `2 D` times the bound, and the shadow rays).
     fn cost(
         built: &Built,
         method: &Method<Tracker>,
@@ -592,7 +598,19 @@ impl Family for Volume {
             })
             .fold(1.0, f64::max);
         let rule = match method {
-            Method::Estimator(_) => return n * (1.0 + depth) * work,
+            Method::Estimator(tracker) => {
+                let wanted = |emission, light| Wanted { emission, light };
+                let walks = match quantity {
+                    Emission => Walks::Radiance(built.shadow, wanted(true, false)),
+                    Light => Walks::Radiance(built.shadow, wanted(false, true)),
+                    Total => Walks::Radiance(built.shadow, wanted(true, true)),
+                    Tau | LnTau | Background => Walks::Transmittance(*tracker),
+                };
+                // Walks the spans refuse (too deep a bound) fail when the job
+                // runs, with their own message; here the bound's depth.
+                let per_walk = expected_lookups(&scene, walks).unwrap_or(depth);
+                return n * (1.0 + per_walk) * work;
+            }
             Method::Rule(rule) => rule,
         };
         // A rule's evaluations at the budget, its error estimate's included

@@ -204,6 +204,19 @@ impl Medium for LinearGradient {
         peak.max(0.0) + 16.0 * f64::EPSILON * scale
     }
 
+    /// The smaller end value of the linear function (it is linear along the
+    /// ray) where `[t0, t1]` lies inside the sphere, less the rounding
+    /// margin of [`Medium::max_density`], floored at 0; else 0.
+    fn min_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
+        if self.sphere.clip(ray, t0, t1) != Some((t0, t1)) {
+            return 0.0;
+        }
+        let low = self.linear(ray.at(t0)).min(self.linear(ray.at(t1)));
+        let scale = self.base.abs()
+            + self.gradient.norm() * (self.sphere.centre.norm() + 2.0 * self.sphere.radius);
+        (low - 16.0 * f64::EPSILON * scale).max(0.0)
+    }
+
     /// `(b - a)` times the value at the midpoint of the positive chord `[a, b]`
     /// (the integral of a linear function), 0 where there is none.
     fn density_integral(&self, ray: &Ray, t0: f64, t1: f64) -> Option<f64> {

@@ -92,6 +92,14 @@ pub trait Medium: std::fmt::Debug + Send + Sync {
     /// delta and ratio tracking).
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64;
 
+    /// A lower bound of the density on `[t0, t1]` along `ray`: how soon a
+    /// delta-tracking walk must stop, for the estimate of its cost before a
+    /// run (an end on the medium's boundary may still read 0 by rounding).
+    /// 0, always a bound, unless the medium knows better.
+    fn min_density(&self, _ray: &Ray, _t0: f64, _t1: f64) -> f64 {
+        0.0
+    }
+
     /// A point the medium lies around (its centre), if it has one: the
     /// scene re-anchors a ray at its closest approach to it before asking for
     /// the support, so a ray from very far away (`|e| = 1e16`, where one ulp

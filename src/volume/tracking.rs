@@ -650,6 +650,118 @@ fn delta_walks<Rg: rand::Rng + ?Sized>(
     Ok(through)
 }
 
+/// Which walks a cost estimate ([`expected_lookups`]) is for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Walks {
+    /// [`transmittance`]'s, with this tracker.
+    Transmittance(Tracker),
+    /// [`radiance`]'s, scoring these terms, shadow rays by this method.
+    Radiance(ShadowMethod, Wanted),
+}
+
+/// The expected density look-ups of one walk along the eye ray of `scene`
+/// (its tentative collisions, and a shadow ray's for each where they are
+/// tracked), from the spans the walks use, before any walk: what a run
+/// costs. Over a span of length `L`, rate `mu` and extinction at least `m`
+/// ([`Medium::min_density`]):
+///
+/// - ratio tracking crosses every span: `sum mu L`, `mu = k sigma_bar`
+///   ([`ratio_rate_factor`]); residual ratio tracking's `mu` is its
+///   residual bound;
+/// - a delta-tracking walk reaches the span with probability at most
+///   `S = exp(-sum of m L over the spans before it)`, and then has at most
+///   `mu (1 - exp(-m L)) / m` tentative collisions there (`mu L` where
+///   `m = 0`): the sum is an upper bound, equal to the expectation where
+///   the density is constant;
+/// - each tentative collision of a radiance walk that scores V-L casts a
+///   shadow ray, ratio tracking over one span where the medium has no
+///   closed form for it: its `mu L`, the largest of the shadow rays from
+///   the chord's start, middle and end (an estimate, not a bound).
+pub fn expected_lookups(scene: &VolumeScene, walks: Walks) -> Result<f64, QuadError> {
+    let Some(medium) = scene.medium.as_deref() else {
+        return Ok(0.0);
+    };
+    let sigma = Extinction {
+        medium,
+        lambda: scene.lambda,
+    };
+    let (ray, t0, t1) = (scene.ray, scene.t_min, scene.t_max);
+    let mut unused = 0;
+    let crossing = |s: &Span| s.majorant * (s.b - s.a);
+    match walks {
+        Walks::Transmittance(Tracker::Delta) => {
+            let spans = spans(
+                Tracker::Delta,
+                sigma,
+                &ray,
+                (t0, t1),
+                DELTA_SPANS,
+                &mut unused,
+            )?;
+            Ok(delta_lookups(sigma, &ray, &spans, |s| s.bar))
+        }
+        Walks::Transmittance(tracker) => {
+            let spans = spans(tracker, sigma, &ray, (t0, t1), SPANS, &mut unused)?;
+            Ok(spans.iter().map(crossing).sum())
+        }
+        Walks::Radiance(shadow, wanted) => {
+            let spans = spans(Tracker::Delta, sigma, &ray, (t0, t1), SPANS, &mut unused)?;
+            let light = scene.light.filter(|_| wanted.light);
+            let scoring = light.is_some() || (wanted.emission && scene.emission.is_some());
+            // radiance's rate: the bound, or one per span where it is 0 and
+            // a walk scores there.
+            let rate = |s: &Span| match (s.bar > 0.0, scoring) {
+                (true, _) => s.bar,
+                (false, true) => 1.0 / (s.b - s.a),
+                (false, false) => 0.0,
+            };
+            let eye = delta_lookups(sigma, &ray, &spans, rate);
+            let Some(l) = light else {
+                return Ok(eye);
+            };
+            let mut per_shadow: f64 = 0.0;
+            let (a, b) = (
+                spans.first().map_or(t0, |s| s.a),
+                spans.last().map_or(t1, |s| s.b),
+            );
+            for t in [a, 0.5 * (a + b), b] {
+                let shadow_ray = Ray {
+                    origin: ray.at(t),
+                    dir: l.toward_light,
+                };
+                let closed = shadow == ShadowMethod::ClosedFormWhereAvailable
+                    && medium
+                        .density_integral(&shadow_ray, 0.0, f64::INFINITY)
+                        .is_some();
+                if !closed {
+                    let s = spans_of_shadow(sigma, &shadow_ray, &mut unused)?;
+                    per_shadow = per_shadow.max(s.iter().map(crossing).sum());
+                }
+            }
+            Ok(eye * (1.0 + per_shadow))
+        }
+    }
+}
+
+/// The bound of [`expected_lookups`] on a delta-tracking walk's tentative
+/// collisions over `spans` at the rate `rate(span)`.
+fn delta_lookups(sigma: Extinction, ray: &Ray, spans: &[Span], rate: impl Fn(&Span) -> f64) -> f64 {
+    let (mut reach, mut total) = (1.0, 0.0);
+    for s in spans {
+        let length = s.b - s.a;
+        let depth = sigma.lambda * sigma.medium.min_density(ray, s.a, s.b) * length;
+        // int_0^L exp(-m t) dt = L (1 - exp(-m L)) / (m L).
+        let within = if depth > 0.0 {
+            length * (-(-depth).exp_m1() / depth)
+        } else {
+            length
+        };
+        total += reach * rate(s) * within;
+        reach *= (-depth).exp();
+    }
+    total
+}
+
 /// `exp(-int sigma_c)`: the controls' factor of residual ratio tracking's
 /// score (1 for the other trackers, whose control is 0).
 fn control_factor(spans: &[Span]) -> f64 {

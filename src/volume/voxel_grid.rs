@@ -73,6 +73,8 @@ pub struct VoxelGrid {
     /// The largest value of each block of `BLOCK^3` voxels (fewer at the
     /// grid's far faces), x fastest, and the blocks per axis.
     block_max: Vec<f64>,
+    /// The smallest value of each block, as `block_max`.
+    block_min: Vec<f64>,
     blocks: [usize; 3],
 }
 
@@ -181,6 +183,7 @@ impl VoxelGrid {
         }
         let blocks = resolution.map(|n| n.div_ceil(BLOCK));
         let mut block_max = vec![0.0f64; blocks.iter().product()];
+        let mut block_min = vec![f64::INFINITY; blocks.iter().product()];
         for (i, &v) in data.iter().enumerate() {
             let (x, y, z) = (
                 i % resolution[0],
@@ -190,6 +193,9 @@ impl VoxelGrid {
             let b = ((z / BLOCK) * blocks[1] + y / BLOCK) * blocks[0] + x / BLOCK;
             if let Some(m) = block_max.get_mut(b) {
                 *m = m.max(v);
+            }
+            if let Some(m) = block_min.get_mut(b) {
+                *m = m.min(v);
             }
         }
         Ok(VoxelGrid {
@@ -201,6 +207,7 @@ impl VoxelGrid {
             per_cell: cell.map(|h| 1.0 / h),
             data_max,
             block_max,
+            block_min,
             blocks,
         })
     }
@@ -398,15 +405,46 @@ impl Medium for VoxelGrid {
     }
 
     /// The largest value over the voxels whose interpolation stencils the
-    /// chord inside `[t0, t1]` can reach: the index box spanned by the chord's
-    /// end points (each widened to the neighbouring centre), not the global
-    /// maximum; over the blocks of 4^3 voxels holding the box where it has
-    /// more than 64 voxels. Times `1 + 8 eps` for the rounding of the
+    /// chord inside `[t0, t1]` can reach ([`VoxelGrid::stencil_box`]), not
+    /// the global maximum. Times `1 + 8 eps` for the rounding of the
     /// interpolation weights; 0 where the ray misses the box.
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
-        let Some((a, b)) = self.chord(ray, t0, t1) else {
+        let Some((lo, hi)) = self.stencil_box(ray, t0, t1) else {
             return 0.0;
         };
+        let whole = (0..3).all(|k| lo[k] == 0 && hi[k] + 1 == self.resolution[k]);
+        let peak = if whole {
+            self.data_max
+        } else {
+            self.fold_box(lo, hi, &self.block_max, (0.0, f64::INFINITY), f64::max)
+        };
+        peak * (1.0 + 8.0 * f64::EPSILON)
+    }
+
+    /// The smallest value over the same voxels (an interpolated value is a
+    /// weighted mean of its stencil's), times `1 - 8 eps`, where `[t0, t1]`
+    /// lies inside the box; else 0. (An end on a face may round to a point
+    /// outside, density 0: a bound for the walks' cost, not for a look-up
+    /// there.)
+    fn min_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
+        if self.chord(ray, t0, t1) != Some((t0, t1)) {
+            return 0.0;
+        }
+        let Some((lo, hi)) = self.stencil_box(ray, t0, t1) else {
+            return 0.0;
+        };
+        self.fold_box(lo, hi, &self.block_min, (f64::INFINITY, 0.0), f64::min)
+            * (1.0 - 8.0 * f64::EPSILON)
+    }
+}
+
+impl VoxelGrid {
+    /// The index box of the voxels whose interpolation stencils the chord
+    /// inside `[t0, t1]` can reach: spanned by the chord's end points, each
+    /// widened to the neighbouring centre; `None` where the ray misses the
+    /// box.
+    fn stencil_box(&self, ray: &Ray, t0: f64, t1: f64) -> Option<([usize; 3], [usize; 3])> {
+        let (a, b) = self.chord(ray, t0, t1)?;
         let (pa, pb) = (ray.at(a), ray.at(b));
         let mut lo = [0usize; 3];
         let mut hi = [0usize; 3];
@@ -416,38 +454,45 @@ impl Medium for VoxelGrid {
             lo[k] = Self::clamp_index(ua.min(ub) - LATTICE_SLACK, n);
             hi[k] = Self::clamp_index(ua.max(ub) + LATTICE_SLACK + 1.0, n);
         }
-        let whole = (0..3).all(|k| lo[k] == 0 && hi[k] + 1 == self.resolution[k]);
+        Some((lo, hi))
+    }
+
+    /// `f` folded from `init` over the values of the voxels in the index box
+    /// `lo..=hi`; where it has more than 64 voxels (a long span, a shadow
+    /// ray's), over `blocks`' values of the blocks of 4^3 voxels that hold it
+    /// instead: a few reads instead of hundreds, and a bound no less safe (it
+    /// may take in voxels just outside the box, so it is looser). A block
+    /// past the table (which cannot happen) counts as `missing`.
+    fn fold_box(
+        &self,
+        lo: [usize; 3],
+        hi: [usize; 3],
+        blocks: &[f64],
+        (init, missing): (f64, f64),
+        f: impl Fn(f64, f64) -> f64,
+    ) -> f64 {
         let voxels: usize = (0..3).map(|k| hi[k] + 1 - lo[k]).product();
-        let peak = if whole {
-            self.data_max
-        } else if voxels > BLOCK * BLOCK * BLOCK {
-            // Many voxels (a long span, a shadow ray's): the maxima of the
-            // blocks that hold them, a few reads instead of hundreds, and a
-            // bound no less safe (it may take in voxels just outside the
-            // box, so it is looser).
+        let mut m = init;
+        if voxels > BLOCK * BLOCK * BLOCK {
             let [bx, by, _] = self.blocks;
-            let mut m: f64 = 0.0;
             for z in lo[2] / BLOCK..=hi[2] / BLOCK {
                 for y in lo[1] / BLOCK..=hi[1] / BLOCK {
                     for x in lo[0] / BLOCK..=hi[0] / BLOCK {
                         let b = (z * by + y) * bx + x;
-                        m = m.max(self.block_max.get(b).copied().unwrap_or(f64::INFINITY));
+                        m = f(m, blocks.get(b).copied().unwrap_or(missing));
                     }
                 }
             }
-            m
         } else {
-            let mut m: f64 = 0.0;
             for z in lo[2]..=hi[2] {
                 for y in lo[1]..=hi[1] {
                     for x in lo[0]..=hi[0] {
-                        m = m.max(self.value(x, y, z));
+                        m = f(m, self.value(x, y, z));
                     }
                 }
             }
-            m
-        };
-        peak * (1.0 + 8.0 * f64::EPSILON)
+        }
+        m
     }
 }
 

@@ -1,0 +1,205 @@
+//! The tracking estimators' cost estimate before a run
+//! (`tracking::expected_lookups`, which the cost guard multiplies by the
+//! walks) against closed forms and against the look-ups the walks make.
+
+use lightquad::domain::Vec3;
+use lightquad::geometry::Ray;
+use lightquad::volume::tracking::{
+    Extinction, Tracker, Walks, Wanted, expected_lookups, radiance, transmittance,
+};
+use lightquad::volume::{
+    ConstantSphere, DirectionalLight, LinearGradient, Medium, ShadowMethod, VolumeScene, VoxelGrid,
+};
+use rand::SeedableRng;
+use std::sync::Arc;
+
+fn along_x(medium: Arc<dyn Medium>, lambda: f64) -> VolumeScene {
+    let ray = Ray::new(Vec3::new(-3.0, 0.01, -0.02), Vec3::x()).expect("ray");
+    let mut s = VolumeScene::new(ray);
+    s.medium = Some(medium);
+    s.lambda = lambda;
+    s
+}
+
+/// A 12^3 grid of pseudo-random densities in [lo, lo + 1) over [-1, 1]^3.
+fn grid(lo: f64) -> Arc<dyn Medium> {
+    let mut state = 12345u64;
+    let data = (0..12 * 12 * 12)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            lo + (state >> 11) as f64 / (1u64 << 53) as f64
+        })
+        .collect();
+    Arc::new(
+        VoxelGrid::new(Vec3::repeat(-1.0), Vec3::repeat(1.0), [12, 12, 12], data).expect("grid"),
+    )
+}
+
+/// The mean look-ups of `n` walks (their evaluations over `n`) and the
+/// standard error of that mean, from `batches` independent batches.
+fn measured(mut run: impl FnMut(&mut rand_pcg::Pcg64) -> u64, n: usize) -> (f64, f64) {
+    let batches = 20;
+    let means: Vec<f64> = (0..batches)
+        .map(|i| {
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(1000 + i);
+            run(&mut rng) as f64 / n as f64
+        })
+        .collect();
+    let mean = means.iter().sum::<f64>() / batches as f64;
+    let var = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (batches - 1) as f64;
+    (mean, (var / batches as f64).sqrt())
+}
+
+/// In a sphere of constant extinction `sigma` a delta-tracking walk stops at
+/// its first tentative collision that is real, and every one is
+/// (`sigma_bar = sigma`): it makes one look-up with probability `1 - tau`,
+/// so the expectation is `1 - exp(-sigma L)`; ratio tracking draws
+/// `k sigma L` tentative collisions, `k = max(1, min(2 D, 256 / D))`, `D =
+/// sigma L`, whatever the density does.
+#[test]
+fn a_constant_sphere_costs_the_closed_forms() {
+    for (kappa, lambda) in [(0.05, 1.0), (1.3, 1.0), (40.0, 1.0), (2.0, 1e4)] {
+        let scene = along_x(
+            Arc::new(ConstantSphere::new(Vec3::zeros(), 1.0, kappa).expect("sphere")),
+            lambda,
+        );
+        let (ray, chord) = (
+            scene.ray,
+            2.0 * (1.0f64 - 0.01f64.powi(2) - 0.02f64.powi(2)).sqrt(),
+        );
+        let d = lambda * kappa * chord;
+        let delta = expected_lookups(&scene, Walks::Transmittance(Tracker::Delta)).expect("delta");
+        let want = -(-d).exp_m1();
+        assert!(
+            (delta / want - 1.0).abs() < 1e-9,
+            "kappa {kappa}: delta {delta} against {want}"
+        );
+        let ratio = expected_lookups(&scene, Walks::Transmittance(Tracker::Ratio)).expect("ratio");
+        let k = (2.0 * d).min(256.0 / d).max(1.0);
+        assert!(
+            (ratio / (k * d) - 1.0).abs() < 1e-9,
+            "kappa {kappa}: ratio {ratio} against {}",
+            k * d
+        );
+
+        // The walks themselves.
+        let sigma = Extinction {
+            medium: scene.medium.as_deref().expect("medium"),
+            lambda,
+        };
+        let n = 20_000;
+        for (tracker, want) in [(Tracker::Delta, delta), (Tracker::Ratio, ratio)] {
+            if want > 1e4 {
+                continue;
+            }
+            let (mean, se) = measured(
+                |rng| {
+                    transmittance(tracker, sigma, &ray, 0.0, f64::INFINITY, n, rng)
+                        .expect("walks")
+                        .evaluations
+                },
+                n,
+            );
+            assert!(
+                (mean - want).abs() <= 5.0 * se + 1e-12 * want,
+                "kappa {kappa} {tracker:?}: {mean} +- {se} look-ups a walk, expected {want}"
+            );
+        }
+    }
+}
+
+/// Where the density varies the delta-tracking figure is a bound: the walks'
+/// mean look-ups are below it (within the noise), and it is never above the
+/// bound's optical depth, which was the estimate before. Through a dense
+/// grid (densities 5e8 to 5e8 + 1 times lambda) a walk stops at its first
+/// look-up, and the figure says so (the bound's depth, about 2e9, refused
+/// such a job at any budget).
+#[test]
+fn delta_tracking_through_a_grid_costs_at_most_the_bound() {
+    for (lo, lambda) in [(0.0, 0.5), (2.0, 1.0), (5e8, 1.0)] {
+        let scene = along_x(grid(lo), lambda);
+        let sigma = Extinction {
+            medium: scene.medium.as_deref().expect("medium"),
+            lambda,
+        };
+        let bound = expected_lookups(&scene, Walks::Transmittance(Tracker::Delta)).expect("delta");
+        let (_, depth) = scene.depth_bound();
+        assert!(
+            bound <= depth * (1.0 + 1e-12),
+            "lo {lo}: {bound} above the depth {depth}"
+        );
+        let n = 20_000;
+        let (mean, se) = measured(
+            |rng| {
+                transmittance(
+                    Tracker::Delta,
+                    sigma,
+                    &scene.ray,
+                    0.0,
+                    f64::INFINITY,
+                    n,
+                    rng,
+                )
+                .expect("walks")
+                .evaluations
+            },
+            n,
+        );
+        assert!(
+            mean <= bound + 5.0 * se,
+            "lo {lo}: {mean} +- {se} look-ups a walk above {bound}"
+        );
+        if lo >= 1.0 {
+            // The lower bound is within a factor 1 + 1/lo of the density.
+            assert!(
+                bound < mean * (1.0 + 2.0 / lo) + 5.0 * se,
+                "lo {lo}: {bound} against {mean}"
+            );
+        }
+        if lo == 5e8 {
+            assert!(
+                bound < 1.0 + 1e-6 && depth > 1e9,
+                "bound {bound}, depth {depth}"
+            );
+        }
+    }
+}
+
+/// A radiance walk scoring V-L casts a shadow ray at each tentative
+/// collision; through a linear gradient (no closed form for a shadow ray
+/// toward the side) the figure counts them, and the walks' look-ups are
+/// within a factor 2 of it (the shadow rays' cost is an estimate from three
+/// of them).
+#[test]
+fn radiance_walks_count_their_shadow_rays() {
+    let medium: Arc<dyn Medium> = Arc::new(
+        LinearGradient::new(Vec3::zeros(), 1.0, 1.5, Vec3::new(0.4, 0.7, 0.0)).expect("gradient"),
+    );
+    let mut scene = along_x(medium, 1.0);
+    scene.light =
+        Some(DirectionalLight::new(Vec3::new(0.0, 1.0, 0.0), 1.0, Some(0.8)).expect("light"));
+    let wanted = Wanted {
+        emission: false,
+        light: true,
+    };
+    let eye = expected_lookups(&scene, Walks::Transmittance(Tracker::Delta)).expect("eye");
+    let figure = expected_lookups(&scene, Walks::Radiance(ShadowMethod::Quadrature, wanted))
+        .expect("figure");
+    assert!(figure > 2.0 * eye, "{figure} against the eye walk's {eye}");
+    let n = 20_000;
+    let (mean, se) = measured(
+        |rng| {
+            radiance(&scene, ShadowMethod::Quadrature, wanted, n, rng)
+                .expect("walks")
+                .light
+                .evaluations
+        },
+        n,
+    );
+    assert!(
+        mean / figure > 0.5 && mean / figure < 2.0,
+        "{mean} +- {se} look-ups a walk against {figure}"
+    );
+}
