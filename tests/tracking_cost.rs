@@ -203,3 +203,42 @@ fn radiance_walks_count_their_shadow_rays() {
         "{mean} +- {se} look-ups a walk against {figure}"
     );
 }
+
+/// A walk is capped at 1e7 tentative collisions a span: on a diagonal ray
+/// through
+/// a 3^3 grid whose only non-zero voxel, 1e9 at (0, 0, 2), the ray's
+/// interpolation never reaches (the spans around the middle voxel bound
+/// it), every tentative collision is null and delta tracking ends with an
+/// error that names the optical depth, not a hang; the cost figure says the
+/// same before any walk.
+#[test]
+fn a_walk_through_a_bound_it_never_meets_stops_at_the_cap() {
+    let mut data = vec![0.0; 27];
+    data[2 * 9] = 1e9;
+    let medium: Arc<dyn Medium> = Arc::new(
+        VoxelGrid::new(Vec3::repeat(-1.0), Vec3::repeat(1.0), [3, 3, 3], data).expect("grid"),
+    );
+    let ray = Ray::new(Vec3::repeat(-2.0), Vec3::repeat(1.0)).expect("ray");
+    let mut scene = VolumeScene::new(ray);
+    scene.medium = Some(medium.clone());
+    // The density along the ray is 0 everywhere (the voxel is off the
+    // interpolation stencils of the diagonal).
+    for i in 0..=1000 {
+        let t = 3.0f64.sqrt() * (0.5 + 2.0 * i as f64 / 1000.0);
+        assert_eq!(medium.density(ray.at(t)), 0.0, "t = {t}");
+    }
+    let figure = expected_lookups(&scene, Walks::Transmittance(Tracker::Delta)).expect("figure");
+    assert!(figure > 1e7, "{figure} look-ups a walk");
+    let sigma = Extinction {
+        medium: medium.as_ref(),
+        lambda: 1.0,
+    };
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    let e = transmittance(Tracker::Delta, sigma, &ray, 0.0, f64::INFINITY, 2, &mut rng)
+        .expect_err("capped");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("optical depth") && msg.contains("tentative collisions"),
+        "{msg}"
+    );
+}
