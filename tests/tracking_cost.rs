@@ -204,13 +204,12 @@ fn radiance_walks_count_their_shadow_rays() {
     );
 }
 
-/// A walk is capped at 1e7 tentative collisions a span: on a diagonal ray
-/// through
-/// a 3^3 grid whose only non-zero voxel, 1e9 at (0, 0, 2), the ray's
-/// interpolation never reaches (the spans around the middle voxel bound
-/// it), every tentative collision is null and delta tracking ends with an
-/// error that names the optical depth, not a hang; the cost figure says the
-/// same before any walk.
+/// A walk is capped at 1e7 tentative collisions a span. On a diagonal ray
+/// through a 3^3 grid whose only non-zero voxel (1e9 at (0, 0, 2)) the
+/// ray's interpolation never reaches, though the spans around the middle
+/// voxel take it into their bound, every tentative collision is null, and
+/// delta tracking ends with an error that names the optical depth, not a
+/// hang; the cost figure says as much before any walk.
 #[test]
 fn a_walk_through_a_bound_it_never_meets_stops_at_the_cap() {
     let mut data = vec![0.0; 27];
