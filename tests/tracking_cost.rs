@@ -8,7 +8,8 @@ use lightquad::volume::tracking::{
     Extinction, Tracker, Walks, Wanted, expected_lookups, radiance, transmittance,
 };
 use lightquad::volume::{
-    ConstantSphere, DirectionalLight, LinearGradient, Medium, ShadowMethod, VolumeScene, VoxelGrid,
+    ConstantSphere, DirectionalLight, GaussianBlob, GaussianBlobs, LinearGradient, Medium,
+    ShadowMethod, VolumeScene, VoxelGrid,
 };
 use rand::SeedableRng;
 use std::sync::Arc;
@@ -239,5 +240,68 @@ fn a_walk_through_a_bound_it_never_meets_stops_at_the_cap() {
     assert!(
         msg.contains("optical depth") && msg.contains("tentative collisions"),
         "{msg}"
+    );
+}
+
+/// Gaussian blobs: the lower bound (each blob's value at the farther end of
+/// a stretch) is below the density at every sampled point, and through a
+/// blob of amplitude 1e7 a delta-tracking walk's figure is tens of look-ups,
+/// as the walks make (the bound's depth, about 1e7, refused 1e5 walks).
+#[test]
+fn delta_tracking_through_a_dense_blob_costs_tens_of_lookups() {
+    let blobs = GaussianBlobs::new(vec![
+        GaussianBlob {
+            centre: Vec3::new(0.1, 0.0, 0.05),
+            amplitude: 1e7,
+            width: 0.4,
+        },
+        GaussianBlob {
+            centre: Vec3::new(-0.5, 0.3, 0.0),
+            amplitude: 2.0,
+            width: 0.2,
+        },
+    ])
+    .expect("blobs");
+    let ray = Ray::new(Vec3::new(-3.0, 0.01, -0.02), Vec3::x()).expect("ray");
+    for (t0, t1) in [(0.0, 6.0), (2.0, 2.3), (2.9, 3.4), (3.5, 9.0), (1.0, 4.0)] {
+        let low = blobs.min_density(&ray, t0, t1);
+        assert!(low > 0.0, "[{t0}, {t1}]");
+        for i in 0..=200 {
+            let t = t0 + (t1 - t0) * i as f64 / 200.0;
+            let v = blobs.density(ray.at(t));
+            assert!(v >= low, "density {v} below {low} at t = {t}");
+        }
+    }
+    let scene = along_x(Arc::new(blobs), 1.0);
+    let figure = expected_lookups(&scene, Walks::Transmittance(Tracker::Delta)).expect("figure");
+    let (_, depth) = scene.depth_bound();
+    assert!(
+        figure < 100.0 && depth > 1e6,
+        "figure {figure}, depth {depth}"
+    );
+    let sigma = Extinction {
+        medium: scene.medium.as_deref().expect("medium"),
+        lambda: 1.0,
+    };
+    let n = 20_000;
+    let (mean, se) = measured(
+        |rng| {
+            transmittance(
+                Tracker::Delta,
+                sigma,
+                &scene.ray,
+                0.0,
+                f64::INFINITY,
+                n,
+                rng,
+            )
+            .expect("walks")
+            .evaluations
+        },
+        n,
+    );
+    assert!(
+        mean <= figure + 5.0 * se,
+        "{mean} +- {se} look-ups a walk above {figure}"
     );
 }

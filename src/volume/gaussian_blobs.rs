@@ -184,6 +184,27 @@ impl Medium for GaussianBlobs {
             .sum()
     }
 
+    /// Each blob's smaller value at the two ends (along a line a Gaussian
+    /// blob is a Gaussian in `t`, whose least value over an interval is at
+    /// an end), summed, less a margin of 1e-9 of it for rounding.
+    fn min_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
+        if !(t0.is_finite() && t1.is_finite()) {
+            return 0.0;
+        }
+        let (p0, p1) = (ray.at(t0), ray.at(t1));
+        let least: f64 = self
+            .blobs
+            .iter()
+            .map(|b| {
+                let far = (p0 - b.centre)
+                    .norm_squared()
+                    .max((p1 - b.centre).norm_squared());
+                b.amplitude * (-far / (2.0 * b.width * b.width)).exp()
+            })
+            .sum();
+        least * (1.0 - 1e-9)
+    }
+
     /// The erf closed form, [`crate::exact::volume::gaussian_line_integral`].
     fn density_integral(&self, ray: &Ray, t0: f64, t1: f64) -> Option<f64> {
         Some(

@@ -675,8 +675,9 @@ pub enum Walks {
 ///   the density is constant;
 /// - each tentative collision of a radiance walk that scores V-L casts a
 ///   shadow ray, ratio tracking over one span where the medium has no
-///   closed form for it: its `mu L`, the largest of the shadow rays from
-///   the chord's start, middle and end (an estimate, not a bound).
+///   closed form for it: on each span of the eye ray, the larger `mu L` of
+///   the shadow rays from the span's two ends (an estimate, not a bound:
+///   a shadow ray from inside the span may cross more).
 pub fn expected_lookups(scene: &VolumeScene, walks: Walks) -> Result<f64, QuadError> {
     let Some(medium) = scene.medium.as_deref() else {
         return Ok(0.0);
@@ -698,7 +699,7 @@ pub fn expected_lookups(scene: &VolumeScene, walks: Walks) -> Result<f64, QuadEr
                 DELTA_SPANS,
                 &mut unused,
             )?;
-            Ok(delta_lookups(sigma, &ray, &spans, |s| s.bar))
+            Ok(delta_lookups(sigma, &ray, &spans, |s| s.bar).iter().sum())
         }
         Walks::Transmittance(tracker) => {
             let spans = spans(tracker, sigma, &ray, (t0, t1), SPANS, &mut unused)?;
@@ -717,14 +718,10 @@ pub fn expected_lookups(scene: &VolumeScene, walks: Walks) -> Result<f64, QuadEr
             };
             let eye = delta_lookups(sigma, &ray, &spans, rate);
             let Some(l) = light else {
-                return Ok(eye);
+                return Ok(eye.iter().sum());
             };
-            let mut per_shadow: f64 = 0.0;
-            let (a, b) = (
-                spans.first().map_or(t0, |s| s.a),
-                spans.last().map_or(t1, |s| s.b),
-            );
-            for t in [a, 0.5 * (a + b), b] {
+            // A shadow ray's look-ups from the point at `t` of the eye ray.
+            let mut shadow_from = |t: f64| -> Result<f64, QuadError> {
                 let shadow_ray = Ray {
                     origin: ray.at(t),
                     dir: l.toward_light,
@@ -733,20 +730,35 @@ pub fn expected_lookups(scene: &VolumeScene, walks: Walks) -> Result<f64, QuadEr
                     && medium
                         .density_integral(&shadow_ray, 0.0, f64::INFINITY)
                         .is_some();
-                if !closed {
+                Ok(if closed {
+                    0.0
+                } else {
                     let s = spans_of_shadow(sigma, &shadow_ray, &mut unused)?;
-                    per_shadow = per_shadow.max(s.iter().map(crossing).sum());
-                }
+                    s.iter().map(crossing).sum()
+                })
+            };
+            let mut total = 0.0;
+            let mut before = spans.first().map_or(Ok(0.0), |s| shadow_from(s.a))?;
+            for (span, eye) in spans.iter().zip(eye) {
+                let after = shadow_from(span.b)?;
+                total += eye * (1.0 + before.max(after));
+                before = after;
             }
-            Ok(eye * (1.0 + per_shadow))
+            Ok(total)
         }
     }
 }
 
 /// The bound of [`expected_lookups`] on a delta-tracking walk's tentative
-/// collisions over `spans` at the rate `rate(span)`.
-fn delta_lookups(sigma: Extinction, ray: &Ray, spans: &[Span], rate: impl Fn(&Span) -> f64) -> f64 {
-    let (mut reach, mut total) = (1.0, 0.0);
+/// collisions on each of `spans` at the rate `rate(span)`.
+fn delta_lookups(
+    sigma: Extinction,
+    ray: &Ray,
+    spans: &[Span],
+    rate: impl Fn(&Span) -> f64,
+) -> Vec<f64> {
+    let mut reach = 1.0;
+    let mut each = Vec::with_capacity(spans.len());
     for s in spans {
         let length = s.b - s.a;
         let depth = sigma.lambda * sigma.medium.min_density(ray, s.a, s.b) * length;
@@ -756,10 +768,10 @@ fn delta_lookups(sigma: Extinction, ray: &Ray, spans: &[Span], rate: impl Fn(&Sp
         } else {
             length
         };
-        total += reach * rate(s) * within;
+        each.push(reach * rate(s) * within);
         reach *= (-depth).exp();
     }
-    total
+    each
 }
 
 /// `exp(-int sigma_c)`: the controls' factor of residual ratio tracking's
