@@ -408,6 +408,39 @@ fn the_cost_guard_counts_what_the_walks_do() {
     );
 }
 
+/// V-L by delta tracking through an 8^3 grid of density 1 with a column of
+/// 1e6 at x-voxel 2 (y-voxels 4 to 7), light along +y: the shadow rays from
+/// the eye ray's first quarter cross the column, about 4.7e5 look-ups a
+/// walk. The figure took its shadow rays from the chord's start, middle and
+/// end only, none of which crosses the column, and accepted 1e8 walks
+/// (weeks of work; hostile probe, session 30); it now refuses them.
+#[test]
+fn the_cost_guard_sees_a_hot_column_beside_the_eye_ray() {
+    let data: Vec<f64> = (0..512)
+        .map(|i| {
+            if i % 8 == 2 && (i / 8) % 8 >= 4 {
+                1e6
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let spec = json!({
+        "name": "column", "family": "volume",
+        "scene": {"shadow": "quadrature", "ray": {"origin": [-2.0, -0.5, 0.0], "direction": [1.0, 0.0, 0.0]},
+                  "medium": {"type": "voxel-grid", "min": [-1, -1, -1], "max": [1, 1, 1],
+                             "resolution": [8, 8, 8], "data": data},
+                  "lambda": 1.0, "light": {"toward_light": [0, 1, 0], "intensity": 1.0, "albedo": 0.8}},
+        "quantities": ["I_L"], "rules": [{"rule": "delta-tracking"}], "budgets": [100000000],
+        "repeats": 1, "reference": {"type": "converged", "n": 8}
+    });
+    refused(
+        &check_text(&spec.to_string()),
+        "budgets",
+        &["delta-tracking", "e14", "--no-cost-limit"],
+    );
+}
+
 /// The whole experiment is guarded too: 6 rules at 174 budgets, 1000
 /// repeats each (a million jobs), and a 16384 x 16384 image (116 GB of results) passed the
 /// per-job guard.

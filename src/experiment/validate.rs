@@ -509,12 +509,12 @@ fn check_cost<F: Family>(
             .map(|&q| F::cost(scene, m, largest, q))
             .sum();
         if cost.is_nan() || cost > MAX_JOB_EVALUATIONS {
-            // Where even budget 2, the least any rule runs at, costs too
-            // much, the scene makes the rule too dear (ratio tracking through
-            // a blob of amplitude 1e307 collides about that often a walk):
+            // Where even the least budget the rule runs at costs too much,
+            // the scene makes the rule too dear (ratio tracking through a
+            // blob of amplitude 1e307 collides about that often a walk):
             // lowering the budget, the advice given, could not help. (The
             // experiment's own smallest budget said so of any single budget.)
-            let least = 2;
+            let least = min_budget::<F>(scene, m, &spec.quantities);
             let at_least: f64 = spec
                 .quantities
                 .iter()

@@ -576,7 +576,8 @@ impl Family for Volume {
     /// ([`super::tracking::expected_lookups`]; it was `1 + D` for every
     /// tracker, which refused delta tracking through dense media, where a
     /// walk stops at its first look-up, and undercounted ratio tracking,
-    /// which draws at up to `2 D` times the bound, and the shadow rays).
+    /// which draws at `k = min(2 D, 256 / D)` times the bound, up to 22.6,
+    /// and the shadow rays).
     fn cost(
         built: &Built,
         method: &Method<Tracker>,

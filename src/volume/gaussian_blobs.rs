@@ -186,7 +186,8 @@ impl Medium for GaussianBlobs {
 
     /// Each blob's smaller value at the two ends (along a line a Gaussian
     /// blob is a Gaussian in `t`, whose least value over an interval is at
-    /// an end), summed, less a margin of 1e-9 of it for rounding.
+    /// an end), summed, less 1e-9 of it: a margin for rounding, not a proof
+    /// (a bound for the cost estimate of tracking, not for a look-up).
     fn min_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
         if !(t0.is_finite() && t1.is_finite()) {
             return 0.0;

@@ -206,7 +206,8 @@ impl Medium for LinearGradient {
 
     /// The smaller end value of the linear function (it is linear along the
     /// ray) where `[t0, t1]` lies inside the sphere, less the rounding
-    /// margin of [`Medium::max_density`], floored at 0; else 0.
+    /// margin `16 eps (|b| + |g| (|c| + 2 R))` that `max_density` adds,
+    /// floored at 0; else 0.
     fn min_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {
         if self.sphere.clip(ray, t0, t1) != Some((t0, t1)) {
             return 0.0;

@@ -44,9 +44,9 @@ pub trait Medium: std::fmt::Debug + Send + Sync {
 
     /// The densities at `points`, into `out` (of the same length): one call
     /// for a batch of look-ups. The provided loop is compiled for each
-    /// medium, so `density` is called directly, inlined, and neighbouring
-    /// look-ups overlap in the processor instead of each waiting for a
-    /// dynamic call.
+    /// medium, so `density` is called directly (and can be inlined), and
+    /// neighbouring look-ups overlap in the processor instead of each
+    /// waiting for a dynamic call.
     fn densities(&self, points: &[Vec3], out: &mut [f64]) {
         for (v, &p) in out.iter_mut().zip(points) {
             *v = self.density(p);

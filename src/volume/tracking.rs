@@ -571,7 +571,10 @@ impl Course {
 /// each waiting on its loads behind a dynamic call (the look-up was half a
 /// walk's time: 0.165 s to 0.127 s for 4M walks on the race's grid), and a
 /// walk that ends hands its place to a fresh one. Each walk is still a
-/// walk of its own, drawn from its own variates.
+/// walk of its own, drawn from its own variates. (A walk past the cap of
+/// [`MAX_COLLISIONS`] a span ends them all with an error, but only after the
+/// batch's other walks have taken as many steps: up to 64 times the cap's
+/// look-ups.)
 fn delta_walks<Rg: rand::Rng + ?Sized>(
     sigma: Extinction,
     ray: &Ray,
@@ -730,11 +733,16 @@ pub fn expected_lookups(scene: &VolumeScene, walks: Walks) -> Result<f64, QuadEr
                     && medium
                         .density_integral(&shadow_ray, 0.0, f64::INFINITY)
                         .is_some();
+                // A shadow ray that tracking refuses (too deep a bound)
+                // counts at the refusal's threshold: walks that collide
+                // near it fail when they run.
                 Ok(if closed {
                     0.0
                 } else {
-                    let s = spans_of_shadow(sigma, &shadow_ray, &mut unused)?;
-                    s.iter().map(crossing).sum()
+                    spans_of_shadow(sigma, &shadow_ray, &mut unused)
+                        .map_or((MAX_COLLISIONS / 2) as f64, |s| {
+                            s.iter().map(crossing).sum()
+                        })
                 })
             };
             let mut total = 0.0;
@@ -761,6 +769,12 @@ fn delta_lookups(
     let mut each = Vec::with_capacity(spans.len());
     for s in spans {
         let length = s.b - s.a;
+        // A span rounded to length 0 takes no collision (its rate may be
+        // 1 / 0 where radiance scores on a span without extinction).
+        if length <= 0.0 {
+            each.push(0.0);
+            continue;
+        }
         let depth = sigma.lambda * sigma.medium.min_density(ray, s.a, s.b) * length;
         // int_0^L exp(-m t) dt = L (1 - exp(-m L)) / (m L).
         let within = if depth > 0.0 {
