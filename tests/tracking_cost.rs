@@ -53,6 +53,24 @@ fn measured(mut run: impl FnMut(&mut rand_pcg::Pcg64) -> u64, n: usize) -> (f64,
     (mean, (var / batches as f64).sqrt())
 }
 
+/// The mean look-ups of `tracker`'s transmittance walks over the whole eye
+/// ray of `scene` ([`measured`], 20 batches of 20,000 walks).
+fn walk_lookups(scene: &VolumeScene, tracker: Tracker) -> (f64, f64) {
+    let sigma = Extinction {
+        medium: scene.medium.as_deref().expect("medium"),
+        lambda: scene.lambda,
+    };
+    let n = 20_000;
+    measured(
+        |rng| {
+            transmittance(tracker, sigma, &scene.ray, 0.0, f64::INFINITY, n, rng)
+                .expect("walks")
+                .evaluations
+        },
+        n,
+    )
+}
+
 /// In a sphere of constant extinction `sigma` a delta-tracking walk stops at
 /// its first tentative collision that is real, and every one is
 /// (`sigma_bar = sigma`): it makes one look-up with probability `1 - tau`,
@@ -66,10 +84,7 @@ fn a_constant_sphere_costs_the_closed_forms() {
             Arc::new(ConstantSphere::new(Vec3::zeros(), 1.0, kappa).expect("sphere")),
             lambda,
         );
-        let (ray, chord) = (
-            scene.ray,
-            2.0 * (1.0f64 - 0.01f64.powi(2) - 0.02f64.powi(2)).sqrt(),
-        );
+        let chord = 2.0 * (1.0f64 - 0.01f64.powi(2) - 0.02f64.powi(2)).sqrt();
         let d = lambda * kappa * chord;
         let delta = expected_lookups(&scene, Walks::Transmittance(Tracker::Delta)).expect("delta");
         let want = -(-d).exp_m1();
@@ -86,23 +101,11 @@ fn a_constant_sphere_costs_the_closed_forms() {
         );
 
         // The walks themselves.
-        let sigma = Extinction {
-            medium: scene.medium.as_deref().expect("medium"),
-            lambda,
-        };
-        let n = 20_000;
         for (tracker, want) in [(Tracker::Delta, delta), (Tracker::Ratio, ratio)] {
             if want > 1e4 {
                 continue;
             }
-            let (mean, se) = measured(
-                |rng| {
-                    transmittance(tracker, sigma, &ray, 0.0, f64::INFINITY, n, rng)
-                        .expect("walks")
-                        .evaluations
-                },
-                n,
-            );
+            let (mean, se) = walk_lookups(&scene, tracker);
             assert!(
                 (mean - want).abs() <= 5.0 * se + 1e-12 * want,
                 "kappa {kappa} {tracker:?}: {mean} +- {se} look-ups a walk, expected {want}"
@@ -121,33 +124,13 @@ fn a_constant_sphere_costs_the_closed_forms() {
 fn delta_tracking_through_a_grid_costs_at_most_the_bound() {
     for (lo, lambda) in [(0.0, 0.5), (2.0, 1.0), (5e8, 1.0)] {
         let scene = along_x(grid(lo), lambda);
-        let sigma = Extinction {
-            medium: scene.medium.as_deref().expect("medium"),
-            lambda,
-        };
         let bound = expected_lookups(&scene, Walks::Transmittance(Tracker::Delta)).expect("delta");
         let (_, depth) = scene.depth_bound();
         assert!(
             bound <= depth * (1.0 + 1e-12),
             "lo {lo}: {bound} above the depth {depth}"
         );
-        let n = 20_000;
-        let (mean, se) = measured(
-            |rng| {
-                transmittance(
-                    Tracker::Delta,
-                    sigma,
-                    &scene.ray,
-                    0.0,
-                    f64::INFINITY,
-                    n,
-                    rng,
-                )
-                .expect("walks")
-                .evaluations
-            },
-            n,
-        );
+        let (mean, se) = walk_lookups(&scene, Tracker::Delta);
         assert!(
             mean <= bound + 5.0 * se,
             "lo {lo}: {mean} +- {se} look-ups a walk above {bound}"
@@ -279,27 +262,7 @@ fn delta_tracking_through_a_dense_blob_costs_tens_of_lookups() {
         figure < 100.0 && depth > 1e6,
         "figure {figure}, depth {depth}"
     );
-    let sigma = Extinction {
-        medium: scene.medium.as_deref().expect("medium"),
-        lambda: 1.0,
-    };
-    let n = 20_000;
-    let (mean, se) = measured(
-        |rng| {
-            transmittance(
-                Tracker::Delta,
-                sigma,
-                &scene.ray,
-                0.0,
-                f64::INFINITY,
-                n,
-                rng,
-            )
-            .expect("walks")
-            .evaluations
-        },
-        n,
-    );
+    let (mean, se) = walk_lookups(&scene, Tracker::Delta);
     assert!(
         mean <= figure + 5.0 * se,
         "{mean} +- {se} look-ups a walk above {figure}"
