@@ -30,34 +30,50 @@ fn scratch(tag: &str) -> PathBuf {
     dir
 }
 
-/// Runs the job in a child process and returns the largest peak resident
-/// memory of any child waited for so far, in bytes (`getrusage`).
+/// Runs the job in a child process and returns that child's own peak
+/// resident memory in bytes (`wait4` on its pid: `getrusage(RUSAGE_CHILDREN)`
+/// would report the largest child of the whole test binary, whose other
+/// tests run children of their own at the same time).
 #[cfg(target_os = "linux")]
 fn run_and_measure(rule: &str, n: usize) -> f64 {
+    use std::io::Read;
+    use std::process::Stdio;
     let dir = scratch(&format!("{rule}-{n}"));
     let file = dir.join("e.json");
     std::fs::write(&file, experiment(rule, n)).expect("write");
-    let o = bin()
+    #[expect(clippy::zombie_processes, reason = "reaped by wait4 below")]
+    let mut child = bin()
         .arg("run")
         .arg(&file)
         .arg("--out")
         .arg(dir.join("out"))
         .args(["--threads", "1"])
-        .output()
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
         .expect("runs");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let _ = std::fs::remove_dir_all(&dir);
-    // SAFETY: getrusage writes one rusage struct, which lives on our stack.
+    let mut stderr = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = e.read_to_string(&mut stderr);
+    }
+    let pid = libc::pid_t::try_from(child.id()).expect("pid fits pid_t");
+    let mut status = 0;
+    // SAFETY: wait4 writes one int and one rusage struct, both on our stack;
+    // the child is reaped here and never waited for through `child`.
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    let rc = unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) };
-    assert_eq!(rc, 0, "getrusage failed");
+    let rc = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(rc, pid, "wait4 failed");
+    assert!(
+        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
+        "status {status}: {stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
     usage.ru_maxrss as f64 * 1024.0
 }
 
 /// The estimates of the two rules whose tables grow with n are within a
 /// factor 1.5 of the peak memory measured (above the binary's own baseline,
-/// measured on a job of 16 nodes). Children run in increasing order of
-/// memory, since the measure is the largest child so far.
+/// measured on a job of 16 nodes).
 #[cfg(target_os = "linux")]
 #[test]
 fn memory_estimates_match_the_measured_peak() {
