@@ -468,7 +468,7 @@ fn fixed_nodes(rule: &str, n: usize) -> Result<(Vec<f64>, Vec<f64>), Failure> {
     match rule {
         "gauss-legendre" => {
             let t = gauss_legendre::table(n)?;
-            Ok((t.x.into_owned(), t.w.into_owned()))
+            Ok((t.x().to_vec(), t.w().to_vec()))
         }
         "simpson" => {
             let t = lightquad::quadrature::simpson::unit_nodes(n).map_err(|_| {

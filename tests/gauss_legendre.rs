@@ -28,17 +28,17 @@ fn nodes_and_weights_match_40_digit_tables_for_n_up_to_100() {
         let t = table(n).expect("valid n");
         for i in 0..n {
             assert!(
-                (t.x[i] - x[i]).abs() <= EPS * x[i].abs().max(0.5),
+                (t.x()[i] - x[i]).abs() <= EPS * x[i].abs().max(0.5),
                 "n={n} i={i}: x {} vs {}",
-                t.x[i],
+                t.x()[i],
                 x[i]
             );
             assert!(
-                rel(t.w[i], w[i]) <= EPS,
+                rel(t.w()[i], w[i]) <= EPS,
                 "n={n} i={i}: w {} vs {} ({:.1} ulps)",
-                t.w[i],
+                t.w()[i],
                 w[i],
-                rel(t.w[i], w[i]) / EPS
+                rel(t.w()[i], w[i]) / EPS
             );
             // The table only has x rounded to f64, so 1 - |x| is known to
             // an absolute ulp here (the large-n test checks it relatively).
@@ -93,12 +93,12 @@ fn tabulated_rules_are_symmetric_sum_to_one_and_exact_for_degree_2n_minus_1() {
     for n in 1..=TABLE_MAX_ORDER {
         // table() mirrors the half rule: ascending, x[i] = -x[n-1-i].
         let t = table(n).expect("valid n");
-        assert_eq!((t.x.len(), t.w.len()), (n, n));
+        assert_eq!((t.x().len(), t.w().len()), (n, n));
         for i in 0..n {
-            assert_eq!(t.x[i], -t.x[n - 1 - i], "n={n} i={i}");
-            assert_eq!(t.w[i], t.w[n - 1 - i], "n={n} i={i}");
+            assert_eq!(t.x()[i], -t.x()[n - 1 - i], "n={n} i={i}");
+            assert_eq!(t.w()[i], t.w()[n - 1 - i], "n={n} i={i}");
             if i > 0 {
-                assert!(t.x[i - 1] < t.x[i], "n={n} i={i}: not ascending");
+                assert!(t.x()[i - 1] < t.x()[i], "n={n} i={i}: not ascending");
             }
         }
         // On [0, 1]: sum w = 1 (each weight is rounded once, so to half an
@@ -129,9 +129,9 @@ fn sampled_nodes_match_40_digit_values_for_large_n() {
             );
             for (i, sign) in [(n - k, 1.0), (k - 1, -1.0)] {
                 assert!(
-                    (t.x[i] - sign * x).abs() <= EPS,
+                    (t.x()[i] - sign * x).abs() <= EPS,
                     "n={n} k={k}: x {} vs {}",
-                    t.x[i],
+                    t.x()[i],
                     sign * x
                 );
                 let got = half_node(n, k).expect("valid node").one_minus_x;
@@ -141,10 +141,10 @@ fn sampled_nodes_match_40_digit_values_for_large_n() {
                     rel(got, y) / EPS
                 );
                 assert!(
-                    rel(t.w[i], w) <= 2.0 * EPS,
+                    rel(t.w()[i], w) <= 2.0 * EPS,
                     "n={n} k={k}: w {} vs {w} ({:.1} ulps)",
-                    t.w[i],
-                    rel(t.w[i], w) / EPS
+                    t.w()[i],
+                    rel(t.w()[i], w) / EPS
                 );
             }
         }
@@ -158,17 +158,23 @@ fn sampled_nodes_match_40_digit_values_for_large_n() {
 /// power is taken as `exp(d ln(1 - y/2))`, which the accurate `y` makes exact
 /// to a few ulps.
 fn shifted_monomial(t: &lightquad::quadrature::gauss_legendre::Table, d: i32) -> f64 {
-    let n = t.x.len();
-    lightquad::sum::sum_f64(t.x.iter().zip(t.w.iter()).enumerate().map(|(i, (x, w))| {
-        let k = if *x < 0.0 { i + 1 } else { n - i };
-        let y = half_node(n, k).expect("valid node").one_minus_x;
-        let power = if *x < 0.0 {
-            (0.5 * y).powi(d)
-        } else {
-            (d as f64 * (-0.5 * y).ln_1p()).exp()
-        };
-        w * power
-    }))
+    let n = t.x().len();
+    lightquad::sum::sum_f64(
+        t.x()
+            .iter()
+            .zip(t.w().iter())
+            .enumerate()
+            .map(|(i, (x, w))| {
+                let k = if *x < 0.0 { i + 1 } else { n - i };
+                let y = half_node(n, k).expect("valid node").one_minus_x;
+                let power = if *x < 0.0 {
+                    (0.5 * y).powi(d)
+                } else {
+                    (d as f64 * (-0.5 * y).ln_1p()).exp()
+                };
+                w * power
+            }),
+    )
 }
 
 #[test]
@@ -195,8 +201,9 @@ fn not_exact_for_degree_2n_and_the_error_is_the_closed_form() {
     for n in 1..=12usize {
         let t = table(n).expect("valid n");
         let q = lightquad::sum::sum_f64(
-            t.x.iter()
-                .zip(t.w.iter())
+            t.x()
+                .iter()
+                .zip(t.w().iter())
                 .map(|(x, w)| w * x.powi(2 * n as i32)),
         );
         let exact = 2.0 / (2.0 * n as f64 + 1.0);
@@ -223,11 +230,12 @@ fn large_n_weights_sum_to_two_and_cos_50x_is_exact() {
     let exact = 2.0 * 50f64.sin() / 50.0;
     for n in [1_000usize, 100_000, 1_000_000] {
         let t = table(n).expect("valid n");
-        let sum_w = lightquad::sum::sum_f64(t.w.iter().copied());
+        let sum_w = lightquad::sum::sum_f64(t.w().iter().copied());
         assert!((sum_w - 2.0).abs() <= 1e-13, "n={n}: sum w = {sum_w}");
         let q = lightquad::sum::sum_f64(
-            t.x.iter()
-                .zip(t.w.iter())
+            t.x()
+                .iter()
+                .zip(t.w().iter())
                 .map(|(x, w)| w * (50.0 * x).cos()),
         );
         assert!((q - exact).abs() <= 1e-13, "n={n}: {q} vs {exact}");

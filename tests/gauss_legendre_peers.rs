@@ -43,7 +43,7 @@ fn the_two_term_regime_agrees_with_bilby() {
     for n in [5000usize, 20_000] {
         let ours = table(n).expect("valid n");
         let (bx, bw) = bilby_rule(n);
-        let (dx, dw) = max_diff(&ours.x, &ours.w, &bx, &bw);
+        let (dx, dw) = max_diff(ours.x(), ours.w(), &bx, &bw);
         assert!(dx <= 4.0 && dw <= 6.0, "n={n}: {dx} eps, {dw} eps");
     }
 }
@@ -63,8 +63,8 @@ fn agrees_with_bilby_and_gauss_quad_and_is_at_least_as_accurate() {
         let (gx, gw) = ascending(gq.iter().map(|(x, w)| (*x, *w)).collect());
 
         // Whole-rule agreement between independent implementations.
-        let (dx_b, dw_b) = max_diff(&ours.x, &ours.w, &bx, &bw);
-        let (dx_g, dw_g) = max_diff(&ours.x, &ours.w, &gx, &gw);
+        let (dx_b, dw_b) = max_diff(ours.x(), ours.w(), &bx, &bw);
+        let (dx_g, dw_g) = max_diff(ours.x(), ours.w(), &gx, &gw);
         eprintln!(
             "n={n}: max |dx| vs bilby {dx_b:.2} eps, vs gauss-quad {dx_g:.2} eps; \
              max rel dw vs bilby {dw_b:.2} eps, vs gauss-quad {dw_g:.2} eps"
@@ -80,11 +80,11 @@ fn agrees_with_bilby_and_gauss_quad_and_is_at_least_as_accurate() {
             let k = node["k"].as_u64().expect("k") as usize;
             let (x, w) = (num(&node["x"]), num(&node["weight"]));
             let i = n - k;
-            for (slot, (xs, ws)) in worst.iter_mut().zip([
-                (&ours.x[..], &ours.w[..]),
-                (&bx[..], &bw[..]),
-                (&gx[..], &gw[..]),
-            ]) {
+            for (slot, (xs, ws)) in
+                worst
+                    .iter_mut()
+                    .zip([(ours.x(), ours.w()), (&bx[..], &bw[..]), (&gx[..], &gw[..])])
+            {
                 slot.0 = slot.0.max((xs[i] - x).abs() / EPS);
                 slot.1 = slot.1.max(rel(ws[i], w) / EPS);
             }

@@ -80,7 +80,7 @@ fn sphere_integral(
     let mut total = 0.0;
     for pc in phi_cuts.windows(2) {
         let (p0, p1) = (pc[0], pc[1]);
-        for (&xp, &wp) in gl.x.iter().zip(gl.w.iter()) {
+        for (&xp, &wp) in gl.x().iter().zip(gl.w().iter()) {
             let phi = p0 + (p1 - p0) * (xp + 1.0) / 2.0;
             let e = frame.s * phi.cos() + frame.t * phi.sin();
             let mut cuts = base.clone();
@@ -97,7 +97,7 @@ fn sphere_integral(
             let mut inner = 0.0;
             for c in cuts.windows(2) {
                 let (a0, a1) = (c[0], c[1]);
-                for (&xa, &wa) in gl.x.iter().zip(gl.w.iter()) {
+                for (&xa, &wa) in gl.x().iter().zip(gl.w().iter()) {
                     let a = a0 + (a1 - a0) * (xa + 1.0) / 2.0;
                     let w = frame.n * a.cos() + e * a.sin();
                     inner += wa * (a1 - a0) / 2.0 * f(w) * a.sin();
@@ -310,10 +310,10 @@ fn chi_square(b: &dyn Brdf, wo: Vec3, n: usize, seed: u64) -> (f64, usize, f64) 
             2.0 * PI * (ip + 1) as f64 / res_phi as f64,
         );
         let mut s = 0.0;
-        for (&xz, &wz) in gl.x.iter().zip(gl.w.iter()) {
+        for (&xz, &wz) in gl.x().iter().zip(gl.w().iter()) {
             let z = z0 + (z1 - z0) * (xz + 1.0) / 2.0;
             let r = ((1.0 - z) * (1.0 + z)).sqrt();
-            for (&xp, &wp) in gl.x.iter().zip(gl.w.iter()) {
+            for (&xp, &wp) in gl.x().iter().zip(gl.w().iter()) {
                 let phi = p0 + (p1 - p0) * (xp + 1.0) / 2.0;
                 s += wz * wp * b.pdf(wo, Vec3::new(r * phi.cos(), r * phi.sin(), z));
             }

@@ -165,9 +165,9 @@ impl Domain<2> for ClippedCone {
         }
         crate::quadrature::gauss_legendre::table(64).map_or(f64::NAN, |table| {
             table
-                .x
+                .x()
                 .iter()
-                .zip(table.w.iter())
+                .zip(table.w())
                 .map(|(x, w)| {
                     let t = (x + 1.0) / 2.0;
                     // (w / 2) 2 phi_0 (2 span t) over t in [0, 1].

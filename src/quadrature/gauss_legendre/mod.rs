@@ -52,39 +52,70 @@ const PARALLEL_FROM: usize = 1 << 15;
 
 /// The n-point Gauss–Legendre rule on `[-1, 1]`, nodes ascending.
 ///
-/// For `n <= TABLE_MAX_ORDER` both slices are borrowed from the compiled-in
-/// tables (no allocation, nothing computed); above, they are owned.
+/// One buffer of `2n` values, the nodes and then the weights. For
+/// `n <= TABLE_MAX_ORDER` it is borrowed from the compiled-in tables (no
+/// allocation, nothing computed); above, it is owned. One allocation, not
+/// two: at n = 1e6 glibc gives two 8 MB buffers back to the kernel at every
+/// free and faults their pages in again at the next rule (about 4 ms of the
+/// 10), while one 16 MB buffer stays below its trim threshold and is reused.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
-    /// Nodes `x_i`, ascending.
-    pub x: Cow<'static, [f64]>,
-    /// Weights `w_i`, summing to 2.
-    pub w: Cow<'static, [f64]>,
+    nodes_then_weights: Cow<'static, [f64]>,
 }
 
-/// Length of all tabulated rules one after another, `sum_{n <= 100} n`.
-const FULL_LEN: usize = TABLE_MAX_ORDER * (TABLE_MAX_ORDER + 1) / 2;
-/// Nodes of every tabulated rule in full, ascending, order n at
-/// `n (n - 1)/2` ([`full_rule`]); built at compile time from the half table.
-static FULL_X: [f64; FULL_LEN] = mirrored(0, true);
-/// Weights of every tabulated rule in full, laid out as [`FULL_X`].
-static FULL_W: [f64; FULL_LEN] = mirrored(2, false);
+impl Table {
+    /// The order n.
+    pub fn len(&self) -> usize {
+        self.nodes_then_weights.len() / 2
+    }
 
-/// Column `col` of the tabulated half rules mirrored into full rules
-/// ascending in x: entry `i < n/2` of order n is row `k = i + 1` (negated when
-/// `negate_lower`: the node `-x_k`), entry `i >= n/2` is row `k = n - i`
-/// (the middle row of an odd rule at `i = n/2`).
-const fn mirrored(col: usize, negate_lower: bool) -> [f64; FULL_LEN] {
+    /// Always false: a rule has at least one node.
+    pub fn is_empty(&self) -> bool {
+        self.nodes_then_weights.is_empty()
+    }
+
+    /// Nodes `x_i`, ascending.
+    pub fn x(&self) -> &[f64] {
+        &self.nodes_then_weights[..self.len()]
+    }
+
+    /// Weights `w_i`, summing to 2.
+    pub fn w(&self) -> &[f64] {
+        &self.nodes_then_weights[self.len()..]
+    }
+
+    /// The same rule in a buffer of its own (a copy of a compiled-in rule).
+    pub fn into_owned(self) -> Self {
+        Self {
+            nodes_then_weights: Cow::Owned(self.nodes_then_weights.into_owned()),
+        }
+    }
+}
+
+/// Length of all tabulated rules one after another, nodes then weights,
+/// `sum_{n <= 100} 2n`.
+const FULL_LEN: usize = TABLE_MAX_ORDER * (TABLE_MAX_ORDER + 1);
+/// Every tabulated rule in full, order n at `n (n - 1)` ([`full_rule`]):
+/// its n nodes ascending, then its n weights; built at compile time from
+/// the half table.
+static FULL: [f64; FULL_LEN] = mirrored();
+
+/// The tabulated half rules mirrored into full rules ascending in x: entry
+/// `i < n/2` of order n is row `k = i + 1` (its node negated: `-x_k`), entry
+/// `i >= n/2` is row `k = n - i` (the middle row of an odd rule at
+/// `i = n/2`); the weights follow the nodes in the same order.
+const fn mirrored() -> [f64; FULL_LEN] {
     let mut out = [0.0; FULL_LEN];
     let mut n = 1;
     while n <= TABLE_MAX_ORDER {
-        let (start, half) = (n * (n - 1) / 2, n * n / 4);
+        let (start, half) = (n * (n - 1), n * n / 4);
         let mut i = 0;
         while i < n {
             let lower = i < n / 2;
             let k = if lower { i + 1 } else { n - i };
-            let v = small_table::HALF_NODES[half + k - 1][col];
-            out[start + i] = if negate_lower && lower { -v } else { v };
+            let [x, _, w] = small_table::HALF_NODES[half + k - 1];
+            out[start + i] = if lower { -x } else { x };
+            out[start + n + i] = w;
             i += 1;
         }
         n += 1;
@@ -92,11 +123,11 @@ const fn mirrored(col: usize, negate_lower: bool) -> [f64; FULL_LEN] {
     out
 }
 
-/// The tabulated rule of order `n <= TABLE_MAX_ORDER` in full: (nodes
-/// ascending, weights), starting at `sum_{m<n} m = n (n - 1)/2`.
-fn full_rule(n: usize) -> (&'static [f64], &'static [f64]) {
-    let start = n * (n - 1) / 2;
-    (&FULL_X[start..start + n], &FULL_W[start..start + n])
+/// The tabulated rule of order `n <= TABLE_MAX_ORDER` in full (nodes
+/// ascending, then weights), starting at `sum_{m<n} 2m = n (n - 1)`.
+fn full_rule(n: usize) -> &'static [f64] {
+    let start = n * (n - 1);
+    &FULL[start..start + 2 * n]
 }
 
 /// Checks an order n.
@@ -272,18 +303,15 @@ fn fill_symmetric(
 pub fn table(n: usize) -> Result<Table, QuadError> {
     check_order(n)?;
     if n <= TABLE_MAX_ORDER {
-        let (x, w) = full_rule(n);
         return Ok(Table {
-            x: Cow::Borrowed(x),
-            w: Cow::Borrowed(w),
+            nodes_then_weights: Cow::Borrowed(full_rule(n)),
         });
     }
-    let mut x = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    fill_symmetric(n, &mut x, &mut w, 1.0, |node| (-node.x, node.x));
+    let mut buffer = vec![0.0; 2 * n];
+    let (x, w) = buffer.split_at_mut(n);
+    fill_symmetric(n, x, w, 1.0, |node| (-node.x, node.x));
     Ok(Table {
-        x: Cow::Owned(x),
-        w: Cow::Owned(w),
+        nodes_then_weights: Cow::Owned(buffer),
     })
 }
 
