@@ -129,6 +129,41 @@ impl<V: Value> Lanes<V> {
         self.lanes = lanes;
     }
 
+    /// [`Lanes::add_products`] and, in the same pass, the scale of the
+    /// terms: `|w_i y_i|` added to `magnitude` and the largest kept in
+    /// `largest`, lane by lane as the sum groups them (finite terms: a plain
+    /// comparison, without `f64::max`'s NaN handling). One pass, each product
+    /// formed once.
+    #[inline(always)]
+    pub fn add_products_scaled(
+        &mut self,
+        ys: &[V],
+        ws: &[f64],
+        magnitude: &mut [V; LANES],
+        largest: &mut [V; LANES],
+    ) {
+        // Local copies, which the compiler keeps in registers.
+        let (mut lanes, mut m, mut l) = (self.lanes, *magnitude, *largest);
+        let mut add = |k: usize, y: V, w: f64| {
+            let t = y.map(|v| v * w);
+            lanes[k].add(t);
+            let a = t.map(f64::abs);
+            m[k] = m[k].zip(a, |p, q| p + q);
+            l[k] = l[k].zip(a, |p, q| if q > p { q } else { p });
+        };
+        let mut y4 = ys.chunks_exact(LANES);
+        let mut w4 = ws.chunks_exact(LANES);
+        for (y, w) in (&mut y4).zip(&mut w4) {
+            for k in 0..LANES {
+                add(k, y[k], w[k]);
+            }
+        }
+        for (y, &w) in y4.remainder().iter().zip(w4.remainder()) {
+            add(0, *y, w);
+        }
+        (self.lanes, *magnitude, *largest) = (lanes, m, l);
+    }
+
     /// The compensated total of every lane.
     pub fn total(&self) -> V {
         let mut all = Compensated::new();

@@ -876,3 +876,64 @@ fn a_budget_whose_working_memory_cannot_fit_is_refused_at_once() {
     let ok = GaussKronrod::default().integrate(1000, &mut rng, |u: [f64; 1]| u[0]);
     assert!((ok.expect("fits").value - 0.5).abs() < 1e-14);
 }
+
+/// The one-axis sum checks its values once a block of 64 nodes: a NaN or
+/// infinite value anywhere in a later block, with a second one after it in
+/// the same block, is reported at the first of them (the node's own `u`),
+/// for scalars and for every channel of a colour; a clean sum's `magnitude`
+/// and `largest` are `sum |w f|` and `max |w f|` computed term by term.
+#[test]
+fn the_line_sum_reports_the_first_non_finite_node_of_any_block() {
+    use lightquad::quadrature::gauss_legendre::unit_nodes;
+    use lightquad::quadrature::nodes::product_sum;
+    let nodes = unit_nodes(300).expect("300 nodes");
+    let u = &nodes.u;
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        for (first, second) in [(0usize, 1usize), (70, 100), (191, 192), (298, 299)] {
+            let err = product_sum([nodes.as_ref()], |p: [f64; 1]| {
+                let hit = p[0] == u[first] || p[0] == u[second];
+                Ok(if hit { bad } else { 1.0 })
+            })
+            .expect_err("a non-finite value");
+            match err {
+                QuadError::NonFiniteIntegrand { point, .. } => {
+                    assert_eq!(point, vec![u[first]], "{bad} at {first} and {second}")
+                }
+                other => panic!("{bad} at {first}: {other}"),
+            }
+            for channel in 0..3 {
+                let err = product_sum([nodes.as_ref()], |p: [f64; 1]| {
+                    let mut v = Rgb::new(1.0, 2.0, 3.0);
+                    if p[0] == u[first] || p[0] == u[second] {
+                        v[channel] = bad;
+                    }
+                    Ok(v)
+                })
+                .expect_err("a non-finite channel");
+                assert!(
+                    matches!(&err, QuadError::NonFiniteIntegrand { point, .. } if *point == vec![u[first]]),
+                    "{bad} in channel {channel} at {first}: {err}"
+                );
+            }
+        }
+    }
+    // A clean sum of a sign-changing integrand: magnitude and largest.
+    let f = |x: f64| (37.0 * x).sin() * (1.0 + 5.0 * x);
+    let s = product_sum([nodes.as_ref()], |p: [f64; 1]| Ok(f(p[0]))).expect("finite");
+    let terms: Vec<f64> = u
+        .iter()
+        .zip(&nodes.w)
+        .map(|(&x, w)| (w * f(x)).abs())
+        .collect();
+    let magnitude = lightquad::sum::sum_f64(terms.iter().copied());
+    let largest = terms.iter().copied().fold(0.0, f64::max);
+    assert!((s.magnitude - magnitude).abs() <= 1e-14 * magnitude);
+    assert_eq!(s.largest, largest);
+    // int_0^1 sin(37 x) (1 + 5 x) dx in closed form.
+    let exact = (1.0 - 6.0 * 37f64.cos()) / 37.0 + 5.0 * 37f64.sin() / (37.0 * 37.0);
+    assert!(
+        (s.value - exact).abs() <= 1e-15,
+        "{} against {exact}",
+        s.value
+    );
+}
