@@ -1,24 +1,52 @@
 //! Records the git commit the binary was built from (when git and a checkout
-//! are available) so every result line can carry it, and builds the bundled
+//! are available; `-dirty` when its sources differ from it) so every result
+//! line can carry it, and builds the bundled
 //! suite into the crate: every `experiments/*.json` and every Mitsuba values
 //! file `reference/values/*.json`, so `lightquad run` works from any folder
 //! (see `src/experiment/bundled.rs`).
 use std::path::{Path, PathBuf};
 
 fn main() {
-    let commit = std::process::Command::new("git")
-        .args(["rev-parse", "--short=12", "HEAD"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .and_then(|o| String::from_utf8(o.stdout).ok())
+    // What goes into the binary: a change to any of these in the work tree
+    // (tracked or not) marks the commit "-dirty", so a result line never
+    // names a commit whose code it was not computed with.
+    const SOURCES: [&str; 6] = [
+        "src",
+        "build.rs",
+        "Cargo.toml",
+        "Cargo.lock",
+        "experiments",
+        "reference/values",
+    ];
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .and_then(|o| String::from_utf8(o.stdout).ok())
+    };
+    let commit = git(&["rev-parse", "--short=12", "HEAD"])
         .map(|s| s.trim().to_string())
         .unwrap_or_default();
-    println!("cargo:rustc-env=LIGHTQUAD_GIT_COMMIT={commit}");
+    let dirty = !commit.is_empty()
+        && git(&[&["status", "--porcelain", "--"][..], &SOURCES[..]].concat())
+            .is_none_or(|changes| !changes.trim().is_empty());
+    let stamp = if dirty {
+        format!("{commit}-dirty")
+    } else {
+        commit
+    };
+    println!("cargo:rustc-env=LIGHTQUAD_GIT_COMMIT={stamp}");
     // The commit moves when HEAD names another branch, when the branch's
-    // ref file is rewritten, or when refs are packed.
+    // ref file is rewritten, or when refs are packed; the stamp's "-dirty"
+    // when the index or a source changes.
     println!("cargo:rerun-if-changed=.git/HEAD");
     println!("cargo:rerun-if-changed=.git/packed-refs");
+    println!("cargo:rerun-if-changed=.git/index");
+    for source in SOURCES {
+        println!("cargo:rerun-if-changed={source}");
+    }
     if let Ok(head) = std::fs::read_to_string(".git/HEAD")
         && let Some(branch) = head.trim().strip_prefix("ref: ")
     {
