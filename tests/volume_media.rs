@@ -860,3 +860,36 @@ fn a_subnormal_density_is_refused() {
     assert!(ConstantSphere::new(Vec3::zeros(), 1.0, 0.0).is_ok());
     assert!(ConstantSphere::new(Vec3::zeros(), 1.0, f64::MIN_POSITIVE).is_ok());
 }
+
+/// A gradient of 1e300 (its square overflows): the density bounds stay
+/// finite and bound the density, which is at most `b + |g| R` = 2e300 in the
+/// unit sphere; the bound's rounding margin is a few ulps of that, not the
+/// infinity of `sqrt(1e600)` that made the depth bound at lambda = 0 NaN
+/// (hostile probe, session 30).
+#[test]
+fn linear_gradient_bounds_stay_finite_for_a_gradient_whose_square_overflows() {
+    let g = LinearGradient::new(Vec3::zeros(), 1.0, 1e300, Vec3::new(1e300, 0.0, 0.0))
+        .expect("valid medium");
+    let r = ray([-3.0, 0.2, 0.0], [1.0, 0.0, 0.0]);
+    // The chord: x from -sqrt(0.96) to +sqrt(0.96), t = x + 3.
+    let h = 0.96f64.sqrt();
+    let (a, b) = (3.0 - h, 3.0 + h);
+    let exact_max = 1e300 * (1.0 + h);
+    let exact_min = 1e300 * (1.0 - h);
+    let max = g.max_density(&r, a, b);
+    let min = g.min_density(&r, a, b);
+    assert!(max.is_finite() && min.is_finite(), "max {max}, min {min}");
+    assert!(
+        max >= exact_max && max <= exact_max * (1.0 + 1e-13),
+        "max {max} against {exact_max}"
+    );
+    assert!(
+        min <= exact_min && min >= exact_min * (1.0 - 1e-12),
+        "min {min} against {exact_min}"
+    );
+    // lambda = 0: no extinction at all, so the depth bound is 0, not NaN.
+    let mut scene = VolumeScene::new(r);
+    scene.medium = Some(Arc::new(g));
+    scene.lambda = 0.0;
+    assert_eq!(scene.depth_bound(), (0.0, 0.0));
+}

@@ -96,6 +96,25 @@ impl LinearGradient {
         self.base + self.gradient.dot(&(p - self.sphere.centre))
     }
 
+    /// The rounding allowance of the density bounds, `16 eps (|b| + |g| (|c|
+    /// + 2 R))`: evaluating `b + g . (x - c)` in the sphere rounds by a few
+    /// ulps of that scale. `|g|` and `|c|` are taken scaled by their largest
+    /// component, so a gradient of 1e300 gives 1e300, not the infinity of
+    /// `sqrt(1e600)` (which made the depth bound at lambda = 0 NaN).
+    fn rounding_margin(&self) -> f64 {
+        let norm = |v: Vec3| {
+            let m = v.amax();
+            if m > 0.0 && m.is_finite() {
+                m * (v / m).norm()
+            } else {
+                m
+            }
+        };
+        let scale = self.base.abs()
+            + norm(self.gradient) * (norm(self.sphere.centre) + 2.0 * self.sphere.radius);
+        16.0 * f64::EPSILON * scale
+    }
+
     /// The linear function along `ray`, centred at its closest approach.
     fn along(&self, ray: &Ray) -> Along {
         let t_c = (self.sphere.centre - ray.origin).dot(&ray.dir);
@@ -199,9 +218,7 @@ impl Medium for LinearGradient {
             return 0.0;
         };
         let peak = self.linear(ray.at(a)).max(self.linear(ray.at(b)));
-        let scale = self.base.abs()
-            + self.gradient.norm() * (self.sphere.centre.norm() + 2.0 * self.sphere.radius);
-        peak.max(0.0) + 16.0 * f64::EPSILON * scale
+        peak.max(0.0) + self.rounding_margin()
     }
 
     /// The smaller end value of the linear function (it is linear along the
@@ -213,9 +230,7 @@ impl Medium for LinearGradient {
             return 0.0;
         }
         let low = self.linear(ray.at(t0)).min(self.linear(ray.at(t1)));
-        let scale = self.base.abs()
-            + self.gradient.norm() * (self.sphere.centre.norm() + 2.0 * self.sphere.radius);
-        (low - 16.0 * f64::EPSILON * scale).max(0.0)
+        (low - self.rounding_margin()).max(0.0)
     }
 
     /// `(b - a)` times the value at the midpoint of the positive chord `[a, b]`
