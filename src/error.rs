@@ -72,6 +72,17 @@ pub enum QuadError {
         /// The scaling exponent.
         exponent: i32,
     },
+    /// A tracking walk would take more tentative collisions on one span of
+    /// the ray than it may.
+    #[error(
+        "a tracking walk needs more than {limit} tentative collisions on one span of the ray: the majorant's optical depth over the span is {depth:.3e}; expected a depth below about {limit} per span: lower the medium's density or lambda (`scene.medium`, `scene.lambda` in an experiment), or integrate with a quadrature rule"
+    )]
+    TooDeepForTracking {
+        /// The majorant's optical depth over the span.
+        depth: f64,
+        /// Most tentative collisions per walk and span.
+        limit: u64,
+    },
     /// The integrand returned a non-finite value.
     #[error("integrand returned {value} at unit-cube point {point:?}")]
     NonFiniteIntegrand {

@@ -221,7 +221,9 @@ fn a_walk_through_a_bound_it_never_meets_stops_at_the_cap() {
         .expect_err("capped");
     let msg = e.to_string();
     assert!(
-        msg.contains("optical depth") && msg.contains("tentative collisions"),
+        msg.contains("optical depth")
+            && msg.contains("tentative collisions")
+            && msg.contains("`scene.medium`, `scene.lambda`"),
         "{msg}"
     );
 }

@@ -449,14 +449,10 @@ fn ratio_rate_factor(depth: f64) -> f64 {
 /// The error returned when a walk needs more than [`MAX_COLLISIONS`]
 /// tentative collisions on one span.
 fn too_deep(span: &Span) -> QuadError {
-    QuadError::invalid(
-        "optical depth",
-        format!("{:.3e}", span.majorant * (span.b - span.a)),
-        format!(
-            "at most {MAX_COLLISIONS} tentative collisions per walk and span: \
-             the majorant's optical depth is too large for tracking"
-        ),
-    )
+    QuadError::TooDeepForTracking {
+        depth: span.majorant * (span.b - span.a),
+        limit: MAX_COLLISIONS,
+    }
 }
 
 /// A free flight's optical depth, a standard exponential variate: `rand_distr`'s
