@@ -10,8 +10,9 @@ fn main() {
     // What goes into the binary: a change to any of these in the work tree
     // (tracked or not) marks the commit "-dirty", so a result line never
     // names a commit whose code it was not computed with.
-    const SOURCES: [&str; 6] = [
+    const SOURCES: [&str; 7] = [
         "src",
+        "docs",
         "build.rs",
         "Cargo.toml",
         "Cargo.lock",
@@ -30,8 +31,12 @@ fn main() {
         .map(|s| s.trim().to_string())
         .unwrap_or_default();
     let dirty = !commit.is_empty()
-        && git(&[&["status", "--porcelain", "--"][..], &SOURCES[..]].concat())
-            .is_none_or(|changes| !changes.trim().is_empty());
+        && git(&[
+            &["--no-optional-locks", "status", "--porcelain", "--"][..],
+            &SOURCES[..],
+        ]
+        .concat())
+        .is_none_or(|changes| !changes.trim().is_empty());
     let stamp = if dirty {
         format!("{commit}-dirty")
     } else {
@@ -40,10 +45,10 @@ fn main() {
     println!("cargo:rustc-env=LIGHTQUAD_GIT_COMMIT={stamp}");
     // The commit moves when HEAD names another branch, when the branch's
     // ref file is rewritten, or when refs are packed; the stamp's "-dirty"
-    // when the index or a source changes.
+    // when a source changes (staging alone changes neither; `status` takes
+    // no optional lock, so it never rewrites the index under another git).
     println!("cargo:rerun-if-changed=.git/HEAD");
     println!("cargo:rerun-if-changed=.git/packed-refs");
-    println!("cargo:rerun-if-changed=.git/index");
     for source in SOURCES {
         println!("cargo:rerun-if-changed={source}");
     }

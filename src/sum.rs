@@ -131,9 +131,10 @@ impl<V: Value> Lanes<V> {
 
     /// [`Lanes::add_products`] and, in the same pass, the scale of the
     /// terms: `|w_i y_i|` added to `magnitude` and the largest kept in
-    /// `largest`, lane by lane as the sum groups them (finite terms: a plain
-    /// comparison, without `f64::max`'s NaN handling). One pass, each product
-    /// formed once.
+    /// `largest`, lane by lane as the sum groups them. One pass, each product
+    /// formed once. `largest` is a plain comparison, without `f64::max`'s NaN
+    /// handling, so it skips a NaN term; `magnitude` carries it (and an
+    /// infinite one), which is how a caller sees that a value was not finite.
     #[inline(always)]
     pub fn add_products_scaled(
         &mut self,

@@ -52,10 +52,13 @@ fn run_and_measure(rule: &str, n: usize) -> f64 {
         .stderr(Stdio::piped())
         .spawn()
         .expect("runs");
-    let mut stderr = String::new();
+    // Drained to the end whatever its bytes, so the child never blocks on a
+    // full pipe.
+    let mut bytes = Vec::new();
     if let Some(mut e) = child.stderr.take() {
-        let _ = e.read_to_string(&mut stderr);
+        let _ = e.read_to_end(&mut bytes);
     }
+    let stderr = String::from_utf8_lossy(&bytes);
     let pid = libc::pid_t::try_from(child.id()).expect("pid fits pid_t");
     let mut status = 0;
     // SAFETY: wait4 writes one int and one rusage struct, both on our stack;

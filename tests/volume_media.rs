@@ -892,4 +892,25 @@ fn linear_gradient_bounds_stay_finite_for_a_gradient_whose_square_overflows() {
     scene.medium = Some(Arc::new(g));
     scene.lambda = 0.0;
     assert_eq!(scene.depth_bound(), (0.0, 0.0));
+    // |g| (|c| + 2 R) past f64 while the density stays finite: a gradient of
+    // 1e308 in the unit sphere, and 1e300 in a sphere 1e10 from the origin.
+    for (c, grad) in [(0.0, 1e308), (1e10, 1e300)] {
+        let g = LinearGradient::new(Vec3::new(c, 0.0, 0.0), 1.0, 1.0, Vec3::new(grad, 0.0, 0.0))
+            .expect("valid medium");
+        let r = ray([c - 3.0, 0.2, 0.0], [1.0, 0.0, 0.0]);
+        let exact_max = 1.0 + grad * h;
+        // The rounding margin, 16 eps (|b| + |g| (|c| + 2 R)): points 1e10
+        // from the origin carry an absolute rounding of about eps 1e10.
+        let margin = 16.0 * f64::EPSILON * (1.0 + grad * (c + 2.0));
+        let max = g.max_density(&r, a, b);
+        assert!(
+            max >= exact_max && max <= (exact_max + margin) * (1.0 + 1e-13),
+            "centre {c}, gradient {grad}: max {max} against {exact_max}"
+        );
+        let mut scene = VolumeScene::new(r);
+        scene.medium = Some(Arc::new(g));
+        scene.lambda = 1e-300;
+        let (sigma, depth) = scene.depth_bound();
+        assert!(sigma.is_finite() && depth.is_finite(), "{sigma} {depth}");
+    }
 }

@@ -180,7 +180,11 @@ const BLOCK: usize = 64;
 /// one pass. The values are checked finite once a block, through the
 /// block's `sum |w y|` (a NaN or infinite value makes it non-finite, and
 /// then the block is searched for the first such node): a check at every
-/// node cost about 5% of the evaluations of `cos(50 x)`.
+/// node cost about 5% of the evaluations of `cos(50 x)`. So `f` may be
+/// called at up to 63 nodes after a non-finite value; the first non-finite
+/// value is still the one reported, before any error `f` returns after it.
+/// `magnitude` is summed a block at a time, so it can differ from a
+/// term-by-term sum in its last few bits.
 fn line_sum<V: Value>(
     a: &UnitNodes,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
@@ -197,16 +201,21 @@ fn line_sum<V: Value>(
     let mut ys = [V::zero(); BLOCK];
     for (start, us) in (0..).step_by(BLOCK).zip(a.u.chunks(BLOCK)) {
         let ys = &mut ys[..us.len()];
-        for (y, &u) in ys.iter_mut().zip(us) {
-            *y = f(u)?;
+        for i in 0..us.len() {
+            match f(us[i]) {
+                Ok(v) => ys[i] = v,
+                // A non-finite value earlier in the block is reported first,
+                // as it would have stopped the sum before this node.
+                Err(e) => return Err(first_non_finite(&us[..i], &ys[..i]).unwrap_or(e)),
+            }
         }
         let ws = &a.w[start..start + us.len()];
         let mut block_magnitude = [V::zero(); LANES];
         value.add_products_scaled(ys, ws, &mut block_magnitude, &mut largest);
         if !block_magnitude.iter().all(V::all_finite)
-            && let Some((u, y)) = us.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
+            && let Some(e) = first_non_finite(us, ys)
         {
-            return Err(non_finite(&[*u], y));
+            return Err(e);
         }
         for (m, b) in magnitude.iter_mut().zip(block_magnitude) {
             *m = m.zip(b, |p, q| p + q);
@@ -232,6 +241,14 @@ fn line_sum<V: Value>(
             .fold(V::zero(), |m, x| m.zip(x, f64::max)),
         evaluations: a.u.len() as u64,
     })
+}
+
+/// The error for the first non-finite value of `ys` (taken at `us`), if any.
+fn first_non_finite<V: Value>(us: &[f64], ys: &[V]) -> Option<QuadError> {
+    us.iter()
+        .zip(ys)
+        .find(|(_, y)| !y.all_finite())
+        .map(|(u, y)| non_finite(&[*u], y))
 }
 
 /// Fewest points per axis at which a composite rule's estimate is trusted.
@@ -457,8 +474,11 @@ pub fn richardson<V: Value>(
     let full = 2f64.powi(order);
     let unchecked = full.min(4.0);
     let error = match sum.companion4 {
-        None => sum.value.zip(coarse, |fine, coarse| {
-            (fine - coarse).abs() / (unchecked - 1.0)
+        // No estimate below the rounding of the sum itself, `eps sum |w f|`
+        // (two rules that agree exactly, on a constant, differ by 0).
+        None => V::from_fn(|c| {
+            ((sum.value.channel(c) - coarse.channel(c)).abs() / (unchecked - 1.0))
+                .max(f64::EPSILON * sum.magnitude.channel(c))
         }),
         Some(coarser) => V::from_fn(|c| {
             let mut q = [

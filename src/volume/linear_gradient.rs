@@ -100,7 +100,8 @@ impl LinearGradient {
     /// + 2 R))`: evaluating `b + g . (x - c)` in the sphere rounds by a few
     /// ulps of that scale. `|g|` and `|c|` are taken scaled by their largest
     /// component, so a gradient of 1e300 gives 1e300, not the infinity of
-    /// `sqrt(1e600)` (which made the depth bound at lambda = 0 NaN).
+    /// `sqrt(1e600)` (which made the depth bound at lambda = 0 NaN), and
+    /// `16 eps` multiplies before the products.
     fn rounding_margin(&self) -> f64 {
         let norm = |v: Vec3| {
             let m = v.amax();
@@ -110,9 +111,11 @@ impl LinearGradient {
                 m
             }
         };
-        let scale = self.base.abs()
-            + norm(self.gradient) * (norm(self.sphere.centre) + 2.0 * self.sphere.radius);
-        16.0 * f64::EPSILON * scale
+        // Each product taken after the factor 16 eps, so a margin of a finite
+        // density stays finite (|g| = 1e308 times 2 R overflowed).
+        let e = 16.0 * f64::EPSILON;
+        e * self.base.abs()
+            + (e * norm(self.gradient)) * (norm(self.sphere.centre) + 2.0 * self.sphere.radius)
     }
 
     /// The linear function along `ray`, centred at its closest approach.

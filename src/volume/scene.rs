@@ -351,6 +351,11 @@ impl VolumeScene {
         let Some(m) = &self.medium else {
             return (0.0, 0.0);
         };
+        // lambda = 0: no extinction whatever the density's bound (0 times an
+        // infinite bound is not NaN here).
+        if self.lambda == 0.0 {
+            return (0.0, 0.0);
+        }
         let (mut sigma, mut depth) = (0.0f64, 0.0f64);
         for piece in m.support(&self.ray, self.t_min, self.t_max) {
             let (t0, t1) = (piece.start(), piece.end());

@@ -402,7 +402,7 @@ fn spans(
             // rate ratio tracking then draws at is k times this, with k > 1
             // only where k D <= 256: ratio_rate_factor.)
             if tracker != Tracker::Delta && majorant * (s1 - s0) > (MAX_COLLISIONS / 2) as f64 {
-                return Err(too_deep(&span));
+                return Err(too_deep(&span, MAX_COLLISIONS / 2));
             }
             spans.push(span);
         }
@@ -446,12 +446,14 @@ fn ratio_rate_factor(depth: f64) -> f64 {
     }
 }
 
-/// The error returned when a walk needs more than [`MAX_COLLISIONS`]
-/// tentative collisions on one span.
-fn too_deep(span: &Span) -> QuadError {
+/// The error returned when a walk needs more than `limit` tentative
+/// collisions on one span: [`MAX_COLLISIONS`] for a walk that reached the
+/// cap, half of it for a ratio-tracking span refused before the first walk
+/// (its collisions are about the span's majorant depth).
+fn too_deep(span: &Span, limit: u64) -> QuadError {
     QuadError::TooDeepForTracking {
         depth: span.majorant * (span.b - span.a),
-        limit: MAX_COLLISIONS,
+        limit,
     }
 }
 
@@ -492,7 +494,7 @@ fn walk<Rg: rand::Rng + ?Sized>(
             *evaluations += 1;
             collisions += 1;
             if collisions > MAX_COLLISIONS {
-                return Err(too_deep(span));
+                return Err(too_deep(span, MAX_COLLISIONS));
             }
             let sigma = lambda * medium.density(ray.at(t));
             score *= 1.0 - (sigma - span.control) * crossing.inverse;
@@ -621,7 +623,7 @@ fn delta_walks<Rg: rand::Rng + ?Sized>(
             w.collisions = if i == w.at { w.collisions + 1 } else { 1 };
             w.at = i;
             if w.collisions > MAX_COLLISIONS {
-                return Err(too_deep(c.span));
+                return Err(too_deep(c.span, MAX_COLLISIONS));
             }
             // Rounding must not carry the point past the span's end.
             let t = (c.span.a + (w.e - c.start) * c.inverse).min(c.span.b);
@@ -1037,7 +1039,7 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
                 evaluations += 1;
                 collisions += 1;
                 if collisions > MAX_COLLISIONS {
-                    return Err(too_deep(span));
+                    return Err(too_deep(span, MAX_COLLISIONS));
                 }
                 let p = ray.at(t);
                 let v = medium.density(p);
