@@ -953,3 +953,34 @@ fn the_line_sum_reports_the_first_non_finite_node_of_any_block() {
         s.value
     );
 }
+
+/// Below the levels that check an estimate (the trapezoid at 3 points,
+/// Gauss–Legendre at 2 and 5 nodes) the estimate is the difference of two
+/// rules, exactly 0 on a constant, while the sum itself is off by its
+/// rounding: the estimate is at least `eps sum |w f|` (here `eps c`) and at
+/// least the true error against the closed form `c`.
+#[test]
+fn small_rule_estimates_are_never_below_the_sums_rounding() {
+    for c in [1.0, 0.1, 3.0e-7] {
+        let f = move |_: [f64; 1]| c;
+        for (name, est) in [
+            ("trapezoid 3", Trapezoid.integrate(3, &mut rng(0), f)),
+            (
+                "gauss-legendre 2",
+                GaussLegendre::default().integrate(2, &mut rng(0), f),
+            ),
+            (
+                "gauss-legendre 5",
+                GaussLegendre::default().integrate(5, &mut rng(0), f),
+            ),
+        ] {
+            let est = est.expect("finite");
+            let truth = (est.value - c).abs();
+            assert!(
+                est.error >= f64::EPSILON * c * (1.0 - 1e-12) && est.error >= truth,
+                "{name} on {c}: estimate {:e}, true error {truth:e}",
+                est.error
+            );
+        }
+    }
+}

@@ -338,3 +338,31 @@ fn a_chord_of_a_few_ulps_costs_a_finite_figure() {
         "{figure}"
     );
 }
+
+/// Ratio tracking through a span whose majorant depth is past half the cap
+/// (a linear gradient from 0 to 2e8 over a chord of 1.96: its spans'
+/// bounds reach depths between 5e6 and 1e7) is refused before the first
+/// walk, and the error names the limit it applied, below the depth it
+/// reports (it said 1e7 against a depth of 5.5e6: hostile probe, session 31).
+#[test]
+fn a_refused_ratio_span_names_the_limit_applied() {
+    let medium: Arc<dyn Medium> = Arc::new(
+        LinearGradient::new(Vec3::zeros(), 1.0, 1e8, Vec3::new(1e8, 0.0, 0.0)).expect("medium"),
+    );
+    let ray = Ray::new(Vec3::new(-3.0, 0.2, 0.0), Vec3::x()).expect("ray");
+    let sigma = Extinction {
+        medium: medium.as_ref(),
+        lambda: 1.0,
+    };
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
+    let e = transmittance(Tracker::Ratio, sigma, &ray, 0.0, f64::INFINITY, 2, &mut rng)
+        .expect_err("refused");
+    match e {
+        lightquad::QuadError::TooDeepForTracking { depth, limit } => {
+            assert_eq!(limit, 5_000_000);
+            // No span's bound exceeds the whole chord's: 2e8 times 1.96.
+            assert!(depth > limit as f64 && depth <= 2e8 * 1.96, "depth {depth}");
+        }
+        other => panic!("{other}"),
+    }
+}
