@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use crate::error::QuadError;
 use crate::estimate::Estimate;
-use crate::sum::{Compensated, LANES, Lanes};
+use crate::sum::{Compensated, LaneValues, Lanes};
 use crate::value::Value;
 
 /// A 1-D rule on `[0, 1]`: nodes `u_i` and weights `w_i` with `sum w_i = 1`
@@ -175,7 +175,7 @@ const BLOCK: usize = 64;
 /// function (`cos`) clobbers every floating-point register, so the running
 /// sums, carried across its calls, were stored and reloaded at every node
 /// (the sum took 1.13 to 1.18 times the bare evaluations of `cos(50 x)`).
-/// Summed apart, they stay in registers, in [`LANES`] independent lanes,
+/// Summed apart, they stay in registers, in [`crate::sum::LANES`] independent lanes,
 /// and the compensated sum, `sum |w y|` and the largest term are formed in
 /// one pass. The values are checked finite once a block, through the
 /// block's `sum |w y|` (a NaN or infinite value makes it non-finite, and
@@ -197,44 +197,36 @@ fn line_sum<V: Value>(
     ];
     let mut value = Lanes::<V>::new();
     let mut others = [Lanes::<V>::new(); 3];
-    let mut magnitude = [V::zero(); LANES];
-    let mut largest = [V::zero(); LANES];
+    let mut magnitude = LaneValues::<V>::zero();
+    let mut largest = LaneValues::<V>::zero();
     let mut ys = [V::zero(); BLOCK];
-    for (start, us) in (0..).step_by(BLOCK).zip(a.u.chunks(BLOCK)) {
+    for (block, (us, ws)) in a.u.chunks(BLOCK).zip(a.w.chunks(BLOCK)).enumerate() {
         let ys = &mut ys[..us.len()];
         for (y, &u) in ys.iter_mut().zip(us) {
             *y = f(u)?;
         }
-        let ws = &a.w[start..start + us.len()];
-        let mut block_magnitude = [V::zero(); LANES];
+        let mut block_magnitude = LaneValues::zero();
         value.add_products_scaled(ys, ws, &mut block_magnitude, &mut largest);
-        if !block_magnitude.iter().all(V::all_finite)
+        if !block_magnitude.all_finite()
             && let Some((u, y)) = us.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
         {
             return Err(non_finite(&[*u], y));
         }
-        for (m, b) in magnitude.iter_mut().zip(block_magnitude) {
-            *m = m.zip(b, |p, q| p + q);
-        }
+        magnitude.add(&block_magnitude);
+        let start = block * BLOCK;
         for (lanes, c) in others.iter_mut().zip(companions) {
             if let Some(c) = c {
                 lanes.add_products(ys, &c[start..start + us.len()]);
             }
         }
     }
-    let lanes_sum = |xs: [V; LANES]| {
-        xs.into_iter()
-            .fold(V::zero(), |s, x| s.zip(x, |a, b| a + b))
-    };
     Ok(ProductSum {
         value: value.total(),
         companion: companions[0].map(|_| others[0].total()),
         companion4: companions[1].map(|_| others[1].total()),
         companion8: companions[2].map(|_| others[2].total()),
-        magnitude: lanes_sum(magnitude),
-        largest: largest
-            .into_iter()
-            .fold(V::zero(), |m, x| m.zip(x, f64::max)),
+        magnitude: magnitude.sum(),
+        largest: largest.max(),
         evaluations: a.u.len() as u64,
     })
 }

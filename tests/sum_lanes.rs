@@ -1,0 +1,189 @@
+//! The SIMD lanes of the shared compensated sum (`lightquad::sum::Lanes`)
+//! against two independent references: the scalar `Compensated` sum taken
+//! one term at a time into the same four lanes (the same total to within
+//! the final rounding, the same largest term bit for bit, at every length
+//! and block size; RGB and six-channel values channel by channel, bit for
+//! bit, as scalar sums), and
+//! the exact sum of terms that are integers times a power of two, computed
+//! in 128-bit integers (the compensated error bound must hold).
+
+use lightquad::quadrature::product::WithError;
+use lightquad::sum::{Compensated, LANES, LaneValues, Lanes};
+use lightquad::value::{Rgb, Value};
+use proptest::prelude::*;
+
+/// The scalar reference: term `i` into lane `i mod 4` for the whole groups
+/// of four, the rest into lane 0; the lanes' totals added compensated. Also `sum |w y|` lane by lane and
+/// the largest `|w y|`.
+fn reference<V: Value>(ys: &[V], ws: &[f64]) -> (V, V, V) {
+    let mut lanes = [Compensated::<V>::new(); LANES];
+    let mut magnitude = [V::zero(); LANES];
+    let mut largest = V::zero();
+    let whole = ys.len() / LANES * LANES;
+    for (i, (y, &w)) in ys.iter().zip(ws).enumerate() {
+        let k = if i < whole { i % LANES } else { 0 };
+        let t = y.map(|v| v * w);
+        lanes[k].add(t);
+        magnitude[k] = magnitude[k].zip(t, |m, x| m + x.abs());
+        largest = largest.zip(t, |l, x| l.max(x.abs()));
+    }
+    // The lanes' totals, combined compensated.
+    let mut all = Compensated::<V>::new();
+    for l in &lanes {
+        all.add(l.total());
+    }
+    let magnitude = magnitude
+        .into_iter()
+        .fold(V::zero(), |s, m| s.zip(m, |a, b| a + b));
+    (all.total(), magnitude, largest)
+}
+
+/// What `Lanes` gives: the products in blocks of `block` terms.
+fn lanes<V: Value>(ys: &[V], ws: &[f64], block: usize) -> (V, V, V) {
+    let mut sum = Lanes::<V>::new();
+    let mut magnitude = LaneValues::<V>::zero();
+    let mut largest = LaneValues::<V>::zero();
+    for (y, w) in ys.chunks(block).zip(ws.chunks(block)) {
+        let mut m = LaneValues::zero();
+        sum.add_products_scaled(y, w, &mut m, &mut largest);
+        magnitude.add(&m);
+    }
+    (sum.total(), magnitude.sum(), largest.max())
+}
+
+fn bits<V: Value>(v: V) -> Vec<u64> {
+    (0..V::CHANNELS).map(|c| v.channel(c).to_bits()).collect()
+}
+
+/// Values with a wide spread of exponents and signs, so that the carries
+/// are not zero and cancellation happens inside lanes.
+fn spread(seed: u64, n: usize) -> Vec<f64> {
+    let mut x = seed | 1;
+    (0..n)
+        .map(|_| {
+            // xorshift64*
+            x ^= x >> 12;
+            x ^= x << 25;
+            x ^= x >> 27;
+            let r = x.wrapping_mul(0x2545_F491_4F6C_DD1D);
+            let mantissa = (r >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            let exponent = ((r & 0x3f) as i32) - 32;
+            mantissa * 2f64.powi(exponent)
+        })
+        .collect()
+}
+
+#[test]
+fn a_lanes_total_matches_four_scalar_compensated_lanes() {
+    // Lengths around the groups of four and the blocks, blocks of 1 to 64.
+    for n in [0usize, 1, 2, 3, 4, 5, 7, 8, 63, 64, 65, 127, 130, 1001] {
+        for block in [1usize, 3, 4, 64] {
+            let ys = spread(17 + n as u64, n);
+            let ws = spread(91 + n as u64, n);
+            // The reference puts the terms after the last whole group of a
+            // block into lane 0, block by block, as `Lanes` does.
+            let (mut value, mut magnitude, mut largest) =
+                ([Compensated::<f64>::new(); LANES], [0.0f64; LANES], 0.0f64);
+            for (y, w) in ys.chunks(block).zip(ws.chunks(block)) {
+                let whole = y.len() / LANES * LANES;
+                for (i, (&y, &w)) in y.iter().zip(w).enumerate() {
+                    let k = if i < whole { i % LANES } else { 0 };
+                    value[k].add(y * w);
+                    magnitude[k] += (y * w).abs();
+                    largest = largest.max((y * w).abs());
+                }
+            }
+            let (v, m, l) = lanes(&ys, &ws, block);
+            let mut all = Compensated::<f64>::new();
+            for lane in &value {
+                all.add(lane.total());
+            }
+            // The value against the scalar lanes' combined total, within the
+            // combination's own rounding (the reference adds each lane's sum
+            // and carry first, `Lanes` all sums and then all carries).
+            let expected = all.total();
+            assert!(
+                (v - expected).abs() <= f64::EPSILON * expected.abs(),
+                "n = {n}, block = {block}: {v:e} against {expected:e}"
+            );
+            let m_ref = magnitude.iter().fold(0.0, |s, x| s + x);
+            // `magnitude` is summed a block at a time, so only its last bits
+            // may differ from the term-by-term lanes.
+            assert!(
+                (m - m_ref).abs() <= 1e-13 * m_ref,
+                "n = {n}, block = {block}: {m:e} against {m_ref:e}"
+            );
+            assert_eq!(l.to_bits(), largest.to_bits(), "n = {n}, block = {block}");
+        }
+    }
+}
+
+#[test]
+fn rgb_and_six_channel_values_sum_channel_by_channel() {
+    // Each channel of an RGB (and of an RGB with its error, six channels)
+    // sum equals the scalar sum of that channel, bit for bit.
+    let n = 203;
+    let ws = spread(5, n);
+    let chans: Vec<Vec<f64>> = (0..6).map(|c| spread(100 + c, n)).collect();
+    let rgb: Vec<Rgb> = (0..n)
+        .map(|i| Rgb::new(chans[0][i], chans[1][i], chans[2][i]))
+        .collect();
+    let six: Vec<WithError<Rgb>> = (0..n)
+        .map(|i| WithError {
+            value: rgb[i],
+            error: Rgb::new(chans[3][i], chans[4][i], chans[5][i]),
+        })
+        .collect();
+    let (v3, m3, l3) = lanes(&rgb, &ws, 64);
+    let (v6, m6, l6) = lanes(&six, &ws, 64);
+    for c in 0..6 {
+        let (v, m, l) = lanes(&chans[c], &ws, 64);
+        if c < 3 {
+            assert_eq!(bits(v3)[c], v.to_bits(), "rgb channel {c}");
+            assert_eq!(bits(m3)[c], m.to_bits(), "rgb channel {c}");
+            assert_eq!(bits(l3)[c], l.to_bits(), "rgb channel {c}");
+        }
+        assert_eq!(bits(v6)[c], v.to_bits(), "six-channel {c}");
+        assert_eq!(bits(m6)[c], m.to_bits(), "six-channel {c}");
+        assert_eq!(bits(l6)[c], l.to_bits(), "six-channel {c}");
+    }
+    // And the scalar reference agrees with the lanes on the RGB sum.
+    let (r, _, rl) = reference(&rgb, &ws);
+    for c in 0..3 {
+        let expected = r.channel(c);
+        assert!((v3.channel(c) - expected).abs() <= f64::EPSILON * expected.abs());
+        assert_eq!(l3.channel(c), rl.channel(c));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Terms `k_i 2^e_i` with |k_i| < 2^40 and e_i in [-60, 0], weights
+    /// powers of two: every product is exact, and the exact sum is an
+    /// integer multiple of 2^-68 held in an i128. The compensated total is
+    /// within `eps |S| + 2 (n eps)^2 sum |t|` of it (Ogita, Rump and Oishi's
+    /// bound for a twice-precision sum, `eps/2 |S| + gamma_(n-1)^2 sum |t|`,
+    /// with room for the lanes' combining and the reference's rounding).
+    #[test]
+    fn the_total_is_within_the_compensated_bound_of_the_exact_sum(
+        terms in prop::collection::vec((-(1i64 << 40)..(1i64 << 40), -60i32..=0, -8i32..=8), 0..600),
+    ) {
+        let ys: Vec<f64> = terms.iter().map(|&(k, e, _)| k as f64 * 2f64.powi(e)).collect();
+        let ws: Vec<f64> = terms.iter().map(|&(_, _, p)| 2f64.powi(p)).collect();
+        // Exact: k 2^(e + p) = k 2^(e + p + 68) units of 2^-68 (at most
+        // 2^116 a term, 600 terms below 2^126).
+        let exact: i128 = terms
+            .iter()
+            .map(|&(k, e, p)| (k as i128) << (e + p + 68))
+            .sum();
+        // Rounded once to f64 (half an ulp of S, allowed for below).
+        let exact_f = exact as f64 * 2f64.powi(-68);
+        let magnitude: f64 = ys.iter().zip(&ws).map(|(y, w)| (y * w).abs()).sum();
+        let n = ys.len() as f64;
+        let (v, m, _) = lanes(&ys, &ws, 64);
+        let bound = 1.5 * f64::EPSILON * exact_f.abs() + 2.0 * (n * f64::EPSILON).powi(2) * magnitude;
+        prop_assert!((v - exact_f).abs() <= bound, "{v:e} against exact {exact_f:e} (bound {bound:e})");
+        prop_assert!((m - magnitude).abs() <= 1e-12 * magnitude);
+    }
+}
