@@ -136,8 +136,8 @@ fn rgb_and_six_channel_values_sum_channel_by_channel() {
         .collect();
     let (v3, m3, l3) = lanes(&rgb, &ws, 64);
     let (v6, m6, l6) = lanes(&six, &ws, 64);
-    for c in 0..6 {
-        let (v, m, l) = lanes(&chans[c], &ws, 64);
+    for (c, chan) in chans.iter().enumerate() {
+        let (v, m, l) = lanes(chan, &ws, 64);
         if c < 3 {
             assert_eq!(bits(v3)[c], v.to_bits(), "rgb channel {c}");
             assert_eq!(bits(m3)[c], m.to_bits(), "rgb channel {c}");
