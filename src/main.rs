@@ -33,7 +33,7 @@ enum Command {
         /// Rule name: `gauss-legendre`, `trapezoid` or `simpson` (rules with a
         /// fixed node set).
         rule: String,
-        /// Number of nodes (Gauss–Legendre: 1..=100000000; trapezoid: >= 2; Simpson: odd, >= 3).
+        /// Number of nodes (Gauss–Legendre: 1..=100000000; trapezoid: 2..=100000000; Simpson: odd, 3..=100000000).
         n: usize,
     },
     /// Run experiments and write a report of error against run time to the

@@ -1070,6 +1070,7 @@ fn a_reference_across_unsplit_outlines_is_unverified_not_converged() {
         .expect("a reference line");
     assert!(line.contains("E_area (unverified"), "{line}");
     assert!(!line.contains("every quantity converged"), "{line}");
+    let _ = fs::remove_dir_all(&dir);
 }
 
 /// The Mitsuba table shows mitsuba-r-three-lights' lightquad value as
@@ -1078,7 +1079,8 @@ fn a_reference_across_unsplit_outlines_is_unverified_not_converged() {
 /// 1.4280660690789), where it was 1.4280711 and marked unverified.
 #[test]
 fn the_mitsuba_table_shows_the_three_lights_value_verified() {
-    let out = scratch("verified-table").join("out");
+    let dir = scratch("verified-table");
+    let out = dir.join("out");
     let run = bin()
         .args(["run", "--threads", "1", "--out"])
         .arg(&out)
@@ -1097,6 +1099,7 @@ fn the_mitsuba_table_shows_the_three_lights_value_verified() {
             .all(|r| r.contains("| 1.4280660691e0 |") && !r.contains("(unverified")),
         "{rows:?}"
     );
+    let _ = fs::remove_dir_all(&dir);
 }
 
 /// Hostile probe of session 26: a rectangle occluder lying in a rectangle

@@ -2195,7 +2195,7 @@ fn underflow_constant_integrands_and_missing_estimates_are_labelled() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/v-tau-stiff-sphere.json"),
     )
     .expect("bundled");
-    let (_dir, out, o) = run_text("stiff", &stiff);
+    let (stiff_dir, out, o) = run_text("stiff", &stiff);
     assert!(o.status.success(), "{}", stderr(&o));
     let report = fs::read_to_string(out.join("v-tau-stiff-sphere/report.md")).expect("report");
     let section = report.split("## I_B").nth(1).expect("an I_B section");
@@ -2236,7 +2236,7 @@ fn underflow_constant_integrands_and_missing_estimates_are_labelled() {
             r#""quantities": ["tau"]"#,
         )
         .replace(r#""budgets": [4, 16, 64]"#, r#""budgets": [2, 16, 64]"#);
-    let (_dir, out, o) = run_text("constant", &constant);
+    let (constant_dir, out, o) = run_text("constant", &constant);
     assert!(o.status.success(), "{}", stderr(&o));
     let index = fs::read_to_string(out.join("index.md")).expect("index");
     let line = index
@@ -2250,6 +2250,9 @@ fn underflow_constant_integrands_and_missing_estimates_are_labelled() {
         .find(|l| l.starts_with("| stratified | 2 |"))
         .expect("a row at n = 2");
     assert!(two.contains("no error estimate"), "{two}");
+    for dir in [stiff_dir, constant_dir] {
+        let _ = fs::remove_dir_all(dir);
+    }
 }
 
 /// File system faults name the path and the reason in words (the hostile
