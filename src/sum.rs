@@ -211,7 +211,9 @@ impl<V: Value> Lanes<V> {
     /// terms: `|w_i y_i|` added to `magnitude` and the largest kept in
     /// `largest`, lane by lane as the sum groups them. One pass, each product
     /// formed once. `magnitude` carries a NaN or infinite term, which is how
-    /// a caller sees that a value was not finite (`largest` may skip a NaN).
+    /// a caller sees that a value was not finite. `largest` skips a NaN term
+    /// on x86-64 (`maxpd` keeps the lane's largest); on other targets `wide`'s
+    /// `fast_max` may keep the NaN instead.
     #[inline(always)]
     pub fn add_products_scaled(
         &mut self,

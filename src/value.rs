@@ -21,7 +21,10 @@ pub type Rgb = Vector3<f64>;
 
 /// What a rule needs of an integrand value: a fixed number of `f64` channels.
 pub trait Value: Copy + Send + Sync + std::fmt::Debug + 'static {
-    /// Number of channels (1 for a scalar, 3 for RGB).
+    /// Number of channels (1 for a scalar, 3 for RGB). At most 6 for the
+    /// deterministic rules, whose sum keeps each channel's lanes in a SIMD
+    /// vector of a fixed-size array ([`crate::sum::LaneValues`]); a value of
+    /// more channels fails to compile there, with that message.
     const CHANNELS: usize;
     /// The value with every channel zero.
     fn zero() -> Self;
