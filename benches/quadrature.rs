@@ -68,11 +68,12 @@ fn gl_integrate(c: &mut Criterion) {
     let Ok(nodes) = unit_nodes(n) else { return };
     // The interval [a, b] = [-1, 1] reaches every integrator through
     // `black_box`, as a caller's run-time interval would: with constant
-    // bounds the peers' inlined affine map `x = (b - a)/2 t + (a + b)/2`
-    // folds to `t + 0`, one dependent operation fewer before each `cos`
-    // than any interval known only at run time (1 to 2.5% of bilby's time
-    // at n = 1e6 in `examples/gl_race.rs`, paired rounds), which is no
-    // property of a quadrature library. Both settings are timed: `*/const` keeps the
+    // bounds bilby's inlined affine map `x = (b - a)/2 t + (a + b)/2` folds
+    // to `t + 0`, one dependent operation fewer before each `cos` than any
+    // interval known only at run time (1 to 4% of bilby's time at n = 1e6
+    // in `examples/gl_race.rs`, paired rounds; gauss-quad's map folds only
+    // partly, and showed no effect), which is no property of a quadrature
+    // library. Both settings are timed: `*/const` keeps the
     // constants.
     let (a, b) = (-1.0f64, 1.0f64);
     g.bench_function(BenchmarkId::new("lightquad", n), |bench| {

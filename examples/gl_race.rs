@@ -8,15 +8,18 @@
 //! from one second to the next, criterion's groups, timed one after
 //! another, can differ by more than the few percent between these
 //! integrators. Here every round times each contender once, in an order
-//! rotated from round to round, and the figure compared is the median over
-//! rounds of each round's ratio `lightquad / peer`: a slow stretch of the
+//! rotated from round to round and reversed every other round (so no
+//! contender always follows the same one, whose traces in the caches it
+//! would inherit), and the figures compared are medians over rounds of
+//! each round's ratio of two contenders' times: a slow stretch of the
 //! machine slows both sides of a ratio alike.
 //!
 //! Two settings: the interval's bounds through `black_box` (a run-time
 //! interval, the usual case) and, marked `const`, compile-time constants,
-//! where the peers' inlined map `x = (b - a)/2 t + (a + b)/2` folds to
-//! `t + 0`. Prints a table: the median and the least time of each
-//! contender and the error of its value against `sin(50)/25`, then the
+//! where bilby's inlined map `x = (b - a)/2 t + (a + b)/2` folds to `t + 0`
+//! (gauss-quad's `0.5 ((b - a) t + (b + a))` only to `0.5 (2 t + 0)`). Prints a table: the median and the least time of each
+//! contender and the error of its value against `sin(50)/25` (to about 32
+//! digits, as a pair of `f64`s: one `f64` is 1.7e-18 off), then the
 //! paired ratios (median and quartiles). `plain loop` is the peers' loop
 //! (`s += w f(x)`) on lightquad's own nodes: lightquad's time over it is
 //! what the compensated sum, `sum |w f|`, the largest term and the finite
@@ -31,11 +34,21 @@ use lightquad::quadrature::nodes::product_sum;
 
 const N: usize = 1_000_000;
 
+/// Most rounds (some 90 ms each).
+const MAX_ROUNDS: usize = 10_000;
+
+/// `int_{-1}^{1} cos(50 x) dx = sin(50)/25` as `HI + LO`, from the Taylor
+/// series of `sin` in 60-digit decimal arithmetic (Python's `decimal`):
+/// `-0.010494994148157151436575745876504901835...`.
+const EXACT_HI: f64 = -0.010494994148157152;
+const EXACT_LO: f64 = 5.858512174793785e-19;
+
 fn integrand(x: f64) -> f64 {
     (50.0 * x).cos()
 }
 
-/// The `q`-quantile of `v` (sorted in place), by the nearest rank.
+/// The element of rank `round((len - 1) q)` of `v` (sorted in place): the
+/// median for `q = 0.5` and an odd length.
 fn quantile(v: &mut [f64], q: f64) -> f64 {
     v.sort_by(f64::total_cmp);
     v[((v.len() - 1) as f64 * q).round() as usize]
@@ -48,8 +61,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(s) => s.parse().map_err(|e| format!("ROUNDS {s:?}: {e}"))?,
         None => 41,
     };
-    if rounds == 0 {
-        return Err("ROUNDS: expected at least 1".into());
+    if !(1..=MAX_ROUNDS).contains(&rounds) {
+        return Err(format!("ROUNDS {rounds}: expected 1 to {MAX_ROUNDS}").into());
     }
     let nodes = unit_nodes(N)?;
     let bil = bilby::GaussLegendre::new(N)?;
@@ -110,17 +123,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         black_box(f());
     }
     let k = contenders.len();
-    let mut times = vec![Vec::with_capacity(rounds); k];
+    let mut times: Vec<Vec<f64>> = (0..k).map(|_| Vec::with_capacity(rounds)).collect();
     let mut values = vec![0.0; k];
     for r in 0..rounds {
         for j in 0..k {
-            let i = (j + r) % k;
+            let i = if r % 2 == 0 {
+                (j + r) % k
+            } else {
+                (k - 1 - j + r) % k
+            };
             let start = Instant::now();
             values[i] = black_box((contenders[i].1)());
             times[i].push(start.elapsed().as_secs_f64() * 1e3);
         }
     }
-    let exact = (50.0f64).sin() / 25.0;
     println!("{N} nodes, {rounds} rounds");
     println!("| contender | median | least | error |");
     println!("|---|---:|---:|---:|");
@@ -130,7 +146,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "| {name} | {:.3} ms | {:.3} ms | {:.1e} |",
             quantile(&mut t, 0.5),
             quantile(&mut t, 0.0),
-            (values[i] - exact).abs()
+            ((values[i] - EXACT_HI) - EXACT_LO).abs()
         );
     }
     println!();
