@@ -73,8 +73,7 @@ fn gl_integrate(c: &mut Criterion) {
     // interval known only at run time (1 to 4% of bilby's time at n = 1e6
     // in `examples/gl_race.rs`, paired rounds; gauss-quad's map folds only
     // partly, and showed no effect), which is no property of a quadrature
-    // library. Both settings are timed: `*/const` keeps the
-    // constants.
+    // library. Both settings are timed: `*/const` keeps the constants.
     let (a, b) = (-1.0f64, 1.0f64);
     g.bench_function(BenchmarkId::new("lightquad", n), |bench| {
         // [a, b] from the unit interval: x = a + (b - a) u, dx = (b - a) du.

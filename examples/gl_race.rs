@@ -17,10 +17,12 @@
 //! Two settings: the interval's bounds through `black_box` (a run-time
 //! interval, the usual case) and, marked `const`, compile-time constants,
 //! where bilby's inlined map `x = (b - a)/2 t + (a + b)/2` folds to `t + 0`
-//! (gauss-quad's `0.5 ((b - a) t + (b + a))` only to `0.5 (2 t + 0)`). Prints a table: the median and the least time of each
-//! contender and the error of its value against `sin(50)/25` (to about 32
-//! digits, as a pair of `f64`s: one `f64` is 1.7e-18 off), then the
-//! paired ratios (median and quartiles). `plain loop` is the peers' loop
+//! (gauss-quad's `0.5 ((b - a) t + (b + a))` only to `0.5 (2 t + 0)`).
+//!
+//! Prints a table: the median and the least time of each contender and the
+//! error of its value against `sin(50)/25` (to about 32 digits, as a pair
+//! of `f64`s: one `f64` is 1.7e-18 off), then the paired ratios (median
+//! and quartiles). `plain loop` is the peers' loop
 //! (`s += w f(x)`) on lightquad's own nodes: lightquad's time over it is
 //! what the compensated sum, `sum |w f|`, the largest term and the finite
 //! checks cost.
@@ -152,25 +154,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!();
     println!("| ratio, paired by round | median | quartiles |");
     println!("|---|---:|---:|");
+    let index = |name: &str| contenders.iter().position(|(n, _)| *n == name);
     for (num, den) in [
-        (0, 1),
-        (0, 2),
-        (0, 3),
-        (4, 5),
-        (4, 6),
-        (0, 4),
-        (1, 5),
-        (2, 6),
+        ("lightquad", "bilby"),
+        ("lightquad", "gauss-quad"),
+        ("lightquad", "plain loop"),
+        ("lightquad const", "bilby const"),
+        ("lightquad const", "gauss-quad const"),
+        ("lightquad", "lightquad const"),
+        ("bilby", "bilby const"),
+        ("gauss-quad", "gauss-quad const"),
     ] {
-        let mut ratio: Vec<f64> = times[num]
-            .iter()
-            .zip(&times[den])
-            .map(|(x, y)| x / y)
-            .collect();
+        let (Some(i), Some(j)) = (index(num), index(den)) else {
+            return Err(format!("no contender {num:?} or {den:?}").into());
+        };
+        let mut ratio: Vec<f64> = times[i].iter().zip(&times[j]).map(|(x, y)| x / y).collect();
         println!(
-            "| {} / {} | {:.3} | {:.3} – {:.3} |",
-            contenders[num].0,
-            contenders[den].0,
+            "| {num} / {den} | {:.3} | {:.3} – {:.3} |",
             quantile(&mut ratio, 0.5),
             quantile(&mut ratio, 0.25),
             quantile(&mut ratio, 0.75)
