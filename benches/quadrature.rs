@@ -8,7 +8,8 @@
 //!   buffer of its own, as the peers' constructors return owned rules.
 //! - `gl_integrate/*`: integrating `cos(50 x)` over [-1, 1] at n = 1e6 with
 //!   cached nodes, against the same peers: the interval through `black_box`
-//!   (as a run-time interval), and `*/const` with constant bounds.
+//!   (as a run-time interval), `*/const` with constant bounds, and `*/par`
+//!   on every core (lightquad's `line_sum_par`, gauss-quad's `par_integrate`).
 //! - `sum_overhead/*`: the shared compensated summation against a bare loop
 //!   that only evaluates the integrand at the same nodes, n = 1e3 .. 1e6.
 
@@ -17,7 +18,7 @@ use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use lightquad::quadrature::gauss_legendre::{TABLE_MAX_ORDER, table, unit_nodes};
-use lightquad::quadrature::nodes::product_sum;
+use lightquad::quadrature::nodes::{line_sum_par, product_sum};
 
 fn gl_nodes(c: &mut Criterion) {
     let mut g = c.benchmark_group("gl_nodes");
@@ -107,6 +108,18 @@ fn gl_integrate(c: &mut Criterion) {
     });
     g.bench_function(BenchmarkId::new("gauss-quad/const", n), |bench| {
         bench.iter(|| gq.integrate(-1.0, 1.0, integrand))
+    });
+    // On every core: lightquad's spans on rayon's threads, gauss-quad's
+    // `par_integrate` (bilby has no parallel Gauss–Legendre integral).
+    g.bench_function(BenchmarkId::new("lightquad/par", n), |bench| {
+        bench.iter(|| {
+            let (a, b) = (black_box(a), black_box(b));
+            let h = b - a;
+            line_sum_par(&nodes, |u| Ok(integrand(a + h * u))).map(|s| s.value * h)
+        })
+    });
+    g.bench_function(BenchmarkId::new("gauss-quad/par", n), |bench| {
+        bench.iter(|| gq.par_integrate(black_box(a), black_box(b), integrand))
     });
     g.finish();
 }

@@ -1,7 +1,9 @@
 //! Gauss–Legendre integration at n = 1e6 with cached nodes, lightquad
 //! against `bilby` and `gauss-quad`, timed in interleaved rounds.
 //!
-//! `cargo run --release --example gl_race -- [ROUNDS]` (default 41)
+//! `cargo run --release --example gl_race -- [ROUNDS] [--serial | --parallel]`
+//! (ROUNDS default 41; `--serial` leaves out the two parallel contenders,
+//! `--parallel` times them alone)
 //!
 //! The same integral as `cargo bench --bench quadrature -- gl_integrate`:
 //! `int_{-1}^{1} cos(50 x) dx`. On a shared machine whose speed drifts
@@ -32,7 +34,7 @@ use std::num::NonZeroUsize;
 use std::time::Instant;
 
 use lightquad::quadrature::gauss_legendre::unit_nodes;
-use lightquad::quadrature::nodes::product_sum;
+use lightquad::quadrature::nodes::{line_sum_par, product_sum};
 
 const N: usize = 1_000_000;
 
@@ -103,6 +105,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }),
         ),
         (
+            "lightquad par",
+            Box::new(|| {
+                let (a, b) = (black_box(a), black_box(b));
+                let h = b - a;
+                line_sum_par(&nodes, |u| Ok(integrand(a + h * u))).map_or(f64::NAN, |s| s.value * h)
+            }),
+        ),
+        (
+            "gauss-quad par",
+            Box::new(|| gq.par_integrate(black_box(a), black_box(b), integrand)),
+        ),
+        (
             "lightquad const",
             Box::new(|| {
                 product_sum([nodes.as_ref()], |u: [f64; 1]| {
@@ -121,6 +135,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
     ];
     // One untimed call each: nodes and code paged in.
+    // `--serial`: without the two that use every core, whose idle rayon
+    // threads spin a while after each call and take a core from whatever
+    // is timed next on a two-core machine; `--parallel`: those two alone.
+    let only: Option<bool> = match std::env::args().nth(2).as_deref() {
+        None => None,
+        Some("--serial") => Some(false),
+        Some("--parallel") => Some(true),
+        Some(other) => {
+            return Err(format!("{other:?}: expected --serial or --parallel").into());
+        }
+    };
+    let contenders: Vec<Contender> = contenders
+        .into_iter()
+        .filter(|(name, _)| only.is_none_or(|par| name.ends_with(" par") == par))
+        .collect();
     for (_, f) in &contenders {
         black_box(f());
     }
@@ -159,6 +188,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("lightquad", "bilby"),
         ("lightquad", "gauss-quad"),
         ("lightquad", "plain loop"),
+        ("lightquad par", "gauss-quad par"),
+        ("lightquad par", "bilby"),
+        ("lightquad par", "lightquad"),
         ("lightquad const", "bilby const"),
         ("lightquad const", "gauss-quad const"),
         ("lightquad", "lightquad const"),
@@ -166,7 +198,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("gauss-quad", "gauss-quad const"),
     ] {
         let (Some(i), Some(j)) = (index(num), index(den)) else {
-            return Err(format!("no contender {num:?} or {den:?}").into());
+            continue;
         };
         let mut ratio: Vec<f64> = times[i].iter().zip(&times[j]).map(|(x, y)| x / y).collect();
         println!(

@@ -128,6 +128,14 @@ impl<V: Value> LaneValues<V> {
         V::from_fn(|c| self.channels[c].to_array().iter().fold(0.0, |s, x| s + x))
     }
 
+    /// Keeps, lane by lane, the larger of `self` and `other` (`largest`
+    /// merged from two spans of terms).
+    pub fn max_with(&mut self, other: &Self) {
+        for c in 0..V::CHANNELS {
+            self.channels[c] = other.channels[c].fast_max(self.channels[c]);
+        }
+    }
+
     /// The largest lane (of lanes that are not NaN).
     pub fn max(&self) -> V {
         V::from_fn(|c| {
@@ -234,6 +242,34 @@ impl<V: Value> Lanes<V> {
                     &mut largest.channels[c],
                 ],
             );
+        }
+    }
+
+    /// Adds another sum lane by lane: TwoSum of the two lanes' sums, the
+    /// carries and TwoSum's error into the carry. So the lanes of a sum
+    /// split into spans and merged in order hold the whole sum to within
+    /// the carries' plain additions, `u` times the carries (themselves
+    /// `u` times the sums), and a single span merged into an empty sum is
+    /// that span's sum bit for bit.
+    ///
+    /// ```
+    /// use lightquad::sum::Lanes;
+    ///
+    /// // 1e16 in one span, -1e16 and the ones in the other: merged, the
+    /// // total is the exact 2.
+    /// let (mut a, mut b) = (Lanes::<f64>::new(), Lanes::<f64>::new());
+    /// a.add_products(&[1e16, 1.0], &[1.0; 2]);
+    /// b.add_products(&[-1e16, 1.0], &[1.0; 2]);
+    /// a.merge(&b);
+    /// assert_eq!(a.total(), 2.0);
+    /// ```
+    pub fn merge(&mut self, other: &Self) {
+        for c in 0..V::CHANNELS {
+            let (s, t) = (self.sum.channels[c], other.sum.channels[c]);
+            let u = s + t;
+            let b = u - s;
+            self.carry.channels[c] += ((s - (u - b)) + (t - b)) + other.carry.channels[c];
+            self.sum.channels[c] = u;
         }
     }
 

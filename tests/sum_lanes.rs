@@ -186,4 +186,36 @@ proptest! {
         prop_assert!((v - exact_f).abs() <= bound, "{v:e} against exact {exact_f:e} (bound {bound:e})");
         prop_assert!((m - magnitude).abs() <= 1e-12 * magnitude);
     }
+
+    /// The same exact sums, the terms cut into consecutive spans at random
+    /// points, each span summed apart and the spans merged in order
+    /// (`Lanes::merge`, what `line_sum_par` does): the same bound holds.
+    #[test]
+    fn spans_merged_in_order_keep_the_compensated_bound(
+        terms in prop::collection::vec((-(1i64 << 40)..(1i64 << 40), -60i32..=0, -8i32..=8), 1..600),
+        cuts in prop::collection::vec(0usize..600, 0..6),
+    ) {
+        let ys: Vec<f64> = terms.iter().map(|&(k, e, _)| k as f64 * 2f64.powi(e)).collect();
+        let ws: Vec<f64> = terms.iter().map(|&(_, _, p)| 2f64.powi(p)).collect();
+        let exact: i128 = terms
+            .iter()
+            .map(|&(k, e, p)| (k as i128) << (e + p + 68))
+            .sum();
+        let exact_f = exact as f64 * 2f64.powi(-68);
+        let magnitude: f64 = ys.iter().zip(&ws).map(|(y, w)| (y * w).abs()).sum();
+        let mut cuts: Vec<usize> = cuts.into_iter().map(|c| c % ys.len()).collect();
+        cuts.push(0);
+        cuts.push(ys.len());
+        cuts.sort_unstable();
+        let mut merged = Lanes::<f64>::new();
+        for span in cuts.windows(2) {
+            let mut part = Lanes::<f64>::new();
+            part.add_products(&ys[span[0]..span[1]], &ws[span[0]..span[1]]);
+            merged.merge(&part);
+        }
+        let v = merged.total();
+        let n = ys.len() as f64;
+        let bound = 1.5 * f64::EPSILON * exact_f.abs() + 2.0 * (n * f64::EPSILON).powi(2) * magnitude;
+        prop_assert!((v - exact_f).abs() <= bound, "{v:e} against exact {exact_f:e} (bound {bound:e})");
+    }
 }

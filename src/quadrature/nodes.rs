@@ -167,68 +167,208 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
     }
 }
 
-/// Nodes per block of [`line_sum`].
-const BLOCK: usize = 64;
-
-/// [`product_sum`] on one axis. The integrand is evaluated at a block of
-/// nodes first, then the block is summed: an integrand that calls a
-/// function (`cos`) clobbers every floating-point register, so the running
-/// sums, carried across its calls, were stored and reloaded at every node
-/// (the sum took 1.13 to 1.18 times the bare evaluations of `cos(50 x)`).
-/// Summed apart, they stay in registers, in [`crate::sum::LANES`] independent lanes,
-/// and the compensated sum, `sum |w y|` and the largest term are formed in
-/// one pass. The values are checked finite once a block, through the
-/// block's `sum |w y|` (a NaN or infinite value makes it non-finite, and
-/// then the block is searched for the first such node): a check at every
-/// node cost about 5% of the evaluations of `cos(50 x)`. So `f` may be
-/// called at up to 63 nodes after a non-finite value, and an error `f`
-/// returns at one of them is reported instead of that value (reporting the
-/// value first, with the loop that took, cost another 8% at n = 1e6).
-/// `magnitude` is summed a block at a time, so it can differ from a
-/// term-by-term sum in its last few bits.
+/// [`product_sum`] on one axis: [`LineSum::add_span`] over all its nodes.
 fn line_sum<V: Value>(
     a: &UnitNodes,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<ProductSum<V>, QuadError> {
-    let companions = [
-        a.companion.as_deref(),
-        a.companion4.as_deref(),
-        a.companion8.as_deref(),
-    ];
-    let mut value = Lanes::<V>::new();
-    let mut others = [Lanes::<V>::new(); 3];
-    let mut magnitude = LaneValues::<V>::zero();
-    let mut largest = LaneValues::<V>::zero();
-    let mut ys = [V::zero(); BLOCK];
-    for (block, (us, ws)) in a.u.chunks(BLOCK).zip(a.w.chunks(BLOCK)).enumerate() {
-        let ys = &mut ys[..us.len()];
-        for (y, &u) in ys.iter_mut().zip(us) {
-            *y = f(u)?;
-        }
-        let mut block_magnitude = LaneValues::zero();
-        value.add_products_scaled(ys, ws, &mut block_magnitude, &mut largest);
-        if !block_magnitude.all_finite()
-            && let Some((u, y)) = us.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
-        {
-            return Err(non_finite(&[*u], y));
-        }
-        magnitude.add(&block_magnitude);
-        let start = block * BLOCK;
-        for (lanes, c) in others.iter_mut().zip(companions) {
-            if let Some(c) = c {
-                lanes.add_products(ys, &c[start..start + us.len()]);
+    let mut sum = LineSum::new();
+    sum.add_span(a, 0..a.len(), &mut f)?;
+    Ok(sum.finish(a))
+}
+
+/// Nodes per span of [`line_sum_par`]: a multiple of [`BLOCK`], fixed, so
+/// the spans, and with them the result, do not depend on the number of
+/// threads. Some 0.2 ms of `cos(50 x)`, long against rayon's hand-over of
+/// a span (microseconds) and short enough that 1e6 nodes make 62 spans for
+/// two to eight threads to share evenly.
+pub const PAR_SPAN: usize = 1 << 14;
+
+/// [`product_sum`] on one axis, its nodes shared among rayon's threads:
+/// the axis is cut into spans of [`PAR_SPAN`] nodes, each summed as
+/// [`product_sum`] sums a whole axis (the same blocks, the same lanes, the
+/// same compensated sum), and the spans' sums are merged in node order
+/// ([`Lanes::merge`]). So the value is the same, bit for bit, whatever the
+/// number of threads, and the same as [`product_sum`]'s up to `n <=
+/// PAR_SPAN`; above, it differs from it in rounding only (the lanes restart
+/// at every span; both are compensated sums).
+///
+/// `f` is called from several threads at once, at nodes in no particular
+/// order. An error is the one [`product_sum`] would give: that of the
+/// first span, in node order, that fails, and in it of the first failing
+/// block. Spans after a failed span that have not started yet are skipped;
+/// spans before it all run.
+///
+/// ```
+/// use lightquad::quadrature::gauss_legendre::unit_nodes;
+/// use lightquad::quadrature::nodes::line_sum_par;
+///
+/// // int_0^1 cos(50 u) du = sin(50)/50 with a million Gauss nodes.
+/// let nodes = unit_nodes(1_000_000)?;
+/// let sum = line_sum_par(&nodes, |u| Ok((50.0 * u).cos()))?;
+/// assert!((sum.value - 50f64.sin() / 50.0).abs() < 1e-17);
+/// assert_eq!(sum.evaluations, 1_000_000);
+/// # Ok::<(), lightquad::error::QuadError>(())
+/// ```
+pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
+    a: &UnitNodes,
+    f: F,
+) -> Result<ProductSum<V>, QuadError> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    // The lowest span that has failed so far: later spans need not run.
+    let failed = AtomicUsize::new(usize::MAX);
+    let spans: Vec<Option<Result<LineSum<V>, QuadError>>> = (0..a.len().div_ceil(PAR_SPAN))
+        .into_par_iter()
+        .map(|k| {
+            if k > failed.load(Ordering::Relaxed) {
+                return None;
             }
+            let span = LineSum::of_span(a, k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len()), &f);
+            if span.is_err() {
+                failed.fetch_min(k, Ordering::Relaxed);
+            }
+            Some(span)
+        })
+        .collect();
+    let mut total = LineSum::new();
+    // In node order: the first failed span is reached before any skipped
+    // one (a span is skipped only after one before it failed).
+    for span in spans.into_iter().flatten() {
+        total.merge(&span?);
+    }
+    Ok(total.finish(a))
+}
+
+/// Nodes per block of [`LineSum::add_span`].
+const BLOCK: usize = 64;
+
+/// The running sums of [`product_sum`] on one axis (and of each span of
+/// [`line_sum_par`]): the weighted sum and its companions in lanes, `sum |w
+/// y|` and the largest term.
+#[derive(Clone, Copy)]
+struct LineSum<V: Value> {
+    value: Lanes<V>,
+    companions: [Lanes<V>; 3],
+    magnitude: LaneValues<V>,
+    largest: LaneValues<V>,
+}
+
+impl<V: Value> LineSum<V> {
+    fn new() -> Self {
+        Self {
+            value: Lanes::new(),
+            companions: [Lanes::new(); 3],
+            magnitude: LaneValues::zero(),
+            largest: LaneValues::zero(),
         }
     }
-    Ok(ProductSum {
-        value: value.total(),
-        companion: companions[0].map(|_| others[0].total()),
-        companion4: companions[1].map(|_| others[1].total()),
-        companion8: companions[2].map(|_| others[2].total()),
-        magnitude: magnitude.sum(),
-        largest: largest.max(),
-        evaluations: a.u.len() as u64,
-    })
+
+    /// Adds the nodes `range` of `a`. The integrand is evaluated at a
+    /// block of nodes first, then the block is summed: an integrand that
+    /// calls a function (`cos`) clobbers every floating-point register, so
+    /// the running sums, carried across its calls, were stored and reloaded
+    /// at every node (the sum took 1.13 to 1.18 times the bare evaluations
+    /// of `cos(50 x)`). Summed apart, they stay in registers, in
+    /// [`crate::sum::LANES`] independent lanes, and the compensated sum,
+    /// `sum |w y|` and the largest term are formed in one pass. The values
+    /// are checked finite once a block, through the block's `sum |w y|` (a
+    /// NaN or infinite value makes it non-finite, and then the block is
+    /// searched for the first such node): a check at every node cost about
+    /// 5% of the evaluations of `cos(50 x)`. So `f` may be called at up to
+    /// 63 nodes after a non-finite value, and an error `f` returns at one of
+    /// them is reported instead of that value (reporting the value first,
+    /// with the loop that took, cost another 8% at n = 1e6). `magnitude` is
+    /// summed a block at a time, so it can differ from a term-by-term sum in
+    /// its last few bits.
+    #[inline(always)]
+    fn add_span(
+        &mut self,
+        a: &UnitNodes,
+        range: std::ops::Range<usize>,
+        f: &mut impl FnMut(f64) -> Result<V, QuadError>,
+    ) -> Result<(), QuadError> {
+        let companions = [
+            a.companion.as_deref(),
+            a.companion4.as_deref(),
+            a.companion8.as_deref(),
+        ];
+        let (u, w) = (&a.u[range.clone()], &a.w[range.clone()]);
+        // Local copies of the sums, which the compiler keeps apart from `self`.
+        let Self {
+            mut value,
+            companions: mut others,
+            mut magnitude,
+            mut largest,
+        } = *self;
+        let mut ys = [V::zero(); BLOCK];
+        for (block, (us, ws)) in u.chunks(BLOCK).zip(w.chunks(BLOCK)).enumerate() {
+            let ys = &mut ys[..us.len()];
+            for (y, &u) in ys.iter_mut().zip(us) {
+                *y = f(u)?;
+            }
+            let mut block_magnitude = LaneValues::zero();
+            value.add_products_scaled(ys, ws, &mut block_magnitude, &mut largest);
+            if !block_magnitude.all_finite()
+                && let Some((u, y)) = us.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
+            {
+                return Err(non_finite(&[*u], y));
+            }
+            magnitude.add(&block_magnitude);
+            let start = range.start + block * BLOCK;
+            for (lanes, c) in others.iter_mut().zip(companions) {
+                if let Some(c) = c {
+                    lanes.add_products(ys, &c[start..start + us.len()]);
+                }
+            }
+        }
+        *self = Self {
+            value,
+            companions: others,
+            magnitude,
+            largest,
+        };
+        Ok(())
+    }
+
+    /// The sums over the nodes `range` of `a`. Not inlined: in rayon's
+    /// deeply inlined worker the integrand was left a call of its own at
+    /// every node.
+    #[inline(never)]
+    fn of_span(
+        a: &UnitNodes,
+        range: std::ops::Range<usize>,
+        f: &impl Fn(f64) -> Result<V, QuadError>,
+    ) -> Result<Self, QuadError> {
+        let mut sum = Self::new();
+        sum.add_span(a, range, &mut |u| f(u))?;
+        Ok(sum)
+    }
+
+    /// Adds the sums of a span that follows the spans already added.
+    fn merge(&mut self, other: &Self) {
+        self.value.merge(&other.value);
+        for (lanes, more) in self.companions.iter_mut().zip(&other.companions) {
+            lanes.merge(more);
+        }
+        self.magnitude.add(&other.magnitude);
+        self.largest.max_with(&other.largest);
+    }
+
+    /// The sums over every node of `a`, once all are added.
+    fn finish(&self, a: &UnitNodes) -> ProductSum<V> {
+        let [c, c4, c8] = &self.companions;
+        ProductSum {
+            value: self.value.total(),
+            companion: a.companion.as_ref().map(|_| c.total()),
+            companion4: a.companion4.as_ref().map(|_| c4.total()),
+            companion8: a.companion8.as_ref().map(|_| c8.total()),
+            magnitude: self.magnitude.sum(),
+            largest: self.largest.max(),
+            evaluations: a.u.len() as u64,
+        }
+    }
 }
 
 /// Fewest points per axis at which a composite rule's estimate is trusted.
