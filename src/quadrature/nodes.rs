@@ -68,7 +68,8 @@ pub struct ProductSum<V: Value> {
 
 /// Sums `f` over the tensor product of `axes` with compensated summation.
 ///
-/// This is the only place where a deterministic rule meets the integrand.
+/// With [`line_sum_par`], the only place where a deterministic rule meets
+/// the integrand.
 /// A non-finite integrand value stops the sum with an error naming the point
 /// (on one axis, at the end of the block of 256 nodes it is in).
 pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
@@ -197,7 +198,9 @@ pub const PAR_SPAN: usize = 1 << 14;
 /// order. An error is the one [`product_sum`] would give: that of the
 /// first span, in node order, that fails, and in it of the first failing
 /// block. Spans after a failed span that have not started yet are skipped;
-/// spans before it all run.
+/// spans before it all run, and spans already started run to their end: a
+/// panic in one of those reaches the caller even where [`product_sum`]
+/// would have stopped at the earlier error.
 ///
 /// ```
 /// use lightquad::quadrature::gauss_legendre::unit_nodes;
