@@ -156,6 +156,24 @@ fn rgb_and_six_channel_values_sum_channel_by_channel() {
     }
 }
 
+/// Terms `k 2^e` and weights `2^p` from `(k, e, p)`, the exact sum of the
+/// products rounded once to `f64` (exact: `k 2^(e + p + 68)` units of
+/// `2^-68` in an i128, at most 2^116 a term, 600 terms below 2^126), and
+/// `sum |w y|`.
+fn exact_terms(terms: &[(i64, i32, i32)]) -> (Vec<f64>, Vec<f64>, f64, f64) {
+    let ys: Vec<f64> = terms
+        .iter()
+        .map(|&(k, e, _)| k as f64 * 2f64.powi(e))
+        .collect();
+    let ws: Vec<f64> = terms.iter().map(|&(_, _, p)| 2f64.powi(p)).collect();
+    let exact: i128 = terms
+        .iter()
+        .map(|&(k, e, p)| (k as i128) << (e + p + 68))
+        .sum();
+    let magnitude = ys.iter().zip(&ws).map(|(y, w)| (y * w).abs()).sum();
+    (ys, ws, exact as f64 * 2f64.powi(-68), magnitude)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
 
@@ -169,17 +187,7 @@ proptest! {
     fn the_total_is_within_the_compensated_bound_of_the_exact_sum(
         terms in prop::collection::vec((-(1i64 << 40)..(1i64 << 40), -60i32..=0, -8i32..=8), 0..600),
     ) {
-        let ys: Vec<f64> = terms.iter().map(|&(k, e, _)| k as f64 * 2f64.powi(e)).collect();
-        let ws: Vec<f64> = terms.iter().map(|&(_, _, p)| 2f64.powi(p)).collect();
-        // Exact: k 2^(e + p) = k 2^(e + p + 68) units of 2^-68 (at most
-        // 2^116 a term, 600 terms below 2^126).
-        let exact: i128 = terms
-            .iter()
-            .map(|&(k, e, p)| (k as i128) << (e + p + 68))
-            .sum();
-        // Rounded once to f64 (half an ulp of S, allowed for below).
-        let exact_f = exact as f64 * 2f64.powi(-68);
-        let magnitude: f64 = ys.iter().zip(&ws).map(|(y, w)| (y * w).abs()).sum();
+        let (ys, ws, exact_f, magnitude) = exact_terms(&terms);
         let n = ys.len() as f64;
         let (v, m, _) = lanes(&ys, &ws, 64);
         let bound = 1.5 * f64::EPSILON * exact_f.abs() + 2.0 * (n * f64::EPSILON).powi(2) * magnitude;
@@ -195,14 +203,7 @@ proptest! {
         terms in prop::collection::vec((-(1i64 << 40)..(1i64 << 40), -60i32..=0, -8i32..=8), 1..600),
         cuts in prop::collection::vec(0usize..600, 0..6),
     ) {
-        let ys: Vec<f64> = terms.iter().map(|&(k, e, _)| k as f64 * 2f64.powi(e)).collect();
-        let ws: Vec<f64> = terms.iter().map(|&(_, _, p)| 2f64.powi(p)).collect();
-        let exact: i128 = terms
-            .iter()
-            .map(|&(k, e, p)| (k as i128) << (e + p + 68))
-            .sum();
-        let exact_f = exact as f64 * 2f64.powi(-68);
-        let magnitude: f64 = ys.iter().zip(&ws).map(|(y, w)| (y * w).abs()).sum();
+        let (ys, ws, exact_f, magnitude) = exact_terms(&terms);
         let mut cuts: Vec<usize> = cuts.into_iter().map(|c| c % ys.len()).collect();
         cuts.push(0);
         cuts.push(ys.len());
