@@ -2,8 +2,8 @@
 //! against `bilby` and `gauss-quad`, timed in interleaved rounds.
 //!
 //! `cargo run --release --example gl_race -- [ROUNDS] [--serial | --parallel]`
-//! (ROUNDS default 41; `--serial` leaves out the two parallel contenders,
-//! `--parallel` times them alone)
+//! (in either order; ROUNDS default 41; `--serial` leaves out the two
+//! parallel contenders, `--parallel` times them alone)
 //!
 //! The same integral as `cargo bench --bench quadrature -- gl_integrate`:
 //! `int_{-1}^{1} cos(50 x) dx`. On a shared machine whose speed drifts
@@ -61,10 +61,26 @@ fn quantile(v: &mut [f64], q: f64) -> f64 {
 type Contender<'a> = (&'static str, Box<dyn Fn() -> f64 + 'a>);
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let rounds: usize = match std::env::args().nth(1) {
-        Some(s) => s.parse().map_err(|e| format!("ROUNDS {s:?}: {e}"))?,
-        None => 41,
-    };
+    // `[ROUNDS] [--serial | --parallel]`, in either order. `--serial`:
+    // without the two that use every core, whose idle rayon threads spin a
+    // while after each call and take a core from whatever is timed next on
+    // a two-core machine; `--parallel`: those two alone.
+    let (mut rounds, mut only): (Option<usize>, Option<bool>) = (None, None);
+    for arg in std::env::args().skip(1) {
+        match arg.as_str() {
+            "--serial" | "--parallel" if only.is_none() => only = Some(arg == "--parallel"),
+            _ if rounds.is_none() && !arg.starts_with('-') => {
+                rounds = Some(arg.parse().map_err(|e| format!("ROUNDS {arg:?}: {e}"))?)
+            }
+            _ => {
+                return Err(format!(
+                    "{arg:?}: expected [ROUNDS] [--serial | --parallel], each at most once"
+                )
+                .into());
+            }
+        }
+    }
+    let rounds = rounds.unwrap_or(41);
     if !(1..=MAX_ROUNDS).contains(&rounds) {
         return Err(format!("ROUNDS {rounds}: expected 1 to {MAX_ROUNDS}").into());
     }
@@ -134,22 +150,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             Box::new(|| gq.integrate(-1.0, 1.0, integrand)),
         ),
     ];
-    // One untimed call each: nodes and code paged in.
-    // `--serial`: without the two that use every core, whose idle rayon
-    // threads spin a while after each call and take a core from whatever
-    // is timed next on a two-core machine; `--parallel`: those two alone.
-    let only: Option<bool> = match std::env::args().nth(2).as_deref() {
-        None => None,
-        Some("--serial") => Some(false),
-        Some("--parallel") => Some(true),
-        Some(other) => {
-            return Err(format!("{other:?}: expected --serial or --parallel").into());
-        }
-    };
+    let all: Vec<&str> = contenders.iter().map(|(name, _)| *name).collect();
     let contenders: Vec<Contender> = contenders
         .into_iter()
         .filter(|(name, _)| only.is_none_or(|par| name.ends_with(" par") == par))
         .collect();
+    // One untimed call each: nodes and code paged in.
     for (_, f) in &contenders {
         black_box(f());
     }
@@ -197,6 +203,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("bilby", "bilby const"),
         ("gauss-quad", "gauss-quad const"),
     ] {
+        if !(all.contains(&num) && all.contains(&den)) {
+            return Err(format!("ratio {num} / {den}: no such contender").into());
+        }
+        // A pair with a side left out by --serial or --parallel.
         let (Some(i), Some(j)) = (index(num), index(den)) else {
             continue;
         };

@@ -86,14 +86,89 @@ fn the_bits_do_not_depend_on_the_number_of_threads() {
     }
 }
 
+/// The bits of every field, the companions' included.
+fn all_bits(s: &ProductSum<f64>) -> Vec<u64> {
+    let companions = [s.companion, s.companion4, s.companion8];
+    let mut all = bits(s).to_vec();
+    all.extend(companions.iter().map(|c| c.map_or(u64::MAX, f64::to_bits)));
+    all
+}
+
 #[test]
 fn up_to_one_span_the_bits_are_product_sums() {
-    for n in [1, 63, 64, 1000, PAR_SPAN] {
-        let nodes = unit_nodes(n).expect("nodes");
-        let f = |u: f64| Ok((7.0 * u).sin() - u);
-        let par = line_sum_par(&nodes, f).expect("sum");
-        let serial = product_sum([nodes.as_ref()], |p: [f64; 1]| f(p[0])).expect("sum");
-        assert_eq!(bits(&par), bits(&serial), "n = {n}");
+    let f = |u: f64| Ok((7.0 * u).sin() - u);
+    // Around a block of 256 nodes, and the most one span holds.
+    for n in [1, 63, 64, 255, 256, 257, 1000, PAR_SPAN] {
+        let gauss = unit_nodes(n).expect("nodes");
+        // The trapezoid rule takes an odd number of points, at least 3.
+        let trapezoid = trapezoid::unit_nodes((n - 1 + n % 2).max(3)).expect("nodes");
+        for nodes in [gauss, trapezoid.into()] {
+            let par = line_sum_par(&nodes, f).expect("sum");
+            let serial = product_sum([nodes.as_ref()], |p: [f64; 1]| f(p[0])).expect("sum");
+            assert_eq!(all_bits(&par), all_bits(&serial), "n = {n}");
+        }
+    }
+}
+
+#[test]
+fn the_largest_term_and_the_magnitude_are_those_of_every_span() {
+    // 100_000 Gauss nodes, 7 spans, on exp(-20 u): the largest term
+    // w_i e^{-20 u_i} lies in the first span, far from the last.
+    let nodes = unit_nodes(100_000).expect("nodes");
+    let f = |u: f64| (-20.0 * u).exp();
+    let sum = in_pool(2, || line_sum_par(&nodes, |u| Ok(f(u)))).expect("sum");
+    let terms = nodes.u.iter().zip(&nodes.w).map(|(&u, w)| w * f(u));
+    let (index, largest) =
+        terms.clone().enumerate().fold(
+            (0, 0.0),
+            |(i, m), (j, t)| if t > m { (j, t) } else { (i, m) },
+        );
+    assert!(index < PAR_SPAN, "the largest term is at node {index}");
+    assert_eq!(sum.largest, largest);
+    // sum |w f| = sum w f here, int_0^1 e^{-20 u} du = (1 - e^-20)/20.
+    let exact = -(-20f64).exp_m1() / 20.0;
+    assert!((sum.magnitude - exact).abs() < 1e-14 * exact);
+    assert!((sum.value - exact).abs() < 4.0 * f64::EPSILON * exact);
+    let plain: f64 = lightquad::sum::sum_f64(terms);
+    assert!((sum.magnitude - plain).abs() < 1e-14 * exact);
+}
+
+#[test]
+fn a_panic_after_an_earlier_failure_gives_the_failure_and_before_it_the_panic() {
+    let nodes = unit_nodes(200_000).expect("nodes");
+    // A NaN in span 1, a panic from span 3 on: the serial sum stops at
+    // the NaN and never reaches the panic, whichever spans ran at once.
+    let nan_at = nodes.u[PAR_SPAN + 5];
+    let panic_from = nodes.u[3 * PAR_SPAN];
+    let f = |u: f64| {
+        if u >= panic_from {
+            panic!("integrand panicked at {u}");
+        }
+        Ok(if u == nan_at { f64::NAN } else { u })
+    };
+    for threads in [1, 2, 4] {
+        match in_pool(threads, || line_sum_par(&nodes, f)) {
+            Err(QuadError::NonFiniteIntegrand { point, .. }) => {
+                assert_eq!(point, vec![nan_at], "{threads} threads")
+            }
+            other => panic!("{threads} threads: expected the NaN, got {other:?}"),
+        }
+    }
+    // With the panic first and the NaN after it, the panic is what the
+    // caller sees.
+    let g = |u: f64| {
+        if u == nodes.u[PAR_SPAN + 5] {
+            panic!("integrand panicked at {u}");
+        }
+        Ok(if u >= panic_from { f64::NAN } else { u })
+    };
+    for threads in [1, 2, 4] {
+        let caught = std::panic::catch_unwind(|| in_pool(threads, || line_sum_par(&nodes, g)));
+        let payload = caught.expect_err("the panic reaches the caller");
+        let message = payload
+            .downcast_ref::<String>()
+            .expect("a formatted message");
+        assert!(message.starts_with("integrand panicked at"), "{message}");
     }
 }
 

@@ -877,19 +877,25 @@ fn a_budget_whose_working_memory_cannot_fit_is_refused_at_once() {
     assert!((ok.expect("fits").value - 0.5).abs() < 1e-14);
 }
 
-/// The one-axis sum checks its values once a block of 64 nodes: a NaN or
-/// infinite value anywhere in a later block, with a second one after it in
-/// the same block, is reported at the first of them (the node's own `u`),
+/// The one-axis sum checks its values once a block of 256 nodes: a NaN or
+/// infinite value anywhere in a block, with a second one after it in the
+/// same block or the next, is reported at the first of them (the node's own `u`),
 /// for scalars and for every channel of a colour; a clean sum's `magnitude`
 /// and `largest` are `sum |w f|` and `max |w f|` computed term by term.
 #[test]
 fn the_line_sum_reports_the_first_non_finite_node_of_any_block() {
     use lightquad::quadrature::gauss_legendre::unit_nodes;
     use lightquad::quadrature::nodes::product_sum;
-    let nodes = unit_nodes(300).expect("300 nodes");
+    let nodes = unit_nodes(600).expect("600 nodes");
     let u = &nodes.u;
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        for (first, second) in [(0usize, 1usize), (70, 100), (191, 192), (298, 299)] {
+        // Pairs in the first block, at its end, across a block's edge, in
+        // a later block and at the end of the last (partial) one.
+        let pairs = [(0usize, 1usize), (70, 200), (254, 255), (255, 256)];
+        for (first, second) in pairs
+            .into_iter()
+            .chain([(256, 257), (300, 511), (598, 599)])
+        {
             let err = product_sum([nodes.as_ref()], |p: [f64; 1]| {
                 let hit = p[0] == u[first] || p[0] == u[second];
                 Ok(if hit { bad } else { 1.0 })

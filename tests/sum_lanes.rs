@@ -156,6 +156,33 @@ fn rgb_and_six_channel_values_sum_channel_by_channel() {
     }
 }
 
+/// Three spans merged in order, each with a carry or a rounded merge:
+/// every piece reaches the total. Span A holds `1 + 2^-60` (sum 1, carry
+/// `2^-60`), span B `1 + 2^-52 + 2^-61` (carry `2^-61`); merged, `2 +
+/// 2^-52` rounds to 2 (ties to even) with TwoSum's error `2^-52`; span C's
+/// `-2` cancels the sums. What is left is the exact `2^-52 + 3 2^-61`,
+/// which leaving out either carry or TwoSum's error would change.
+#[test]
+fn merged_spans_keep_their_carries_and_the_merges_rounding() {
+    let p = |e: i32| 2f64.powi(e);
+    let span = |ys: &[f64]| {
+        let mut lanes = Lanes::<f64>::new();
+        // One term a group of four, so every term lands in lane 0.
+        let spread: Vec<f64> = ys.iter().flat_map(|&y| [y, 0.0, 0.0, 0.0]).collect();
+        lanes.add_products(&spread, &vec![1.0; spread.len()]);
+        lanes
+    };
+    let mut merged = Lanes::<f64>::new();
+    for part in [
+        span(&[1.0, p(-60)]),
+        span(&[1.0 + p(-52), p(-61)]),
+        span(&[-2.0]),
+    ] {
+        merged.merge(&part);
+    }
+    assert_eq!(merged.total(), p(-52) + 3.0 * p(-61));
+}
+
 /// Terms `k 2^e` and weights `2^p` from `(k, e, p)`, the exact sum of the
 /// products rounded once to `f64` (exact: `k 2^(e + p + 68)` units of
 /// `2^-68` in an i128, at most 2^116 a term, 600 terms below 2^126), and

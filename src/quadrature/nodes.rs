@@ -198,9 +198,11 @@ pub const PAR_SPAN: usize = 1 << 14;
 /// order. An error is the one [`product_sum`] would give: that of the
 /// first span, in node order, that fails, and in it of the first failing
 /// block. Spans after a failed span that have not started yet are skipped;
-/// spans before it all run, and spans already started run to their end: a
-/// panic in one of those reaches the caller even where [`product_sum`]
-/// would have stopped at the earlier error.
+/// spans before it all run, and spans already started run to their end. A
+/// panic of `f` is an outcome of its span like an error: it reaches the
+/// caller only where no span before it failed, as with [`product_sum`]
+/// (the panic hook may still print the message of one that is then
+/// dropped).
 ///
 /// ```
 /// use lightquad::quadrature::gauss_legendre::unit_nodes;
@@ -220,26 +222,37 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
-    // The lowest span that has failed so far: later spans need not run.
+    // The lowest span that has failed (or panicked) so far: later spans
+    // need not run.
     let failed = AtomicUsize::new(usize::MAX);
-    let spans: Vec<Option<Result<LineSum<V>, QuadError>>> = (0..a.len().div_ceil(PAR_SPAN))
-        .into_par_iter()
-        .map(|k| {
-            if k > failed.load(Ordering::Relaxed) {
-                return None;
-            }
-            let span = LineSum::of_span(a, k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len()), &f);
-            if span.is_err() {
-                failed.fetch_min(k, Ordering::Relaxed);
-            }
-            Some(span)
-        })
-        .collect();
+    let spans: Vec<Option<std::thread::Result<Result<LineSum<V>, QuadError>>>> =
+        (0..a.len().div_ceil(PAR_SPAN))
+            .into_par_iter()
+            .map(|k| {
+                if k > failed.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let range = k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len());
+                // `f` is only borrowed, and a span that panicked is never
+                // read: nothing broken by the panic is seen again.
+                let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    LineSum::of_span(a, range, &f)
+                }));
+                if !matches!(span, Ok(Ok(_))) {
+                    failed.fetch_min(k, Ordering::Relaxed);
+                }
+                Some(span)
+            })
+            .collect();
     let mut total = LineSum::new();
     // In node order: the first failed span is reached before any skipped
-    // one (a span is skipped only after one before it failed).
+    // one (a span is skipped only after one before it failed), and a panic
+    // resumes only when no span before it failed.
     for span in spans.into_iter().flatten() {
-        total.merge(&span?);
+        match span {
+            Ok(span) => total.merge(&span?),
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
     }
     Ok(total.finish(a))
 }
@@ -250,6 +263,9 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
 /// bilby 1.047, 1.058, 1.047 at 64 against 1.034, 1.046, 1.032 at 256).
 /// The buffer is 2 KiB for a scalar, 12 KiB for the largest value.
 const BLOCK: usize = 256;
+
+// A span of `line_sum_par` is whole blocks, so its blocks are `product_sum`'s.
+const _: () = assert!(PAR_SPAN % BLOCK == 0);
 
 /// The running sums of [`product_sum`] on one axis (and of each span of
 /// [`line_sum_par`]): the weighted sum and its companions in lanes, `sum |w
