@@ -225,25 +225,24 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     // The lowest span that has failed (or panicked) so far: later spans
     // need not run.
     let failed = AtomicUsize::new(usize::MAX);
-    let spans: Vec<Option<std::thread::Result<Result<LineSum<V>, QuadError>>>> =
-        (0..a.len().div_ceil(PAR_SPAN))
-            .into_par_iter()
-            .map(|k| {
-                if k > failed.load(Ordering::Relaxed) {
-                    return None;
-                }
-                let range = k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len());
-                // `f` is only borrowed, and a span that panicked is never
-                // read: nothing broken by the panic is seen again.
-                let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    LineSum::of_span(a, range, &f)
-                }));
-                if !matches!(span, Ok(Ok(_))) {
-                    failed.fetch_min(k, Ordering::Relaxed);
-                }
-                Some(span)
-            })
-            .collect();
+    let spans: Vec<Option<SpanOutcome<V>>> = (0..a.len().div_ceil(PAR_SPAN))
+        .into_par_iter()
+        .map(|k| {
+            if k > failed.load(Ordering::Relaxed) {
+                return None;
+            }
+            let range = k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len());
+            // `f` is only borrowed, and a span that panicked is never
+            // read: nothing broken by the panic is seen again.
+            let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                LineSum::of_span(a, range, &f)
+            }));
+            if !matches!(span, Ok(Ok(_))) {
+                failed.fetch_min(k, Ordering::Relaxed);
+            }
+            Some(span)
+        })
+        .collect();
     let mut total = LineSum::new();
     // In node order: the first failed span is reached before any skipped
     // one (a span is skipped only after one before it failed), and a panic
@@ -257,6 +256,10 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     Ok(total.finish(a))
 }
 
+/// What one span of [`line_sum_par`] came to: its sums, the integrand's
+/// error, or the payload of its panic.
+type SpanOutcome<V> = std::thread::Result<Result<LineSum<V>, QuadError>>;
+
 /// Nodes per block of [`LineSum::add_span`]. 256 rather than 64: each
 /// block's finite check and hand-over cost some 1.3% of the evaluations of
 /// `cos(50 x)` at 64 (paired rounds of `examples/gl_race.rs`, lightquad over
@@ -265,7 +268,7 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
 const BLOCK: usize = 256;
 
 // A span of `line_sum_par` is whole blocks, so its blocks are `product_sum`'s.
-const _: () = assert!(PAR_SPAN % BLOCK == 0);
+const _: () = assert!(PAR_SPAN.is_multiple_of(BLOCK));
 
 /// The running sums of [`product_sum`] on one axis (and of each span of
 /// [`line_sum_par`]): the weighted sum and its companions in lanes, `sum |w
