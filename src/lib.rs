@@ -47,7 +47,9 @@
 //! # Ok::<(), lightquad::QuadError>(())
 //! ```
 
-#![forbid(unsafe_code)]
+// One `unsafe` call in the crate: the compensated sum's AVX pass, after
+// checking that the CPU has AVX (`sum::avx::add_channel`).
+#![deny(unsafe_code)]
 #![deny(clippy::unwrap_used, clippy::expect_used)]
 #![warn(missing_docs)]
 
