@@ -74,7 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             _ => {
                 return Err(format!(
-                    "{arg:?}: expected [ROUNDS] [--serial | --parallel], each at most once"
+                    "{arg:?}: expected [ROUNDS] [--serial | --parallel]: one number, one of the two flags"
                 )
                 .into());
             }

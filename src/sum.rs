@@ -359,7 +359,9 @@ mod avx {
 
     /// [`add_channel_portable`], in AVX registers where the CPU has them
     /// (a cached flag, checked once a call), else as it is. The same
-    /// operations on each lane in the same order, so the same bits.
+    /// operations on each lane in the same order, so the same bits (but
+    /// for a NaN's payload where two NaNs meet in one product, a NaN value
+    /// times a NaN weight: which comes out is the compiler's choice).
     #[inline(always)]
     pub(super) fn add_channel<V: Value, const SCALED: bool>(
         ys: &[V],
@@ -488,7 +490,9 @@ mod tests {
     /// The AVX pass gives the portable pass's bits: every lane of the sum,
     /// the carry, `sum |w y|` and the largest term, for scalars and each
     /// channel of a colour, on lengths with every remainder, with terms of
-    /// both signs over many scales, a NaN term among them too.
+    /// both signs over many scales, -0, a subnormal, -MAX, infinities and
+    /// a NaN among them (finite weights: see [`avx::add_channel`] on NaN
+    /// payloads).
     #[test]
     fn the_avx_pass_gives_the_portable_bits() {
         if !std::arch::is_x86_feature_detected!("avx") {
@@ -498,9 +502,13 @@ mod tests {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
         for n in (0..=9).chain([255, 256, 257]) {
             for nan in [None, Some(n / 2)] {
+                // Every seventh term one of the edge values.
+                let edges = [-0.0, 5e-324, -f64::MAX, f64::INFINITY, f64::NEG_INFINITY];
                 let mut term = |i: usize| {
                     if nan == Some(i) {
                         f64::NAN
+                    } else if i % 7 == 6 {
+                        edges[(i / 7) % edges.len()]
                     } else {
                         (rng.random::<f64>() - 0.5) * 10f64.powi(rng.random_range(-20..20))
                     }
