@@ -251,8 +251,8 @@ impl<V: Value> Lanes<V> {
     /// carries and TwoSum's error into the carry. So the lanes of a sum
     /// split into spans and merged in order hold the whole sum to within
     /// the carries' plain additions, `u` times the carries (each at most
-    /// `u` times the sum of its span's running partial sums), and a single span merged into an empty sum is
-    /// that span's sum bit for bit.
+    /// `u` times the sum of its span's running partial sums), and a single
+    /// span merged into an empty sum is that span's sum bit for bit.
     ///
     /// ```
     /// use lightquad::sum::Lanes;
