@@ -83,6 +83,21 @@ pub enum QuadError {
         /// Most tentative collisions per walk and span.
         limit: u64,
     },
+    /// The weighted sum of finite integrand values left the f64 range: a
+    /// raw sum ([`crate::quadrature::nodes::product_sum`],
+    /// [`crate::quadrature::nodes::line_sum_par`]) of values within rounding
+    /// of `f64::MAX`, whose running sums can pass it where the integral does
+    /// not. [`crate::quadrature::Rule::try_integrate`] takes such an
+    /// integrand again scaled, and never returns this.
+    #[error(
+        "the weighted sum of the integrand's values leaves the f64 range (its largest term is {largest}, the sum of their magnitudes {magnitude}); expected values below about 1e300: scale the integrand, or integrate through a rule's `try_integrate`, which scales it"
+    )]
+    SumOutOfRange {
+        /// The largest `|w f|`, formatted.
+        largest: String,
+        /// `sum |w f|`, formatted.
+        magnitude: String,
+    },
     /// The integrand returned a non-finite value.
     #[error("integrand returned {value} at unit-cube point {point:?}")]
     NonFiniteIntegrand {

@@ -2,12 +2,15 @@
 //! threads, against closed forms (Gauss–Legendre on `cos(50 u)`, the
 //! trapezoid rule and its coarser companions on `u^2`), and its promises:
 //! the same bits whatever the number of threads, the same bits as
-//! `product_sum` up to one span, and the error `product_sum` gives.
+//! `product_sum` up to one span, and the error `product_sum` gives
+//! (for a non-finite value, and for finite values whose sum leaves the f64
+//! range).
 
 use lightquad::error::QuadError;
 use lightquad::quadrature::gauss_legendre::unit_nodes;
 use lightquad::quadrature::nodes::{PAR_SPAN, ProductSum, line_sum_par, product_sum};
-use lightquad::quadrature::trapezoid;
+use lightquad::quadrature::{GaussLegendre, Rule, trapezoid};
+use rand::SeedableRng;
 
 /// `int_0^1 cos(50 u) du = sin(50)/50` as `HI + LO` (half of
 /// `sin(50)/25 = -0.010494994148157151436575745876504901835...`, from the
@@ -211,4 +214,49 @@ fn a_nan_in_a_late_span_is_reported_at_the_first_node_where_it_occurs() {
         format!("{:?}", par.expect_err("an error")),
         format!("{:?}", serial.expect_err("an error"))
     );
+}
+
+/// `int_0^1 f64::MAX du = f64::MAX`, representable, but the running sums of
+/// `w_i f64::MAX` pass it (the weights sum to 1 only to within rounding):
+/// 1e5 Gauss nodes summed to NaN and came back `Ok(NaN)`. Now a sum that
+/// leaves the range is an error naming it, at one and two threads and in
+/// two dimensions, and a rule's `try_integrate` still finds the integral
+/// (it takes the integrand again scaled).
+#[test]
+fn values_near_f64_max_whose_sums_leave_the_range_are_an_error() {
+    let near_max = |v: f64| (f64::MAX * (1.0 - 1e-12)..=f64::MAX).contains(&v);
+    // Where the sums stay in range, the integral itself.
+    let few = unit_nodes(1000).expect("nodes");
+    let sum = product_sum([few.as_ref()], |_: [f64; 1]| Ok(f64::MAX)).expect("in range");
+    assert!(near_max(sum.value), "{:e}", sum.value);
+    let out_of_range = |r: Result<ProductSum<f64>, QuadError>, what: &str| match r {
+        Err(e @ QuadError::SumOutOfRange { .. }) => {
+            assert!(
+                e.to_string().contains("leaves the f64 range"),
+                "{what}: {e}"
+            )
+        }
+        other => panic!("{what}: expected SumOutOfRange, got {other:?}"),
+    };
+    let many = unit_nodes(100_000).expect("nodes");
+    out_of_range(
+        product_sum([many.as_ref()], |_: [f64; 1]| Ok(f64::MAX)),
+        "1e5 nodes",
+    );
+    let million = unit_nodes(1_000_000).expect("nodes");
+    for threads in [1, 2] {
+        out_of_range(
+            in_pool(threads, || line_sum_par(&million, |_| Ok(f64::MAX))),
+            &format!("1e6 nodes, {threads} threads"),
+        );
+    }
+    out_of_range(
+        product_sum([few.as_ref(), few.as_ref()], |_: [f64; 2]| Ok(f64::MAX)),
+        "1000 x 1000 nodes",
+    );
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+    let e = GaussLegendre::default()
+        .try_integrate(100_000, &mut rng, |_: [f64; 1]| Ok(f64::MAX))
+        .expect("a rule scales the integrand");
+    assert!(near_max(e.value), "{:e}", e.value);
 }

@@ -317,6 +317,15 @@ pub trait Rule {
                     },
                 )
             };
+            // A raw sum that left the f64 range (values within rounding of
+            // f64::MAX, past the log): a pass whose estimate overflowed.
+            let pass = match pass {
+                Err(QuadError::SumOutOfRange { .. }) => {
+                    let nan = V::from_fn(|_| f64::NAN);
+                    Ok(Estimate::deterministic(nan, nan, fresh))
+                }
+                pass => pass,
+            };
             // The channels whose largest |f| is beyond 2^500 at their scale.
             let rescale = |e: V, largest: V| {
                 e.zip(largest, |e, l| {

@@ -71,7 +71,10 @@ pub struct ProductSum<V: Value> {
 /// With [`line_sum_par`], the only place where a deterministic rule meets
 /// the integrand.
 /// A non-finite integrand value stops the sum with an error naming the point
-/// (on one axis, at the end of the block of 256 nodes it is in).
+/// (on one axis, at the end of the block of 256 nodes it is in). Finite
+/// values whose sums leave the f64 range (values within rounding of
+/// `f64::MAX`) are [`QuadError::SumOutOfRange`], never a sum that is not
+/// finite.
 pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
     axes: [&UnitNodes; D],
     mut f: F,
@@ -148,7 +151,7 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
         let mut d = D;
         loop {
             if d == 0 {
-                return Ok(ProductSum {
+                return in_range(ProductSum {
                     value: acc.total(),
                     companion: with_companion.then(|| acc_c.total()),
                     companion4: with_companion4.then(|| acc_c4.total()),
@@ -175,7 +178,29 @@ fn line_sum<V: Value>(
 ) -> Result<ProductSum<V>, QuadError> {
     let mut sum = LineSum::new();
     sum.add_span(a, 0..a.len(), &mut f)?;
-    Ok(sum.finish(a))
+    in_range(sum.finish(a))
+}
+
+/// `sum`, or [`QuadError::SumOutOfRange`] where a sum of its finite terms
+/// is not finite. Weights that sum to 1 keep the integral within the range
+/// of the values, but not the running sums: the sum of `f64::MAX` on 1e5
+/// Gauss nodes came out NaN, where the integral is `f64::MAX`.
+fn in_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError> {
+    let sums = [
+        Some(sum.value),
+        sum.companion,
+        sum.companion4,
+        sum.companion8,
+        Some(sum.magnitude),
+    ];
+    if sums.iter().flatten().all(Value::all_finite) {
+        Ok(sum)
+    } else {
+        Err(QuadError::SumOutOfRange {
+            largest: format!("{:?}", sum.largest),
+            magnitude: format!("{:?}", sum.magnitude),
+        })
+    }
 }
 
 /// Nodes per span of [`line_sum_par`]: a multiple of [`BLOCK`], fixed, so
@@ -195,7 +220,8 @@ pub const PAR_SPAN: usize = 1 << 14;
 /// at every span; both are compensated sums).
 ///
 /// `f` is called from several threads at once, at nodes in no particular
-/// order. An error is the one [`product_sum`] would give: that of the
+/// order. An error (a non-finite value, a sum out of range, or the
+/// integrand's own) is the one [`product_sum`] would give: that of the
 /// first span, in node order, that fails, and in it of the first failing
 /// block. Spans after a failed span that have not started yet are skipped;
 /// spans before it all run, and spans already started run to their end. A
@@ -253,7 +279,7 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
             Err(panic) => std::panic::resume_unwind(panic),
         }
     }
-    Ok(total.finish(a))
+    in_range(total.finish(a))
 }
 
 /// What one span of [`line_sum_par`] came to: its sums, the integrand's
