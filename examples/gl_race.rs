@@ -23,8 +23,8 @@
 //!
 //! Prints a table: the median and the least time of each contender and the
 //! error of its value against `sin(50)/25` (to about 32 digits, as a pair
-//! of `f64`s: one `f64` is 1.7e-18 off), then the paired ratios (median
-//! and quartiles). `plain loop` is the peers' loop
+//! of `f64`s: one `f64` is 1.7e-18 off), then the paired ratios (median,
+//! a 95% interval of the median, and quartiles). `plain loop` is the peers' loop
 //! (`s += w f(x)`) on lightquad's own nodes: lightquad's time over it is
 //! what the compensated sum, `sum |w f|`, the largest term and the finite
 //! checks cost.
@@ -56,6 +56,20 @@ fn integrand(x: f64) -> f64 {
 fn quantile(v: &mut [f64], q: f64) -> f64 {
     v.sort_by(f64::total_cmp);
     v[((v.len() - 1) as f64 * q).round() as usize]
+}
+
+/// A 95% confidence interval of the median of `v` (sorted in place) that
+/// assumes nothing of the distribution: the order statistics of ranks
+/// `n/2 -+ 1.96 sqrt(n)/2`, between which the median of the population
+/// lies with probability 0.95 (normal approximation to the binomial
+/// count of samples below it; rounds taken as independent).
+fn median_interval(v: &mut [f64]) -> (f64, f64) {
+    v.sort_by(f64::total_cmp);
+    let n = v.len() as f64;
+    let half = 1.96 * n.sqrt() / 2.0;
+    let low = (n / 2.0 - half).floor().max(0.0) as usize;
+    let high = ((n / 2.0 + half).ceil() as usize).min(v.len() - 1);
+    (v[low], v[high])
 }
 
 type Contender<'a> = (&'static str, Box<dyn Fn() -> f64 + 'a>);
@@ -187,8 +201,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     println!();
-    println!("| ratio, paired by round | median | quartiles |");
-    println!("|---|---:|---:|");
+    println!("| ratio, paired by round | median | 95% interval of the median | quartiles |");
+    println!("|---|---:|---:|---:|");
     let index = |name: &str| contenders.iter().position(|(n, _)| *n == name);
     for (num, den) in [
         ("lightquad", "bilby"),
@@ -211,8 +225,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             continue;
         };
         let mut ratio: Vec<f64> = times[i].iter().zip(&times[j]).map(|(x, y)| x / y).collect();
+        let (low, high) = median_interval(&mut ratio);
         println!(
-            "| {num} / {den} | {:.3} | {:.3} – {:.3} |",
+            "| {num} / {den} | {:.4} | {low:.4} – {high:.4} | {:.3} – {:.3} |",
             quantile(&mut ratio, 0.5),
             quantile(&mut ratio, 0.25),
             quantile(&mut ratio, 0.75)
