@@ -39,7 +39,7 @@
 //! A feature no node comes near reads as zero and is not seen (as for every
 //! rule); one that a single node carries (most of a box's `sum |w f|`) makes
 //! the estimate doubted ([`dominated`]), and so does a final estimate that
-//! the run's own history contradicts, or a run of one box ([`contradicted`]).
+//! the run's own history contradicts, or a run of one box (`contradicted`).
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;

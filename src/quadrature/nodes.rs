@@ -203,7 +203,7 @@ fn in_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError> {
     }
 }
 
-/// Nodes per span of [`line_sum_par`]: a multiple of [`BLOCK`], fixed, so
+/// Nodes per span of [`line_sum_par`]: a multiple of `BLOCK`, fixed, so
 /// the spans, and with them the result, do not depend on the number of
 /// threads. Some 0.2 ms of `cos(50 x)`, long against rayon's hand-over of
 /// a span (microseconds) and short enough that 1e6 nodes make 62 spans for

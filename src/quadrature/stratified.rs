@@ -42,9 +42,9 @@
 //! in the samples: the nearest cells read values far above the rest, and the
 //! second differences there are a few terms that bound nothing about the
 //! peak (a Gaussian of width 1e-3 read as 1e-300 +- 1e-299). Where the
-//! second differences have fewer than [`FEW_CELLS`] degrees of freedom and
+//! second differences have fewer than `FEW_CELLS` degrees of freedom and
 //! one sample inside the cube (not in a cell on its boundary) carries more
-//! than [`DOMINANT`] of the sum of `|f|` (twice the even share at a few
+//! than `DOMINANT` of the sum of `|f|` (twice the even share at a few
 //! cells), the estimate is doubted. Over a battery of 186 integrands
 //! (peaks, Gaussians, cusps, jumps, kinks, periodic and exponential ones)
 //! at 75 budgets from 2 to 2e5, the estimates under a tenth of the true

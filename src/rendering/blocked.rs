@@ -435,7 +435,7 @@ fn hidden_by<K: Kernel>(
 /// An emitter's light with nothing in the way over its exact cone of
 /// directions `cone` (a sphere's, a cap light's, the environment's
 /// hemisphere, a disk's from its axis), `int K(w) cos theta L d w` above the
-/// horizon (and inside the lobe's clamp), by [`over_fan`] about the cone's
+/// horizon (and inside the lobe's clamp), by `over_fan` about the cone's
 /// axis out to its half-angle: exact pieces, where a rule over the cone
 /// ends at one box for a flat kernel (the integrand is a low polynomial in
 /// the cone's map) and cannot vouch for it.
@@ -466,7 +466,7 @@ pub fn over_cone<K: Kernel>(
 
 /// A planar or sphere light's light with nothing in the way, `int K(w) cos
 /// theta L d w` over the directions that meet it above the horizon (and
-/// inside the lobe's clamp), by [`over_fan`] about the direction to its
+/// inside the lobe's clamp), by `over_fan` about the direction to its
 /// bounding sphere: exact pieces where the horizon or the clamp cuts the
 /// light (over its surface the integrand kinks there: a rectangle across
 /// the horizon was 3.1e-8 off by adaptive Genz–Malik). `None` for lights at

@@ -667,7 +667,7 @@ pub enum Walks {
 /// ([`Medium::min_density`]):
 ///
 /// - ratio tracking crosses every span: `sum mu L`, `mu = k sigma_bar`
-///   ([`ratio_rate_factor`]); residual ratio tracking's `mu` is its
+///   (`ratio_rate_factor`); residual ratio tracking's `mu` is its
 ///   residual bound;
 /// - a delta-tracking walk reaches the span with probability at most
 ///   `S = exp(-sum of m L over the spans before it)`, and then has at most

@@ -405,7 +405,7 @@ impl Medium for VoxelGrid {
     }
 
     /// The largest value over the voxels whose interpolation stencils the
-    /// chord inside `[t0, t1]` can reach ([`VoxelGrid::stencil_box`]), not
+    /// chord inside `[t0, t1]` can reach (`VoxelGrid::stencil_box`), not
     /// the global maximum. Times `1 + 8 eps` for the rounding of the
     /// interpolation weights; 0 where the ray misses the box.
     fn max_density(&self, ray: &Ray, t0: f64, t1: f64) -> f64 {

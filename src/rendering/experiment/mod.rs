@@ -1,0 +1,786 @@
+//! The rendering-equation family (R-* in docs/EQUATIONS.md) as the experiment
+//! layer sees it (`"family": "rendering"`): a receiver (a point, its normal
+//! and, for reflected radiance, a BRDF and the direction toward the viewer),
+//! emitters and occluders; irradiance and reflected radiance at the receiver
+//! by **form**, each form a different integrand over a different domain of
+//! the same value, so that a report shows the forms side by side per rule and
+//! budget; multiple importance sampling beside the rules; closed forms where
+//! the scene has one, a converged adaptive evaluation otherwise.
+//!
+//! The value (R-H, R-A without the emitted term at the receiver):
+//!
+//! `E(x, n) = int_H L_i(x, w) cos theta dw`, `L_r(x, wo) = int_H f_r(w, wo)
+//! L_i(x, w) cos theta dw`
+//!
+//! | quantity | form | domain, per evaluation | integrand in `u` |
+//! |---|---|---|---|
+//! | `E_hemisphere` | R-H | the hemisphere, uniform map `cos theta = u_1`, `J = 2 pi` | `L_i(x, w) cos theta 2 pi`: a ray cast per node |
+//! | `E_cosine` | R-H | the hemisphere, Malley's map in projected solid angle, `J = pi` | `L_i(x, w) pi` |
+//! | `E_cone` | R-H per emitter | the cone of directions that holds the emitter (exact for a sphere, a cap light, the environment's hemisphere and a disk seen from its axis; a bounding cone otherwise) | `L_i^k(x, w) cos theta J` |
+//! | `E_area` | R-A (R-S, R-3P's `g`) per emitter | the emitter's surface through its map with the Jacobian (rectangle, polar disk, Duffy triangle, the visible cap of a sphere; the cap of directions of a light at infinity) | `L_e cos theta cos theta' / r^2 V(x, y) J` |
+//! | `L_hemisphere`, `L_cosine`, `L_cone`, `L_area` | as the `E_` forms | as above | the same with `f_r(w, wo)` |
+//! | `L_brdf` | R-H | the BRDF-sampled map of `scene.receiver.brdf` for `wo`, `J = 1 / pdf` | `f_r L_i cos theta / pdf` |
+//!
+//! (`J` is the Jacobian of the domain's map.)
+//!
+//! The per-emitter forms (`_cone`, `_area`) spend the budget on each emitter
+//! and add the parts. Every quantity is a 2-D integral: every 2-D rule
+//! integrates it (`genz-malik`, `gauss-legendre`, `trapezoid`, `simpson`,
+//! `monte-carlo`, `stratified`, `sobol`, and a product of two 1-D rules);
+//! a 1-D rule alone (`gauss-kronrod`) is refused when the experiment is
+//! checked. The L quantities need `scene.receiver.brdf` (refused at the
+//! quantity without one).
+//!
+//! **Estimators.** `{"rule": "mis-balance"}` and `{"rule": "mis-power"}`:
+//! light sampling and BRDF sampling combined by Veach's balance or power
+//! heuristic ([`crate::rendering::mis`]), one sample of each strategy per
+//! unit of budget, with a standard error. The light strategy is the
+//! quantity's form, so they estimate `E_area`, `L_area` (light sampled by
+//! area) and `E_cone`, `L_cone` (light sampled in its cone), and are refused
+//! for the other forms; irradiance is `pi` times the reflected radiance of a
+//! white Lambertian BRDF (its BRDF sampling is cosine sampling).
+//!
+//! **Closed forms** ([`crate::exact::rendering`]), for scenes without
+//! occluders whose emitters cannot shadow each other (one emitter, or only
+//! lights at infinity): a rectangle or triangle light by Lambert's contour
+//! formula (clipped at the horizon), a disk light seen from its axis by the
+//! parallel coaxial disk, a sphere light and a cap light by Snyder's cap
+//! formula (partly below the horizon included), the environment `pi L`;
+//! reflected radiance for a Lambertian BRDF `rho / pi E`, and for a Phong
+//! lobe under the environment alone at normal incidence (`2 pi / (n + 2)`)
+//! or of exponent 1 at any incidence (the clamped-cosine product).
+//!
+//! **Converged reference** ([`Rendering::converged`]): adaptive Genz–Malik
+//! per emitter on the smoothest form the emitter has: its exact cone
+//! (sphere, cap light, coaxial disk), the BRDF-sampled map for the
+//! environment under a non-Lambertian BRDF (the lobe becomes smooth), the
+//! cone for the environment otherwise, and its surface (R-A) for planar
+//! lights. Under a non-Lambertian BRDF a finite light's form is checked
+//! against the BRDF-sampled map restricted to that light (a lobe narrower
+//! than the light is smooth there and a peak in the light's own domain; a
+//! lobe across the light's outline the other way round): the one with the
+//! smaller error estimate is kept, its error widened to their difference
+//! where they disagree beyond ten times their estimates.
+//!
+//! Where the integrand would kink or jump inside those domains, the
+//! converged reference integrates between exact outlines instead, in polar
+//! directions with nested adaptive Gauss–Kronrod
+//! ([`crate::rendering::blocked`], [`crate::rendering::arcs`]): a flat
+//! kernel over an exact cone; a planar light cut by the horizon or the
+//! lobe's clamp; and, where something can block a light and its shadow is
+//! not a polygon the scene can cut out exactly, the light with nothing in
+//! the way less what each blocker hides, cut at the blocker's, the light's,
+//! the horizon's, the clamp's and the other blockers' outlines. That needs
+//! every blocker wholly in front of the light or wholly behind it
+//! ([`crate::rendering::order`]); where one straddles it (a sphere through
+//! the plane of a rectangle light) the hidden part is taken over the
+//! blocker's domain with a visibility test, and the reference says
+//! "unverified" instead of converged.
+//!
+//! **Terms left out.** R-A's visibility is evaluated only where something
+//! can block an emitter ([`crate::rendering::scene::Scene::has_blockers`]):
+//! without occluders, and with no other finite emitter, no shadow ray is
+//! cast ([`Work::shadow_rays`] counts them); a BRDF kernel or cosine of 0
+//! casts no ray either.
+//!
+//! ```
+//! use lightquad::family::{Family, Method};
+//! use lightquad::rendering::experiment::{Mis, Rendering, RenderingQuantity, SceneSpec};
+//! use rand::SeedableRng;
+//!
+//! // A disk light of radius 1 at height 2 facing the receiver from its axis.
+//! let spec: SceneSpec = serde_json::from_value(serde_json::json!({
+//!     "receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+//!     "emitters": [{"type": "disk", "centre": [0.0, 0.0, 2.0], "normal": [0.0, 0.0, -1.0],
+//!                   "radius": 1.0, "radiance": 1.5}]
+//! }))?;
+//! let built = Rendering::build(&spec)?;
+//! // E = pi L R^2 / (h^2 + R^2) (Howell's element to a coaxial disk).
+//! let want = std::f64::consts::PI * 1.5 / 5.0;
+//! let exact = Rendering::closed_form(&built, RenderingQuantity::EArea).ok_or("none")?[0];
+//! assert!((exact - want).abs() < 1e-15);
+//! // The area and cone forms by Gauss-Legendre, as an experiment's job runs them.
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+//! let gl: Method<Mis> = serde_json::from_str(r#"{"rule": "gauss-legendre"}"#)?;
+//! let q = [RenderingQuantity::EArea, RenderingQuantity::ECone];
+//! let out = Rendering::evaluate(&built, &gl, 1024, &mut rng, &q)?;
+//! for q in q {
+//!     assert!((out[&q].value[0] / want - 1.0).abs() < 1e-12, "{q:?}");
+//! }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::cell::Cell;
+use std::f64::consts::PI;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::brdf::{Brdf, Ggx, Lambert, NormalizedPhong, Phong, Sample};
+use super::emitter::{AnyEmitter, Emitter, LightSampling};
+use super::forms::{self, Irradiance, Kernel, Reach, Reflected};
+use super::mis::{Heuristic, mis};
+use super::receiver::Receiver;
+use super::scene::Scene;
+use crate::domain::{HemisphereMap, Vec3, integrate_over};
+use crate::error::{QuadError, SpecError};
+use crate::estimate::Estimate;
+use crate::family::{self, Family, Measured, Method, Outcome};
+use crate::quadrature::Rule;
+
+mod reference;
+mod spec;
+
+pub use reference::lit_triangles;
+use reference::{closed_form, converged_value, exact_cone};
+pub(crate) use spec::renamed;
+pub use spec::{
+    BrdfSpec, CapLightSpec, DiskLightSpec, DiskSpec, EmitterSpec, EnvironmentSpec, GgxSpec,
+    LambertSpec, MAX_COORDINATE, OccluderSpec, PhongSpec, ReceiverSpec, RectangleLightSpec,
+    RectangleSpec, SceneSpec, SphereLightSpec, SphereSpec, TriangleLightSpec, TriangleSpec,
+};
+use spec::{build, needs_visibility};
+
+/// The rendering family.
+#[derive(Debug, Clone, Copy)]
+pub struct Rendering;
+
+/// Any BRDF of the family, dispatched to its type.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyBrdf {
+    /// [`Lambert`].
+    Lambert(Lambert),
+    /// [`Phong`].
+    Phong(Phong),
+    /// [`NormalizedPhong`].
+    NormalizedPhong(NormalizedPhong),
+    /// [`Ggx`].
+    Ggx(Ggx),
+}
+
+/// Forwards a method to the variant's type.
+macro_rules! forward_brdf {
+    ($self:ident, $b:ident => $call:expr) => {
+        match $self {
+            AnyBrdf::Lambert($b) => $call,
+            AnyBrdf::Phong($b) => $call,
+            AnyBrdf::NormalizedPhong($b) => $call,
+            AnyBrdf::Ggx($b) => $call,
+        }
+    };
+}
+
+impl Brdf for AnyBrdf {
+    fn eval(&self, wi: Vec3, wo: Vec3) -> f64 {
+        forward_brdf!(self, b => b.eval(wi, wo))
+    }
+    fn sample(&self, wo: Vec3, u: [f64; 2]) -> Option<Sample> {
+        forward_brdf!(self, b => b.sample(wo, u))
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f64 {
+        forward_brdf!(self, b => b.pdf(wo, wi))
+    }
+    fn invert(&self, wo: Vec3, wi: Vec3) -> Option<[f64; 2]> {
+        forward_brdf!(self, b => b.invert(wo, wi))
+    }
+    fn clamp(&self, wo: Vec3) -> Option<Vec3> {
+        forward_brdf!(self, b => b.clamp(wo))
+    }
+}
+
+impl Reach for AnyBrdf {
+    fn reach(&self, wo: Vec3) -> f64 {
+        forward_brdf!(self, b => b.reach(wo))
+    }
+}
+
+/// A quantity of the rendering family: a value (irradiance `E`, reflected
+/// radiance `L`) by a form (module documentation).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema,
+)]
+pub enum RenderingQuantity {
+    /// `E` by R-H over the hemisphere, uniform in solid angle.
+    #[serde(rename = "E_hemisphere")]
+    EHemisphere,
+    /// `E` by R-H over the hemisphere, cosine-weighted (projected solid angle).
+    #[serde(rename = "E_cosine")]
+    ECosine,
+    /// `E` by R-H over each emitter's cone of directions.
+    #[serde(rename = "E_cone")]
+    ECone,
+    /// `E` by R-A over each emitter's surface.
+    #[serde(rename = "E_area")]
+    EArea,
+    /// `L_r` by R-H over the hemisphere, uniform in solid angle.
+    #[serde(rename = "L_hemisphere")]
+    LHemisphere,
+    /// `L_r` by R-H over the hemisphere, cosine-weighted.
+    #[serde(rename = "L_cosine")]
+    LCosine,
+    /// `L_r` by R-H over the BRDF-sampled map.
+    #[serde(rename = "L_brdf")]
+    LBrdf,
+    /// `L_r` by R-H over each emitter's cone of directions.
+    #[serde(rename = "L_cone")]
+    LCone,
+    /// `L_r` by R-A over each emitter's surface.
+    #[serde(rename = "L_area")]
+    LArea,
+}
+
+/// The domain a quantity is integrated over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Form {
+    /// The hemisphere, uniform map.
+    Hemisphere,
+    /// The hemisphere, projected (cosine-weighted) map.
+    Cosine,
+    /// The BRDF-sampled map.
+    Brdf,
+    /// Each emitter's cone of directions.
+    Cone,
+    /// Each emitter's surface.
+    Area,
+}
+
+impl RenderingQuantity {
+    /// True for reflected radiance (`L_`), false for irradiance (`E_`).
+    pub fn reflected(&self) -> bool {
+        use RenderingQuantity::*;
+        matches!(self, LHemisphere | LCosine | LBrdf | LCone | LArea)
+    }
+
+    /// The form.
+    pub fn form(&self) -> Form {
+        use RenderingQuantity::*;
+        match self {
+            EHemisphere | LHemisphere => Form::Hemisphere,
+            ECosine | LCosine => Form::Cosine,
+            LBrdf => Form::Brdf,
+            ECone | LCone => Form::Cone,
+            EArea | LArea => Form::Area,
+        }
+    }
+}
+
+impl family::Quantity for RenderingQuantity {
+    fn name(&self) -> &'static str {
+        use RenderingQuantity::*;
+        match self {
+            EHemisphere => "E_hemisphere",
+            ECosine => "E_cosine",
+            ECone => "E_cone",
+            EArea => "E_area",
+            LHemisphere => "L_hemisphere",
+            LCosine => "L_cosine",
+            LBrdf => "L_brdf",
+            LCone => "L_cone",
+            LArea => "L_area",
+        }
+    }
+
+    fn all() -> &'static [Self] {
+        use RenderingQuantity::*;
+        &[
+            EHemisphere,
+            ECosine,
+            ECone,
+            EArea,
+            LHemisphere,
+            LCosine,
+            LBrdf,
+            LCone,
+            LArea,
+        ]
+    }
+
+    /// Irradiance and radiance are never negative: emitters' radiances and
+    /// the BRDFs are `>= 0` (checked where the scene is read), so a literal
+    /// reference below 0 is a mistake, refused at its path.
+    fn bounds(&self) -> (f64, f64) {
+        (0.0, f64::INFINITY)
+    }
+}
+
+/// Multiple importance sampling of light and BRDF samples, the family's
+/// estimators beside the rules (module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "rule", rename_all = "kebab-case")]
+pub enum Mis {
+    /// Veach's balance heuristic.
+    MisBalance,
+    /// Veach's power heuristic (`beta = 2`).
+    MisPower,
+}
+
+impl Mis {
+    fn heuristic(&self) -> Heuristic {
+        match self {
+            Mis::MisBalance => Heuristic::Balance,
+            Mis::MisPower => Heuristic::Power,
+        }
+    }
+}
+
+impl family::Estimator for Mis {
+    fn name(&self) -> &'static str {
+        match self {
+            Mis::MisBalance => "mis-balance",
+            Mis::MisPower => "mis-power",
+        }
+    }
+    fn about(&self) -> &'static str {
+        match self {
+            Mis::MisBalance => {
+                "multiple importance sampling, balance heuristic: a light sample (by area for \
+                 E_area, L_area; in its cone for E_cone, L_cone) and a BRDF sample per unit of \
+                 budget; standard error"
+            }
+            Mis::MisPower => {
+                "multiple importance sampling, power heuristic (beta = 2): a light sample (by \
+                 area for E_area, L_area; in its cone for E_cone, L_cone) and a BRDF sample per \
+                 unit of budget; standard error"
+            }
+        }
+    }
+    /// Two samples: a standard error needs them.
+    fn min_budget(&self) -> usize {
+        2
+    }
+    fn is_random(&self) -> bool {
+        true
+    }
+    fn all() -> Vec<Self> {
+        vec![Mis::MisBalance, Mis::MisPower]
+    }
+}
+
+/// The built scene.
+#[derive(Debug, Clone)]
+pub struct Built {
+    /// Emitters and occluders.
+    pub scene: Scene<f64>,
+    /// The receiving point and its frame.
+    pub receiver: Receiver,
+    /// The BRDF, if the scene has one.
+    pub brdf: Option<AnyBrdf>,
+    /// `wo`, unit, above the horizon (with the BRDF).
+    pub toward_viewer: Option<Vec3>,
+}
+
+/// The work of one evaluation beyond the integrand evaluations of the
+/// [`Measured`] it gives: the terms a scene does not need are left out, and
+/// this says so in numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Work {
+    /// R-A's shadow rays (visibility tests `V(x, y)`): 0 where nothing can
+    /// block the emitters. Counted for the area forms, whose visibility is a
+    /// term of its own; in the R-H forms visibility is the ray cast that
+    /// finds `L_i`, and MIS tests it inside [`crate::rendering::mis`].
+    pub shadow_rays: u64,
+}
+
+/// `L_` quantities need a BRDF.
+const NEEDS_BRDF: &str = "reflected radiance needs the receiver's BRDF and the direction toward \
+                          the viewer: give scene.receiver.brdf and scene.receiver.toward_viewer, \
+                          or ask for the E_ quantities";
+
+impl Family for Rendering {
+    const NAME: &'static str = "rendering";
+    const ABOUT: &'static str = "irradiance and reflected radiance at a point from area lights, \
+                                 spheres, caps and an environment, with occluders, by the \
+                                 hemispherical (R-H) and area (R-A) forms and MIS";
+    const EQUATIONS: &'static [&'static str] = &["R-3P", "R-H", "R-A", "R-S"];
+    const BUDGET_UNIT: &'static str = "integrand evaluations (per emitter for the cone and area \
+                                       forms; samples per strategy for MIS)";
+
+    type SceneSpec = SceneSpec;
+    type Scene = Built;
+    type Quantity = RenderingQuantity;
+    type Estimator = Mis;
+
+    fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
+        build(spec)
+    }
+
+    /// Every form is an integral over a 2-D domain.
+    fn dimension(_: &Built, _: RenderingQuantity) -> usize {
+        2
+    }
+
+    /// Radiance is a scalar here.
+    fn channels(_: &Built, _: RenderingQuantity) -> usize {
+        1
+    }
+
+    fn lacks(built: &Built, q: RenderingQuantity) -> Option<String> {
+        (q.reflected() && built.brdf.is_none()).then(|| NEEDS_BRDF.to_string())
+    }
+
+    /// The light-sampled forms: MIS's light strategy is the quantity's form.
+    fn estimates(_: &Mis) -> &'static [RenderingQuantity] {
+        use RenderingQuantity::*;
+        &[EArea, ECone, LArea, LCone]
+    }
+
+    /// The per-emitter forms cost the budget per emitter; MIS two samples
+    /// per unit of budget.
+    fn cost(built: &Built, method: &Method<Mis>, budget: usize, q: RenderingQuantity) -> f64 {
+        let n = budget as f64;
+        let emitters = built.scene.emitters().len() as f64;
+        // Each sample's shadow ray tests every occluder (100 000 triangles
+        // made a sample about 1 ms).
+        let visibility = 1.0 + built.scene.occluders().len() as f64;
+        visibility
+            * match (method, q.form()) {
+                (Method::Estimator(_), _) => 2.0 * n,
+                (_, Form::Cone | Form::Area) => n * emitters,
+                _ => n,
+            }
+    }
+
+    fn evaluate(
+        built: &Built,
+        method: &Method<Mis>,
+        budget: usize,
+        rng: &mut rand_pcg::Pcg64,
+        quantities: &[RenderingQuantity],
+    ) -> Result<Outcome<RenderingQuantity>, QuadError> {
+        quantities
+            .iter()
+            .map(|&q| Ok((q, evaluate_counted(built, method, budget, rng, q)?.0)))
+            .collect()
+    }
+
+    fn closed_form(built: &Built, q: RenderingQuantity) -> Option<Vec<f64>> {
+        closed_form(built, q).map(|v| vec![v])
+    }
+
+    fn closed_forms_available() -> &'static str {
+        "closed forms without occluders and with one emitter (or only lights at infinity): \
+         rectangle and triangle lights (Lambert's contour formula), a disk light seen from its \
+         axis with a parallel receiver, sphere and cap lights (Snyder's cap, below the horizon \
+         included), the environment; L for a Lambertian BRDF, and for a Phong lobe under the \
+         environment alone at normal incidence or of exponent 1"
+    }
+
+    /// Adaptive Genz–Malik (relative tolerance 1e-14) with up to
+    /// [`CONVERGED_PER_N`]` n` evaluations per emitter, on the smoothest
+    /// form each emitter has (module documentation); every `E_` quantity
+    /// gets the one irradiance value, every `L_` quantity the one reflected
+    /// radiance.
+    fn converged(
+        built: &Built,
+        n: usize,
+        quantities: &[RenderingQuantity],
+    ) -> Result<Outcome<RenderingQuantity>, QuadError> {
+        let budget = CONVERGED_PER_N.saturating_mul(n);
+        let mut irradiance = None;
+        let mut reflected = None;
+        let mut out = Outcome::new();
+        for &q in quantities {
+            let slot = if q.reflected() {
+                &mut reflected
+            } else {
+                &mut irradiance
+            };
+            let m = match slot {
+                Some(m) => m,
+                None => slot.insert(converged_value(built, q.reflected(), budget)?),
+            };
+            out.insert(q, Measured::from(*m));
+        }
+        Ok(out)
+    }
+
+    fn settings(spec: &SceneSpec) -> String {
+        settings(spec)
+    }
+
+    fn scene_audit(built: &Built) -> Option<String> {
+        Some(terms_section(built))
+    }
+
+    /// R-S as printed, without the area element ([`super::audit`]).
+    fn audit() -> Option<String> {
+        Some(super::audit::markdown())
+    }
+}
+
+/// Evaluations per emitter of the converged reference for each `n` of
+/// `{"type": "converged", "n": n}`: 400 (the default) gives 40000, about
+/// 2350 Genz–Malik boxes.
+pub const CONVERGED_PER_N: usize = 100;
+
+/// One quantity by `method` at `budget`, with the work it took beside the
+/// integrand evaluations ([`Work`]).
+pub fn evaluate_counted(
+    built: &Built,
+    method: &Method<Mis>,
+    budget: usize,
+    rng: &mut rand_pcg::Pcg64,
+    q: RenderingQuantity,
+) -> Result<(Measured, Work), QuadError> {
+    let shadow_rays = Cell::new(0);
+    let estimate = match method {
+        Method::Rule(rule) => by_rule(built, rule, q, budget, rng, &shadow_rays)?,
+        Method::Estimator(mis) => by_mis(built, *mis, q, budget, rng)?,
+    };
+    Ok((
+        Measured::from(estimate),
+        Work {
+            shadow_rays: shadow_rays.get(),
+        },
+    ))
+}
+
+/// The reflected-radiance kernel of the scene's BRDF for its viewer, or
+/// the error naming what is missing.
+fn reflected_kernel(built: &Built) -> Result<Reflected<'_, AnyBrdf>, QuadError> {
+    let (Some(brdf), Some(wo)) = (built.brdf.as_ref(), built.toward_viewer) else {
+        return Err(QuadError::invalid("brdf", "none", NEEDS_BRDF));
+    };
+    Reflected::new(brdf, &built.receiver, wo)
+}
+
+/// `q` by a quadrature rule.
+fn by_rule<R: Rule>(
+    built: &Built,
+    rule: &R,
+    q: RenderingQuantity,
+    n: usize,
+    rng: &mut rand_pcg::Pcg64,
+    shadow_rays: &Cell<u64>,
+) -> Result<Estimate<f64>, QuadError> {
+    if !q.reflected() {
+        return by_form(built, &Irradiance, q.form(), rule, n, rng, shadow_rays);
+    }
+    let kernel = reflected_kernel(built)?;
+    if q.form() == Form::Brdf {
+        return forms::brdf_sampled(rule, &built.scene, &built.receiver, &kernel, n, rng);
+    }
+    by_form(built, &kernel, q.form(), rule, n, rng, shadow_rays)
+}
+
+/// The form `form` of the integral of kernel `K` ([`forms`]).
+fn by_form<K: Kernel, R: Rule>(
+    built: &Built,
+    kernel: &K,
+    form: Form,
+    rule: &R,
+    n: usize,
+    rng: &mut rand_pcg::Pcg64,
+    shadow_rays: &Cell<u64>,
+) -> Result<Estimate<f64>, QuadError> {
+    let (scene, receiver) = (&built.scene, &built.receiver);
+    match form {
+        Form::Hemisphere => forms::hemispherical(
+            rule,
+            scene,
+            receiver,
+            kernel,
+            HemisphereMap::Uniform,
+            n,
+            rng,
+        ),
+        Form::Cosine => forms::hemispherical(
+            rule,
+            scene,
+            receiver,
+            kernel,
+            HemisphereMap::Projected,
+            n,
+            rng,
+        ),
+        Form::Cone => forms::cone(rule, scene, receiver, kernel, n, rng),
+        Form::Area => area_counted(built, kernel, rule, n, rng, shadow_rays),
+        Form::Brdf => Err(QuadError::invalid(
+            "quantity",
+            "a BRDF-sampled irradiance",
+            "L_brdf (irradiance has no BRDF to sample)",
+        )),
+    }
+}
+
+/// R-A as [`forms::area`] evaluates it, each shadow ray counted (by
+/// wrapping [`forms::area_visibility`]).
+fn area_counted<K: Kernel, R: Rule>(
+    built: &Built,
+    kernel: &K,
+    rule: &R,
+    n: usize,
+    rng: &mut rand_pcg::Pcg64,
+    shadow_rays: &Cell<u64>,
+) -> Result<Estimate<f64>, QuadError> {
+    let (scene, receiver) = (&built.scene, &built.receiver);
+    let mut total = Estimate::zero();
+    for (k, e) in scene.emitters().iter().enumerate() {
+        let domain = e.surface(receiver)?;
+        let skip = if e.at_infinity() { None } else { Some(k) };
+        let tested = scene.has_blockers(skip);
+        let base = forms::area_visibility(scene, receiver.point(), k);
+        let visible = |y: Vec3| {
+            if tested {
+                shadow_rays.set(shadow_rays.get() + 1);
+            }
+            base(y)
+        };
+        let g = forms::area_integrand_with(scene, receiver, kernel, k, visible)?;
+        total = total.combine(integrate_over(rule, &domain, n, rng, g)?);
+    }
+    Ok(total)
+}
+
+/// `q` by MIS: light samples by the quantity's form, BRDF samples of the
+/// scene's BRDF (of a white Lambertian one, times `pi`, for irradiance).
+fn by_mis(
+    built: &Built,
+    mis_kind: Mis,
+    q: RenderingQuantity,
+    n: usize,
+    rng: &mut rand_pcg::Pcg64,
+) -> Result<Estimate<f64>, QuadError> {
+    let sampling = match q.form() {
+        Form::Area => LightSampling::Area,
+        Form::Cone => LightSampling::Cone,
+        _ => {
+            return Err(QuadError::invalid(
+                "quantity",
+                family::Quantity::name(&q),
+                "one of E_area, E_cone, L_area, L_cone for MIS (its light strategy is the form)",
+            ));
+        }
+    };
+    let (scene, receiver) = (&built.scene, &built.receiver);
+    let heuristic = mis_kind.heuristic();
+    if q.reflected() {
+        let kernel = reflected_kernel(built)?;
+        return mis(scene, receiver, &kernel, sampling, heuristic, n, rng);
+    }
+    let white = Lambert::new(1.0)?;
+    let kernel = Reflected::new(&white, receiver, receiver.normal())?;
+    Ok(mis(scene, receiver, &kernel, sampling, heuristic, n, rng)?.scaled(PI))
+}
+
+fn settings(spec: &SceneSpec) -> String {
+    let (e, o) = (spec.emitters.len(), spec.occluders.len());
+    let visibility = if needs_visibility(spec) {
+        format!(
+            "visibility V (R-A's shadow rays, the V of R-3P's g) evaluated: one shadow ray per \
+             area-form evaluation whose other factors are non-zero, tested against {o} \
+             occluder(s) and the other finite emitters"
+        )
+    } else {
+        "visibility V (R-A's shadow rays, the V of R-3P's g) not evaluated: no occluder, and no \
+         emitter can shadow another, so V = 1 and no shadow ray is cast"
+            .to_string()
+    };
+    format!(
+        "{e} emitter(s), {o} occluder(s); {visibility}; the R-H forms find L_i by one ray per \
+         evaluation against the emitters and occluders (none where the kernel times cos theta \
+         is 0); the cone and area forms spend the budget on each emitter; MIS draws one light \
+         and one BRDF sample per unit of budget"
+    )
+}
+
+/// The report's section on this scene: the forms and the terms each
+/// evaluates.
+fn terms_section(built: &Built) -> String {
+    use std::fmt::Write as _;
+    let scene = &built.scene;
+    let mut s = String::from("## Forms and terms of this scene\n\n");
+    let names: Vec<&str> = scene
+        .emitters()
+        .iter()
+        .map(|e| match e {
+            AnyEmitter::Rectangle(_) => "rectangle",
+            AnyEmitter::Disk(_) => "disk",
+            AnyEmitter::Triangle(_) => "triangle",
+            AnyEmitter::Sphere(_) => "sphere",
+            AnyEmitter::Environment(_) => "environment",
+            AnyEmitter::Cap(_) => "cap",
+        })
+        .collect();
+    let cones: Vec<&str> = scene
+        .emitters()
+        .iter()
+        .map(|e| {
+            if exact_cone(e, &built.receiver) {
+                "exact"
+            } else {
+                "bounding"
+            }
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "Emitters: {} (cones from the receiver: {}); occluders: {}.\n",
+        names.join(", "),
+        cones.join(", "),
+        scene.occluders().len()
+    );
+    let shadow: Vec<String> = scene
+        .emitters()
+        .iter()
+        .enumerate()
+        .map(|(k, e)| {
+            let skip = if e.at_infinity() { None } else { Some(k) };
+            if scene.has_blockers(skip) {
+                format!("emitter {k}: tested")
+            } else {
+                format!("emitter {k}: not evaluated (nothing can block it; 0 shadow rays)")
+            }
+        })
+        .collect();
+    s.push_str("| quantity | form | domain | integrand | terms evaluated per node |\n");
+    s.push_str("|---|---|---|---|---|\n");
+    let brdf = built.brdf.is_some();
+    let kernel = |q: RenderingQuantity| if q.reflected() { "f_r " } else { "" };
+    for &q in <RenderingQuantity as family::Quantity>::all() {
+        if q.reflected() && !brdf {
+            continue;
+        }
+        let k = kernel(q);
+        let (form, domain, integrand, terms) = match q.form() {
+            Form::Hemisphere => (
+                "R-H",
+                "hemisphere, uniform map",
+                format!("2 pi {k}L_i cos theta"),
+                "L_i: one ray against every surface",
+            ),
+            Form::Cosine => (
+                "R-H",
+                "hemisphere, projected (Malley) map",
+                format!("pi {k}L_i"),
+                "L_i: one ray against every surface",
+            ),
+            Form::Brdf => (
+                "R-H",
+                "BRDF-sampled map",
+                "f_r L_i cos theta / pdf".to_string(),
+                "L_i: one ray against every surface",
+            ),
+            Form::Cone => (
+                "R-H per emitter",
+                "the emitter's cone of directions",
+                format!("{k}L_i^k cos theta J"),
+                "L_i^k: one ray against every surface",
+            ),
+            Form::Area => (
+                "R-A (R-S, g of R-3P) per emitter",
+                "the emitter's surface, its map's Jacobian",
+                format!("L_e {k}cos theta cos theta' / r^2 V J"),
+                "V: a shadow ray where tested (below)",
+            ),
+        };
+        let name = family::Quantity::name(&q);
+        let _ = writeln!(s, "| {name} | {form} | {domain} | {integrand} | {terms} |");
+    }
+    let _ = writeln!(
+        s,
+        "\nJ is the Jacobian of the domain's map. Visibility of the area forms: {}.",
+        shadow.join("; ")
+    );
+    s
+}
