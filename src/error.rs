@@ -86,17 +86,18 @@ pub enum QuadError {
     /// The weighted sum of finite integrand values left the f64 range: a
     /// raw sum ([`crate::quadrature::nodes::product_sum`],
     /// [`crate::quadrature::nodes::line_sum_par`]) of values within rounding
-    /// of `f64::MAX`, whose running sums can pass it where the integral does
-    /// not. [`crate::quadrature::Rule::try_integrate`] takes such an
-    /// integrand again scaled, and never returns this.
+    /// of `f64::MAX`, whose running sum can pass it where the integral does
+    /// not (in two and more dimensions). Never a sum that is not finite.
+    /// [`crate::quadrature::Rule::try_integrate`] takes such an integrand
+    /// again scaled, and never returns this.
     #[error(
-        "the weighted sum of the integrand's values leaves the f64 range (its largest term is {largest}, the sum of their magnitudes {magnitude}); expected values below about 1e300: scale the integrand, or integrate through a rule's `try_integrate`, which scales it"
+        "the weighted sum of the integrand's finite values overflows f64: it came to {value} (its largest term |w f| is {largest}); expected values whose sums stay below f64::MAX: scale the integrand down, or integrate through a rule's `try_integrate`, which scales it"
     )]
     SumOutOfRange {
+        /// The sum as it came out (infinite or NaN in some channel), formatted.
+        value: String,
         /// The largest `|w f|`, formatted.
         largest: String,
-        /// `sum |w f|`, formatted.
-        magnitude: String,
     },
     /// The integrand returned a non-finite value.
     #[error("integrand returned {value} at unit-cube point {point:?}")]

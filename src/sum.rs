@@ -276,14 +276,28 @@ impl<V: Value> Lanes<V> {
     }
 
     /// The compensated total of every lane: the sums, lane 0 first, then
-    /// the carries.
+    /// the carries. A channel whose lanes are finite but whose total passes
+    /// `f64::MAX` on the way (each lane near a quarter of it: the sum of
+    /// values within rounding of `f64::MAX`) is totalled again from a
+    /// quarter of each lane, exact for normal numbers, and scaled back: a
+    /// total beyond the f64 range is infinite, one within it is found.
     pub fn total(&self) -> V {
+        let total = self.total_scaled(1.0);
+        if total.all_finite() {
+            return total;
+        }
+        let quarter = self.total_scaled(0.25);
+        total.zip(quarter, |t, q| if t.is_finite() { t } else { 4.0 * q })
+    }
+
+    /// [`Lanes::total`] of every lane times `scale`.
+    fn total_scaled(&self, scale: f64) -> V {
         let mut all = Compensated::new();
         for k in 0..LANES {
-            all.add(V::from_fn(|c| self.sum.channels[c].to_array()[k]));
+            all.add(V::from_fn(|c| scale * self.sum.channels[c].to_array()[k]));
         }
         for k in 0..LANES {
-            all.add(V::from_fn(|c| self.carry.channels[c].to_array()[k]));
+            all.add(V::from_fn(|c| scale * self.carry.channels[c].to_array()[k]));
         }
         all.total()
     }

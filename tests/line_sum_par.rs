@@ -216,44 +216,52 @@ fn a_nan_in_a_late_span_is_reported_at_the_first_node_where_it_occurs() {
     );
 }
 
-/// `int_0^1 f64::MAX du = f64::MAX`, representable, but the running sums of
-/// `w_i f64::MAX` pass it (the weights sum to 1 only to within rounding):
-/// 1e5 Gauss nodes summed to NaN and came back `Ok(NaN)`. Now a sum that
-/// leaves the range is an error naming it, at one and two threads and in
-/// two dimensions, and a rule's `try_integrate` still finds the integral
-/// (it takes the integrand again scaled).
+/// `int_0^1 f64::MAX du = f64::MAX`, representable, but the sum of `w_i
+/// f64::MAX` passes it on the way (the weights sum to 1 only to within
+/// rounding): 1e5 Gauss nodes summed to NaN and came back `Ok(NaN)`. Now
+/// the lanes' total finds it, serial and parallel, with the companions of a
+/// composite rule, and `sum |w f|` stays finite; where a sum does leave the
+/// range (the odometer's single running sum in two dimensions) it is an
+/// error naming it; and a rule's `try_integrate` finds the integral.
 #[test]
-fn values_near_f64_max_whose_sums_leave_the_range_are_an_error() {
+fn sums_of_values_near_f64_max_are_found_or_an_error_never_a_nan() {
     let near_max = |v: f64| (f64::MAX * (1.0 - 1e-12)..=f64::MAX).contains(&v);
-    // Where the sums stay in range, the integral itself.
-    let few = unit_nodes(1000).expect("nodes");
-    let sum = product_sum([few.as_ref()], |_: [f64; 1]| Ok(f64::MAX)).expect("in range");
-    assert!(near_max(sum.value), "{:e}", sum.value);
-    let out_of_range = |r: Result<ProductSum<f64>, QuadError>, what: &str| match r {
-        Err(e @ QuadError::SumOutOfRange { .. }) => {
-            assert!(
-                e.to_string().contains("leaves the f64 range"),
-                "{what}: {e}"
-            )
+    let found = |r: Result<ProductSum<f64>, QuadError>, what: &str| {
+        let s = r.unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert!(near_max(s.value), "{what}: {:e}", s.value);
+        assert!(near_max(s.magnitude), "{what}: {:e}", s.magnitude);
+        for c in [s.companion, s.companion4, s.companion8]
+            .into_iter()
+            .flatten()
+        {
+            assert!(near_max(c), "{what}: companion {c:e}");
         }
-        other => panic!("{what}: expected SumOutOfRange, got {other:?}"),
     };
-    let many = unit_nodes(100_000).expect("nodes");
-    out_of_range(
-        product_sum([many.as_ref()], |_: [f64; 1]| Ok(f64::MAX)),
-        "1e5 nodes",
-    );
-    let million = unit_nodes(1_000_000).expect("nodes");
-    for threads in [1, 2] {
-        out_of_range(
-            in_pool(threads, || line_sum_par(&million, |_| Ok(f64::MAX))),
-            &format!("1e6 nodes, {threads} threads"),
+    for n in [1000, 100_000, 1_000_000] {
+        let nodes = unit_nodes(n).expect("nodes");
+        found(
+            product_sum([nodes.as_ref()], |_: [f64; 1]| Ok(f64::MAX)),
+            &format!("{n} nodes"),
         );
+        for threads in [1, 2] {
+            found(
+                in_pool(threads, || line_sum_par(&nodes, |_| Ok(f64::MAX))),
+                &format!("{n} nodes, {threads} threads"),
+            );
+        }
     }
-    out_of_range(
-        product_sum([few.as_ref(), few.as_ref()], |_: [f64; 2]| Ok(f64::MAX)),
-        "1000 x 1000 nodes",
+    let composite = trapezoid::unit_nodes(8 * (1 << 15) + 1).expect("nodes");
+    found(
+        in_pool(2, || line_sum_par(&composite, |_| Ok(f64::MAX))),
+        "trapezoid",
     );
+    let few = unit_nodes(1000).expect("nodes");
+    match product_sum([few.as_ref(), few.as_ref()], |_: [f64; 2]| Ok(f64::MAX)) {
+        Err(e @ QuadError::SumOutOfRange { .. }) => {
+            assert!(e.to_string().contains("overflows f64"), "{e}")
+        }
+        other => panic!("1000 x 1000 nodes: expected SumOutOfRange, got {other:?}"),
+    }
     let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
     let e = GaussLegendre::default()
         .try_integrate(100_000, &mut rng, |_: [f64; 1]| Ok(f64::MAX))

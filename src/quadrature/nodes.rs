@@ -72,9 +72,10 @@ pub struct ProductSum<V: Value> {
 /// the integrand.
 /// A non-finite integrand value stops the sum with an error naming the point
 /// (on one axis, at the end of the block of 256 nodes it is in). Finite
-/// values whose sums leave the f64 range (values within rounding of
-/// `f64::MAX`) are [`QuadError::SumOutOfRange`], never a sum that is not
-/// finite.
+/// values within rounding of `f64::MAX`, whose sum passes it on the way,
+/// are summed on one axis (see [`crate::sum::Lanes::total`]); in two and
+/// more dimensions such a sum is [`QuadError::SumOutOfRange`], never a sum
+/// that is not finite.
 pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
     axes: [&UnitNodes; D],
     mut f: F,
@@ -181,24 +182,32 @@ fn line_sum<V: Value>(
     in_range(sum.finish(a))
 }
 
-/// `sum`, or [`QuadError::SumOutOfRange`] where a sum of its finite terms
-/// is not finite. Weights that sum to 1 keep the integral within the range
-/// of the values, but not the running sums: the sum of `f64::MAX` on 1e5
-/// Gauss nodes came out NaN, where the integral is `f64::MAX`.
+/// `sum` with `magnitude` at most `f64::MAX`, or
+/// [`QuadError::SumOutOfRange`] where a weighted sum of its finite terms is
+/// not finite. Weights that sum to 1 keep an integral within the range of
+/// the values, but not every running sum: the sum of `f64::MAX` on 1e5
+/// Gauss nodes came out NaN, where the integral is `f64::MAX`
+/// ([`crate::sum::Lanes::total`] now finds it; the odometer's single
+/// running sum of [`product_sum`] in two and more dimensions can still
+/// pass the range). `sum |w f|` passes `f64::MAX` only by rounding (it is
+/// at most `max |f|` times the weights' sum, 1), so it is kept at
+/// `f64::MAX`: a scale of rounding, not a value.
 fn in_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError> {
     let sums = [
         Some(sum.value),
         sum.companion,
         sum.companion4,
         sum.companion8,
-        Some(sum.magnitude),
     ];
     if sums.iter().flatten().all(Value::all_finite) {
-        Ok(sum)
+        Ok(ProductSum {
+            magnitude: sum.magnitude.map(|m| m.min(f64::MAX)),
+            ..sum
+        })
     } else {
         Err(QuadError::SumOutOfRange {
+            value: format!("{:?}", sum.value),
             largest: format!("{:?}", sum.largest),
-            magnitude: format!("{:?}", sum.magnitude),
         })
     }
 }
