@@ -59,17 +59,22 @@ fn quantile(v: &mut [f64], q: f64) -> f64 {
 }
 
 /// A 95% confidence interval of the median of `v` (sorted in place) that
-/// assumes nothing of the distribution: the order statistics of ranks
-/// `n/2 -+ 1.96 sqrt(n)/2`, between which the median of the population
-/// lies with probability 0.95 (normal approximation to the binomial
-/// count of samples below it; rounds taken as independent).
-fn median_interval(v: &mut [f64]) -> (f64, f64) {
+/// assumes nothing of the distribution: the order statistics of 1-based
+/// ranks `floor(n/2 - 1.96 sqrt(n)/2)` and `ceil(1 + n/2 + 1.96 sqrt(n)/2)`
+/// (Conover, *Practical Nonparametric Statistics*: the normal approximation
+/// to the binomial count of samples below the median; rounds taken as
+/// independent). None below 6 rounds, where even the least and the
+/// largest value bracket the median with probability under 0.95.
+fn median_interval(v: &mut [f64]) -> Option<(f64, f64)> {
+    if v.len() < 6 {
+        return None;
+    }
     v.sort_by(f64::total_cmp);
     let n = v.len() as f64;
     let half = 1.96 * n.sqrt() / 2.0;
-    let low = (n / 2.0 - half).floor().max(0.0) as usize;
-    let high = ((n / 2.0 + half).ceil() as usize).min(v.len() - 1);
-    (v[low], v[high])
+    let low = ((n / 2.0 - half).floor() as usize).max(1);
+    let high = ((1.0 + n / 2.0 + half).ceil() as usize).min(v.len());
+    Some((v[low - 1], v[high - 1]))
 }
 
 type Contender<'a> = (&'static str, Box<dyn Fn() -> f64 + 'a>);
@@ -225,9 +230,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             continue;
         };
         let mut ratio: Vec<f64> = times[i].iter().zip(&times[j]).map(|(x, y)| x / y).collect();
-        let (low, high) = median_interval(&mut ratio);
+        let interval = median_interval(&mut ratio)
+            .map_or("– (under 6 rounds)".into(), |(l, h)| {
+                format!("{l:.4} – {h:.4}")
+            });
         println!(
-            "| {num} / {den} | {:.4} | {low:.4} – {high:.4} | {:.3} – {:.3} |",
+            "| {num} / {den} | {:.4} | {interval} | {:.3} – {:.3} |",
             quantile(&mut ratio, 0.5),
             quantile(&mut ratio, 0.25),
             quantile(&mut ratio, 0.75)

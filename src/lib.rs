@@ -49,8 +49,8 @@
 
 // One `unsafe` call in the crate: the compensated sum's AVX pass, after
 // checking that the CPU has AVX (`sum::avx::add_channel`). `.ci/run`
-// fails on a second `allow(unsafe_code)`, and clippy on a block without
-// its SAFETY comment.
+// fails on a second `unsafe` or `unsafe_code` anywhere in src, and clippy
+// on a block without its SAFETY comment.
 #![deny(unsafe_code)]
 #![deny(clippy::undocumented_unsafe_blocks)]
 #![deny(clippy::unwrap_used, clippy::expect_used)]
