@@ -197,24 +197,16 @@ impl<V: Value> Lanes<V> {
 
     /// Adds `w_i y_i` for every `i` of `ys` and `ws` (of equal length): each
     /// group of [`LANES`] terms one per lane, the terms after the last whole
-    /// group into lane 0. Not inlined, so a caller's loop that also inlines
-    /// [`Lanes::add_products_scaled`] is not crowded by a second copy.
-    #[inline(never)]
+    /// group into lane 0. In AVX registers where the CPU has them
+    /// ([`with_kernel`]); a loop that calls this for many short groups is
+    /// better written as a [`KernelTask`], which chooses once.
     pub fn add_products(&mut self, ys: &[V], ws: &[f64]) {
-        let (mut unused_magnitude, mut unused_largest) = (f64x4::ZERO, f64x4::ZERO);
-        for c in 0..V::CHANNELS {
-            add_channel::<V, false>(
-                ys,
-                ws,
-                c,
-                [
-                    &mut self.sum.channels[c],
-                    &mut self.carry.channels[c],
-                    &mut unused_magnitude,
-                    &mut unused_largest,
-                ],
-            );
-        }
+        with_kernel(Products {
+            lanes: self,
+            ys,
+            ws,
+            scale: None,
+        })
     }
 
     /// [`Lanes::add_products`] and, in the same pass, the scale of the
@@ -224,7 +216,6 @@ impl<V: Value> Lanes<V> {
     /// a caller sees that a value was not finite. `largest` skips a NaN term
     /// on x86-64 (`maxpd` keeps the lane's largest); on other targets `wide`'s
     /// `fast_max` may keep the NaN instead.
-    #[inline(always)]
     pub fn add_products_scaled(
         &mut self,
         ys: &[V],
@@ -232,8 +223,46 @@ impl<V: Value> Lanes<V> {
         magnitude: &mut LaneValues<V>,
         largest: &mut LaneValues<V>,
     ) {
+        with_kernel(Products {
+            lanes: self,
+            ys,
+            ws,
+            scale: Some((magnitude, largest)),
+        })
+    }
+
+    /// [`Lanes::add_products`] with the pass `kernel`.
+    #[inline(always)]
+    pub(crate) fn add_products_in(&mut self, kernel: impl Kernel<V>, ys: &[V], ws: &[f64]) {
+        let (mut unused_magnitude, mut unused_largest) = (f64x4::ZERO, f64x4::ZERO);
         for c in 0..V::CHANNELS {
-            add_channel::<V, true>(
+            kernel.add_channel(
+                ys,
+                ws,
+                c,
+                [
+                    &mut self.sum.channels[c],
+                    &mut self.carry.channels[c],
+                    &mut unused_magnitude,
+                    &mut unused_largest,
+                ],
+                false,
+            );
+        }
+    }
+
+    /// [`Lanes::add_products_scaled`] with the pass `kernel`.
+    #[inline(always)]
+    pub(crate) fn add_products_scaled_in(
+        &mut self,
+        kernel: impl Kernel<V>,
+        ys: &[V],
+        ws: &[f64],
+        magnitude: &mut LaneValues<V>,
+        largest: &mut LaneValues<V>,
+    ) {
+        for c in 0..V::CHANNELS {
+            kernel.add_channel(
                 ys,
                 ws,
                 c,
@@ -243,6 +272,7 @@ impl<V: Value> Lanes<V> {
                     &mut magnitude.channels[c],
                     &mut largest.channels[c],
                 ],
+                true,
             );
         }
     }
@@ -303,6 +333,92 @@ impl<V: Value> Lanes<V> {
     }
 }
 
+/// The pass that adds one channel of a group of products `w_i y_i` to
+/// that channel's lanes `[sum, carry, magnitude, largest]`, as
+/// [`add_channel_portable`] adds them (with `scaled`, `|w_i y_i|` into
+/// `magnitude` and the largest into `largest`). Two passes give the same
+/// bits: the portable one and, on x86-64 with AVX, one in AVX registers.
+pub(crate) trait Kernel<V: Value>: Copy {
+    fn add_channel(self, ys: &[V], ws: &[f64], c: usize, lanes: [&mut f64x4; 4], scaled: bool);
+}
+
+/// A [`Kernel`] that is a closure: the AVX pass is a closure defined in a
+/// function compiled for AVX, whose target features it takes on.
+#[derive(Clone, Copy)]
+struct PassFn<F>(F);
+
+impl<V: Value, F: Fn(&[V], &[f64], usize, [&mut f64x4; 4], bool) + Copy> Kernel<V> for PassFn<F> {
+    #[inline(always)]
+    fn add_channel(self, ys: &[V], ws: &[f64], c: usize, lanes: [&mut f64x4; 4], scaled: bool) {
+        (self.0)(ys, ws, c, lanes, scaled)
+    }
+}
+
+/// The closure as a [`Kernel`], its signature taken from the bound.
+#[inline(always)]
+fn pass_fn<V: Value, F: Fn(&[V], &[f64], usize, [&mut f64x4; 4], bool) + Copy>(f: F) -> PassFn<F> {
+    PassFn(f)
+}
+
+/// Work that sums with the lanes, run by [`with_kernel`] with the best
+/// [`Kernel`] the CPU allows. `run` is compiled once for each kernel, and
+/// with the AVX kernel inside a function compiled for AVX: the whole loop
+/// (the integrand with it) is AVX code and the pass is inlined into it,
+/// rather than called, once a short group, across the boundary between
+/// code for the baseline and code for AVX (which the compiler cannot
+/// inline).
+pub(crate) trait KernelTask<V: Value> {
+    type Output;
+    fn run(self, kernel: impl Kernel<V>) -> Self::Output;
+}
+
+/// Runs `task` with the AVX pass where the CPU has AVX (checked at every
+/// call: a cached flag), the portable pass elsewhere.
+#[inline(always)]
+pub(crate) fn with_kernel<V: Value, T: KernelTask<V>>(task: T) -> T::Output {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: `avx::run` is compiled for AVX, and the CPU has AVX:
+        // checked just above.
+        #[allow(unsafe_code)]
+        return unsafe { avx::run(task) };
+    }
+    task.run(portable_kernel())
+}
+
+/// The portable pass as a [`Kernel`].
+#[inline(always)]
+fn portable_kernel<V: Value>() -> impl Kernel<V> {
+    pass_fn(|ys: &[V], ws: &[f64], c, lanes, scaled| {
+        if scaled {
+            add_channel_portable::<V, true>(ys, ws, c, lanes)
+        } else {
+            add_channel_portable::<V, false>(ys, ws, c, lanes)
+        }
+    })
+}
+
+/// [`Lanes::add_products`] or, with a scale, [`Lanes::add_products_scaled`]
+/// as a [`KernelTask`].
+struct Products<'a, V: Value> {
+    lanes: &'a mut Lanes<V>,
+    ys: &'a [V],
+    ws: &'a [f64],
+    scale: Option<(&'a mut LaneValues<V>, &'a mut LaneValues<V>)>,
+}
+
+impl<V: Value> KernelTask<V> for Products<'_, V> {
+    type Output = ();
+    fn run(self, kernel: impl Kernel<V>) {
+        match self.scale {
+            Some((magnitude, largest)) => self
+                .lanes
+                .add_products_scaled_in(kernel, self.ys, self.ws, magnitude, largest),
+            None => self.lanes.add_products_in(kernel, self.ys, self.ws),
+        }
+    }
+}
+
 /// Adds channel `c` of the products `w_i y_i`, four at a time, to the lanes
 /// `[sum, carry, magnitude, largest]` of that channel: term `4 j + k` into
 /// lane `k`, each term after the last whole group into lane 0 (the other
@@ -346,18 +462,11 @@ fn add_channel_portable<V: Value, const SCALED: bool>(
     (*sum, *carry, *magnitude, *largest) = (s, e, m, l);
 }
 
-#[cfg(not(target_arch = "x86_64"))]
-use add_channel_portable as add_channel;
-/// The one-channel pass of [`Lanes`]: [`avx::add_channel`] where the CPU
-/// has AVX, the portable [`add_channel_portable`] elsewhere.
-#[cfg(target_arch = "x86_64")]
-use avx::add_channel;
-
-/// The lanes' pass in AVX registers, chosen at run time. `wide`'s `f64x4`
-/// is fixed when the crate is built, to x86-64's baseline SSE2, which takes
-/// the four lanes two at a time; AVX takes them at once. The sum pass is
-/// what lightquad took over a plain loop (Gauss–Legendre on `cos(50 x)` at
-/// n = 1e6, `examples/gl_race.rs`): 1.03 to 1.04 times it in SSE2.
+/// The lanes' pass in AVX registers. `wide`'s `f64x4` is fixed when the
+/// crate is built, to x86-64's baseline SSE2, which takes the four lanes
+/// two at a time; AVX takes them at once. The sum pass is what lightquad
+/// took over a plain loop (Gauss–Legendre on `cos(50 x)` at n = 1e6,
+/// `examples/gl_race.rs`): 1.03 to 1.04 times it in SSE2.
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use std::arch::x86_64::{
@@ -368,34 +477,28 @@ mod avx {
 
     use wide::f64x4;
 
-    use super::{LANES, add_channel_portable};
+    use super::{KernelTask, LANES, pass_fn};
     use crate::value::Value;
 
-    /// [`add_channel_portable`], in AVX registers where the CPU has them
-    /// (a cached flag, checked once a call), else as it is. The same
-    /// operations on each lane in the same order, so the same bits (but
-    /// for a NaN's payload where two NaNs meet in one product, a NaN value
-    /// times a NaN weight: which comes out is the compiler's choice).
-    #[inline(always)]
-    pub(super) fn add_channel<V: Value, const SCALED: bool>(
-        ys: &[V],
-        ws: &[f64],
-        c: usize,
-        lanes: [&mut f64x4; 4],
-    ) {
-        if std::arch::is_x86_feature_detected!("avx") {
-            // SAFETY: `in_avx` uses AVX instructions, and the CPU has
-            // them: checked just above.
-            #[allow(unsafe_code)]
-            unsafe {
-                in_avx::<V, SCALED>(ys, ws, c, lanes)
+    /// `task` with the AVX pass, compiled for AVX. The pass is a closure
+    /// defined here, so it is AVX code too and [`in_avx`] inlines into it:
+    /// the same operations on each lane in the same order as
+    /// [`super::add_channel_portable`], so the same bits (but for a NaN's
+    /// payload where two NaNs meet in one product, a NaN value times a NaN
+    /// weight: which comes out is the compiler's choice).
+    #[target_feature(enable = "avx")]
+    pub(super) fn run<V: Value, T: KernelTask<V>>(task: T) -> T::Output {
+        task.run(pass_fn(|ys: &[V], ws: &[f64], c, lanes, scaled| {
+            if scaled {
+                in_avx::<V, true>(ys, ws, c, lanes)
+            } else {
+                in_avx::<V, false>(ys, ws, c, lanes)
             }
-        } else {
-            add_channel_portable::<V, SCALED>(ys, ws, c, lanes)
-        }
+        }))
     }
 
     #[target_feature(enable = "avx")]
+    #[inline]
     fn in_avx<V: Value, const SCALED: bool>(
         ys: &[V],
         ws: &[f64],
@@ -480,8 +583,24 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use wide::f64x4;
 
-    use super::{add_channel_portable, avx};
+    use super::{Kernel, KernelTask, add_channel_portable, with_kernel};
     use crate::value::{Rgb, Value};
+
+    /// One channel's pass with the kernel [`with_kernel`] chooses.
+    struct Channel<'a, V: Value> {
+        ys: &'a [V],
+        ws: &'a [f64],
+        c: usize,
+        lanes: [&'a mut f64x4; 4],
+        scaled: bool,
+    }
+
+    impl<V: Value> KernelTask<V> for Channel<'_, V> {
+        type Output = ();
+        fn run(self, kernel: impl Kernel<V>) {
+            kernel.add_channel(self.ys, self.ws, self.c, self.lanes, self.scaled)
+        }
+    }
 
     /// The four lanes of one channel after a pass.
     fn pass<V: Value, const SCALED: bool>(
@@ -494,7 +613,13 @@ mod tests {
         let mut lanes = [1e-3, -2e-17, 0.5, 1e-4].map(|x| f64x4::new([x, -x, 2.0 * x, 0.0]));
         let [s, e, m, l] = &mut lanes;
         if avx {
-            avx::add_channel::<V, SCALED>(ys, ws, c, [s, e, m, l]);
+            with_kernel(Channel {
+                ys,
+                ws,
+                c,
+                lanes: [s, e, m, l],
+                scaled: SCALED,
+            });
         } else {
             add_channel_portable::<V, SCALED>(ys, ws, c, [s, e, m, l]);
         }
@@ -505,8 +630,7 @@ mod tests {
     /// the carry, `sum |w y|` and the largest term, for scalars and each
     /// channel of a colour, on lengths with every remainder, with terms of
     /// both signs over many scales, -0, a subnormal, -MAX, infinities and
-    /// a NaN among them (finite weights: see [`avx::add_channel`] on NaN
-    /// payloads).
+    /// a NaN among them (finite weights: see `avx::run` on NaN payloads).
     #[test]
     fn the_avx_pass_gives_the_portable_bits() {
         if !std::arch::is_x86_feature_detected!("avx") {

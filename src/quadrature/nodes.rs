@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use crate::error::QuadError;
 use crate::estimate::Estimate;
-use crate::sum::{Compensated, LaneValues, Lanes};
+use crate::sum::{Compensated, Kernel, KernelTask, LaneValues, Lanes, with_kernel};
 use crate::value::Value;
 
 /// A 1-D rule on `[0, 1]`: nodes `u_i` and weights `w_i` with `sum w_i = 1`
@@ -103,7 +103,7 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
     }
 
     if D == 1 {
-        return line_sum(axes[0], |u| {
+        return line_sum(axes[0], move |u| {
             let mut p = [0.0; D];
             p[0] = u;
             f(p)
@@ -175,10 +175,10 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
 /// [`product_sum`] on one axis: [`LineSum::add_span`] over all its nodes.
 fn line_sum<V: Value>(
     a: &UnitNodes,
-    mut f: impl FnMut(f64) -> Result<V, QuadError>,
+    f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<ProductSum<V>, QuadError> {
     let mut sum = LineSum::new();
-    sum.add_span(a, 0..a.len(), &mut f)?;
+    sum.add_span(a, 0..a.len(), f)?;
     in_range(sum.finish(a))
 }
 
@@ -295,12 +295,22 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
 /// error, or the payload of its panic.
 type SpanOutcome<V> = std::thread::Result<Result<LineSum<V>, QuadError>>;
 
-/// Nodes per block of [`LineSum::add_span`]. 256 rather than 64: each
-/// block's finite check and hand-over cost some 1.3% of the evaluations of
+/// Nodes per block of [`LineSum::add_span`]: the values of a block are
+/// checked finite at once, and the companions summed. 256 rather than 64:
+/// each block's check and hand-over cost some 1.3% of the evaluations of
 /// `cos(50 x)` at 64 (paired rounds of `examples/gl_race.rs`, lightquad over
-/// bilby 1.047, 1.058, 1.047 at 64 against 1.034, 1.046, 1.032 at 256).
-/// The buffer is 2 KiB for a scalar, 12 KiB for the largest value.
+/// bilby 1.047, 1.058, 1.047 at 64 against 1.034, 1.046, 1.032 at 256, when
+/// the block was summed after it was evaluated). The buffer is 2 KiB for a
+/// scalar, 12 KiB for the largest value.
 const BLOCK: usize = 256;
+
+/// Nodes per group of [`LineSum::add_span`]: the integrand is evaluated
+/// at a group, then the group before it is summed. A multiple of
+/// [`crate::sum::LANES`], so a block's lanes take the same terms as when
+/// the block is summed at once (the same bits).
+const GROUP: usize = 16;
+
+const _: () = assert!(BLOCK.is_multiple_of(GROUP) && GROUP.is_multiple_of(crate::sum::LANES));
 
 // A span of `line_sum_par` is whole blocks, so its blocks are `product_sum`'s.
 const _: () = assert!(PAR_SPAN.is_multiple_of(BLOCK));
@@ -327,70 +337,50 @@ impl<V: Value> LineSum<V> {
     }
 
     /// Adds the nodes `range` of `a`. The integrand is evaluated at a
-    /// block of nodes first, then the block is summed: an integrand that
-    /// calls a function (`cos`) clobbers every floating-point register, so
-    /// the running sums, carried across its calls, were stored and reloaded
-    /// at every node (the sum took 1.13 to 1.18 times the bare evaluations
-    /// of `cos(50 x)`). Summed apart, they stay in registers, in
-    /// [`crate::sum::LANES`] independent lanes, and the compensated sum,
-    /// `sum |w y|` and the largest term are formed in one pass. The values
-    /// are checked finite once a block, through the block's `sum |w y|` (a
-    /// NaN or infinite value makes it non-finite, and then the block is
-    /// searched for the first such node): a check at every node cost about
-    /// 5% of the evaluations of `cos(50 x)`. So `f` may be called at up to
-    /// 255 nodes after a non-finite value, and an error `f` returns at one of
-    /// them is reported instead of that value (reporting the value first,
-    /// with the loop that took, cost another 8% at n = 1e6). `magnitude` is
-    /// summed a block at a time, so it can differ from a term-by-term sum in
-    /// its last few bits.
+    /// group of [`GROUP`] nodes, then the group before it is summed, in
+    /// [`crate::sum::LANES`] independent lanes (the compensated sum, `sum |w
+    /// y|` and the largest term in one pass), all in one function compiled
+    /// for the lanes' kernel ([`with_kernel`]): AVX where the CPU has it.
+    ///
+    /// Why this shape, measured on `cos(50 x)` at n = 1e6 against bilby's
+    /// plain loop (`examples/gl_race.rs`):
+    /// - An integrand that calls a function (`cos`) clobbers every
+    ///   floating-point register, so sums carried across each call are
+    ///   stored and reloaded at every node: 1.13 to 1.18 times the bare
+    ///   evaluations, term by term.
+    /// - A whole block of 256 values summed after it is evaluated kept the
+    ///   sums in registers, but the pass (a chain of dependent additions)
+    ///   then ran alone, not in the shadow of the calls: 1.02 to 1.03 times
+    ///   bilby, with the pass in AVX called once a block.
+    /// - Groups of 16, summed between the calls in the same function, hide
+    ///   the pass behind the calls: 1.00 to 1.01 times bilby (groups of 8
+    ///   and of 32 came out at 1.03).
+    /// - The integrand is taken by value: through a reference, each node
+    ///   reloaded the captures' addresses before their values (2.5%).
+    ///
+    /// The values are checked finite once a block of [`BLOCK`] nodes,
+    /// through the block's `sum |w y|` (a NaN or infinite value makes it
+    /// non-finite, and then the block is searched for the first such node):
+    /// a check at every node cost about 5% of the evaluations of `cos(50
+    /// x)`. So `f` may be called at up to 255 nodes after a non-finite value,
+    /// and an error `f` returns at one of them is reported instead of that
+    /// value (reporting the value first, with the loop that took, cost
+    /// another 8% at n = 1e6). `magnitude` is summed a block at a time, so it
+    /// can differ from a term-by-term sum in its last few bits. The
+    /// companions' lanes take a block at a time.
     #[inline(always)]
     fn add_span(
         &mut self,
         a: &UnitNodes,
         range: std::ops::Range<usize>,
-        f: &mut impl FnMut(f64) -> Result<V, QuadError>,
+        f: impl FnMut(f64) -> Result<V, QuadError>,
     ) -> Result<(), QuadError> {
-        let companions = [
-            a.companion.as_deref(),
-            a.companion4.as_deref(),
-            a.companion8.as_deref(),
-        ];
-        let (u, w) = (&a.u[range.clone()], &a.w[range.clone()]);
-        // Local copies of the sums, which the compiler keeps apart from `self`.
-        let Self {
-            mut value,
-            companions: mut others,
-            mut magnitude,
-            mut largest,
-        } = *self;
-        let mut ys = [V::zero(); BLOCK];
-        for (block, (us, ws)) in u.chunks(BLOCK).zip(w.chunks(BLOCK)).enumerate() {
-            let ys = &mut ys[..us.len()];
-            for (y, &u) in ys.iter_mut().zip(us) {
-                *y = f(u)?;
-            }
-            let mut block_magnitude = LaneValues::zero();
-            value.add_products_scaled(ys, ws, &mut block_magnitude, &mut largest);
-            if !block_magnitude.all_finite()
-                && let Some((u, y)) = us.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
-            {
-                return Err(non_finite(&[*u], y));
-            }
-            magnitude.add(&block_magnitude);
-            let start = range.start + block * BLOCK;
-            for (lanes, c) in others.iter_mut().zip(companions) {
-                if let Some(c) = c {
-                    lanes.add_products(ys, &c[start..start + us.len()]);
-                }
-            }
-        }
-        *self = Self {
-            value,
-            companions: others,
-            magnitude,
-            largest,
-        };
-        Ok(())
+        with_kernel(Span {
+            sums: self,
+            a,
+            range,
+            f,
+        })
     }
 
     /// The sums over the nodes `range` of `a`. Not inlined: in rayon's
@@ -403,7 +393,7 @@ impl<V: Value> LineSum<V> {
         f: &impl Fn(f64) -> Result<V, QuadError>,
     ) -> Result<Self, QuadError> {
         let mut sum = Self::new();
-        sum.add_span(a, range, &mut |u| f(u))?;
+        sum.add_span(a, range, f)?;
         Ok(sum)
     }
 
@@ -429,6 +419,102 @@ impl<V: Value> LineSum<V> {
             largest: self.largest.max(),
             evaluations: a.u.len() as u64,
         }
+    }
+}
+
+/// [`LineSum::add_span`] as a [`KernelTask`]: the nodes `range` of `a`
+/// added to `sums`.
+struct Span<'a, V: Value, F> {
+    sums: &'a mut LineSum<V>,
+    a: &'a UnitNodes,
+    range: std::ops::Range<usize>,
+    f: F,
+}
+
+impl<V: Value, F: FnMut(f64) -> Result<V, QuadError>> KernelTask<V> for Span<'_, V, F> {
+    type Output = Result<(), QuadError>;
+
+    /// The integrand at a group of [`GROUP`] nodes, then the group's
+    /// products into the lanes, group after group; the finite check and
+    /// the companions a block of [`BLOCK`] nodes at a time.
+    #[inline(always)]
+    fn run(self, kernel: impl Kernel<V>) -> Self::Output {
+        let Self {
+            sums,
+            a,
+            range,
+            mut f,
+        } = self;
+        let companions = [
+            a.companion.as_deref(),
+            a.companion4.as_deref(),
+            a.companion8.as_deref(),
+        ];
+        let (u, w) = (&a.u[range.clone()], &a.w[range.clone()]);
+        // Local copies of the sums, which the compiler keeps apart from `sums`.
+        let LineSum {
+            mut value,
+            companions: mut others,
+            mut magnitude,
+            mut largest,
+        } = *sums;
+        let mut ys = [V::zero(); BLOCK];
+        for (block, (us, ws)) in u.chunks(BLOCK).zip(w.chunks(BLOCK)).enumerate() {
+            let ys = &mut ys[..us.len()];
+            let mut block_magnitude = LaneValues::zero();
+            // The integrand a group of `GROUP` nodes at a time (a loop of
+            // known length, unrolled), and the group before it summed after
+            // it: by then the values' stores have left the store buffer, and
+            // a load of four of them as one vector does not wait on them.
+            let (groups, tail) = us.as_chunks::<GROUP>();
+            let mut pending = 0..0;
+            for (g, ug) in groups.iter().enumerate() {
+                let start = g * GROUP;
+                for (y, &u) in ys[start..start + GROUP].iter_mut().zip(ug) {
+                    *y = f(u)?;
+                }
+                value.add_products_scaled_in(
+                    kernel,
+                    &ys[pending.clone()],
+                    &ws[pending],
+                    &mut block_magnitude,
+                    &mut largest,
+                );
+                pending = start..start + GROUP;
+            }
+            let start = groups.len() * GROUP;
+            for (y, &u) in ys[start..].iter_mut().zip(tail) {
+                *y = f(u)?;
+            }
+            for group in [pending, start..us.len()] {
+                value.add_products_scaled_in(
+                    kernel,
+                    &ys[group.clone()],
+                    &ws[group],
+                    &mut block_magnitude,
+                    &mut largest,
+                );
+            }
+            if !block_magnitude.all_finite()
+                && let Some((u, y)) = us.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
+            {
+                return Err(non_finite(&[*u], y));
+            }
+            magnitude.add(&block_magnitude);
+            let start = range.start + block * BLOCK;
+            for (lanes, c) in others.iter_mut().zip(companions) {
+                if let Some(c) = c {
+                    lanes.add_products_in(kernel, ys, &c[start..start + us.len()]);
+                }
+            }
+        }
+        *sums = LineSum {
+            value,
+            companions: others,
+            magnitude,
+            largest,
+        };
+        Ok(())
     }
 }
 
