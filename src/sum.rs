@@ -198,8 +198,8 @@ impl<V: Value> Lanes<V> {
     /// Adds `w_i y_i` for every `i` of `ys` and `ws` (of equal length): each
     /// group of [`LANES`] terms one per lane, the terms after the last whole
     /// group into lane 0. In AVX registers where the CPU has them
-    /// ([`with_kernel`]); a loop that calls this for many short groups is
-    /// better written as a [`KernelTask`], which chooses once.
+    /// (`with_kernel`); a loop that calls this for many short groups is
+    /// better written as a `KernelTask`, which chooses once.
     pub fn add_products(&mut self, ys: &[V], ws: &[f64]) {
         with_kernel(Products {
             lanes: self,
