@@ -481,68 +481,63 @@ mod avx {
     use crate::value::Value;
 
     /// `task` with the AVX pass, compiled for AVX. The pass is a closure
-    /// defined here, so it is AVX code too and [`in_avx`] inlines into it:
-    /// the same operations on each lane in the same order as
-    /// [`super::add_channel_portable`], so the same bits (but for a NaN's
-    /// payload where two NaNs meet in one product, a NaN value times a NaN
-    /// weight: which comes out is the compiler's choice).
+    /// defined here, so it is AVX code too, and `inline(always)`, which a
+    /// function compiled for AVX may not be: in one of two callers that
+    /// asked the same, the compiler left a `#[inline]` pass a call of its
+    /// own once a group (`line_sum_par`'s spans, not `product_sum`). The
+    /// same operations on each lane in the same order as
+    /// [`super::add_channel_portable`], so the same bits, but for which NaN
+    /// comes out where two meet in one operation (a NaN term added to a
+    /// carry already made NaN by infinities of both signs): the compiler
+    /// may swap the operands of an addition, and x86 keeps the first NaN.
+    /// A NaN is a NaN to every caller, which stops at a value that is not
+    /// finite.
     #[target_feature(enable = "avx")]
     pub(super) fn run<V: Value, T: KernelTask<V>>(task: T) -> T::Output {
-        task.run(pass_fn(|ys: &[V], ws: &[f64], c, lanes, scaled| {
-            if scaled {
-                in_avx::<V, true>(ys, ws, c, lanes)
-            } else {
-                in_avx::<V, false>(ys, ws, c, lanes)
-            }
-        }))
-    }
-
-    #[target_feature(enable = "avx")]
-    #[inline]
-    fn in_avx<V: Value, const SCALED: bool>(
-        ys: &[V],
-        ws: &[f64],
-        c: usize,
-        [sum, carry, magnitude, largest]: [&mut f64x4; 4],
-    ) {
-        let mut state = [
-            to_avx(*sum),
-            to_avx(*carry),
-            to_avx(*magnitude),
-            to_avx(*largest),
-        ];
-        let mut y4 = ys.chunks_exact(LANES);
-        let mut w4 = ws.chunks_exact(LANES);
-        for (y, w) in (&mut y4).zip(&mut w4) {
-            let y = _mm256_setr_pd(
-                y[0].channel(c),
-                y[1].channel(c),
-                y[2].channel(c),
-                y[3].channel(c),
-            );
-            add::<SCALED>(
-                &mut state,
-                _mm256_mul_pd(y, _mm256_setr_pd(w[0], w[1], w[2], w[3])),
-            );
-        }
-        for (y, &w) in y4.remainder().iter().zip(w4.remainder()) {
-            add::<SCALED>(&mut state, _mm256_setr_pd(y.channel(c) * w, 0.0, 0.0, 0.0));
-        }
-        let [s, e, m, l] = state;
-        (*sum, *carry, *magnitude, *largest) = (from_avx(s), from_avx(e), from_avx(m), from_avx(l));
+        task.run(pass_fn(
+            #[inline(always)]
+            |ys: &[V], ws: &[f64], c, [sum, carry, magnitude, largest]: [&mut f64x4; 4], scaled| {
+                let mut state = [
+                    to_avx(*sum),
+                    to_avx(*carry),
+                    to_avx(*magnitude),
+                    to_avx(*largest),
+                ];
+                let mut y4 = ys.chunks_exact(LANES);
+                let mut w4 = ws.chunks_exact(LANES);
+                for (y, w) in (&mut y4).zip(&mut w4) {
+                    let y = _mm256_setr_pd(
+                        y[0].channel(c),
+                        y[1].channel(c),
+                        y[2].channel(c),
+                        y[3].channel(c),
+                    );
+                    let t = _mm256_mul_pd(y, _mm256_setr_pd(w[0], w[1], w[2], w[3]));
+                    add(&mut state, t, scaled);
+                }
+                for (y, &w) in y4.remainder().iter().zip(w4.remainder()) {
+                    let t = _mm256_setr_pd(y.channel(c) * w, 0.0, 0.0, 0.0);
+                    add(&mut state, t, scaled);
+                }
+                let [s, e, m, l] = state;
+                (*sum, *carry, *magnitude, *largest) =
+                    (from_avx(s), from_avx(e), from_avx(m), from_avx(l));
+            },
+        ))
     }
 
     /// One group of four terms `t` into `[sum, carry, magnitude, largest]`,
-    /// as [`add_channel_portable`] adds it: TwoSum, `|t|` and `maxpd`.
+    /// as [`super::add_channel_portable`] adds it: TwoSum and, with
+    /// `scaled`, `|t|` and `maxpd`.
     #[target_feature(enable = "avx")]
     #[inline]
-    fn add<const SCALED: bool>([s, e, m, l]: &mut [__m256d; 4], t: __m256d) {
+    fn add([s, e, m, l]: &mut [__m256d; 4], t: __m256d, scaled: bool) {
         let u = _mm256_add_pd(*s, t);
         let b = _mm256_sub_pd(u, *s);
         let err = _mm256_add_pd(_mm256_sub_pd(*s, _mm256_sub_pd(u, b)), _mm256_sub_pd(t, b));
         *e = _mm256_add_pd(*e, err);
         *s = u;
-        if SCALED {
+        if scaled {
             let a = _mm256_andnot_pd(_mm256_set1_pd(-0.0), t);
             *m = _mm256_add_pd(*m, a);
             *l = _mm256_max_pd(a, *l);
@@ -602,7 +597,8 @@ mod tests {
         }
     }
 
-    /// The four lanes of one channel after a pass.
+    /// The four lanes of one channel after a pass, as bits (every NaN as
+    /// `f64::NAN`'s).
     fn pass<V: Value, const SCALED: bool>(
         ys: &[V],
         ws: &[f64],
@@ -623,14 +619,18 @@ mod tests {
         } else {
             add_channel_portable::<V, SCALED>(ys, ws, c, [s, e, m, l]);
         }
-        lanes.map(|v| v.to_array().map(f64::to_bits))
+        lanes.map(|v| {
+            v.to_array()
+                .map(|x| if x.is_nan() { f64::NAN } else { x }.to_bits())
+        })
     }
 
     /// The AVX pass gives the portable pass's bits: every lane of the sum,
     /// the carry, `sum |w y|` and the largest term, for scalars and each
     /// channel of a colour, on lengths with every remainder, with terms of
     /// both signs over many scales, -0, a subnormal, -MAX, infinities and
-    /// a NaN among them (finite weights: see `avx::run` on NaN payloads).
+    /// a NaN among them. Any NaN counts as one value (see `avx::run` on
+    /// which NaN comes out).
     #[test]
     fn the_avx_pass_gives_the_portable_bits() {
         if !std::arch::is_x86_feature_detected!("avx") {
