@@ -343,7 +343,7 @@ pub(crate) trait Kernel<V: Value>: Copy {
 }
 
 /// A [`Kernel`] that is a closure: the AVX pass is a closure defined in a
-/// function compiled for AVX, whose target features it takes on.
+/// function compiled for AVX, and AVX code where it is inlined there.
 #[derive(Clone, Copy)]
 struct PassFn<F>(F);
 
@@ -481,7 +481,7 @@ mod avx {
     use crate::value::Value;
 
     /// `task` with the AVX pass, compiled for AVX. The pass is a closure
-    /// defined here, so it is AVX code too, and `inline(always)`, which a
+    /// defined here and `inline(always)` (AVX code once inlined here), which a
     /// function compiled for AVX may not be: in one of two callers that
     /// asked the same, the compiler left a `#[inline]` pass a call of its
     /// own once a group (`line_sum_par`'s spans, not `product_sum`). The
