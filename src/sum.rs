@@ -490,7 +490,7 @@ mod avx {
     /// comes out where two meet in one operation (a NaN term added to a
     /// carry already made NaN by infinities of both signs): the compiler
     /// may swap the operands of an addition, and x86 keeps the first NaN.
-    /// A NaN is a NaN to every caller, which stops at a value that is not
+    /// A NaN is a NaN to every caller in the crate, which stops at a value that is not
     /// finite.
     #[target_feature(enable = "avx")]
     pub(super) fn run<V: Value, T: KernelTask<V>>(task: T) -> T::Output {
