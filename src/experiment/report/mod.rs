@@ -1,0 +1,128 @@
+//! Reports, the sinks of a run: per experiment a Markdown page (a table per
+//! quantity, fitted orders, time to reach target errors, stability flags) with
+//! SVG plots of error against time and against n, a CSV of every job, and an
+//! index page that links every experiment and ranks the rules by time to error.
+//!
+//! Nothing here knows a family: a page is described by a [`Page`], and values
+//! are channel vectors (a scalar, RGB, an image), compared by their root mean
+//! square.
+//!
+//! A module a step: [`rows`](fn@rows) aggregates the jobs into a table's rows
+//! and flags them; [`order`](fn@order) fits orders and times to targets through
+//! them; a [`Section`] gathers what one quantity shows (both pages print it);
+//! the Markdown page, `results.csv` and the index are written from those, and
+//! [`ranked`] orders the rules for the index.
+//!
+//! ```
+//! use std::collections::BTreeMap;
+//! use lightquad::experiment::report::{Against, RuleInfo, order, rows};
+//! use lightquad::quadrature::{Rule, Trapezoid};
+//!
+//! let text = r#"{"name": "doc-report", "family": "calibration", "scene": {}, "quantities": ["exp"],
+//!   "rules": [{"rule": "trapezoid"}], "budgets": [8, 16, 32, 64, 128], "repeats": 1,
+//!   "reference": {"type": "closed-form"}}"#;
+//! let exp = lightquad::families::builtin().load(serde_json::from_str(text)?, "hash")?;
+//! let results: Vec<_> = exp.jobs(None).into_iter().map(|job| exp.run_job(job)).collect();
+//! // One row per (rule, budget) against the reference e - 1, and the order fitted
+//! // against the resolution a budget buys (n - 1 intervals): -2 for the trapezoid rule.
+//! let intervals: BTreeMap<usize, f64> = [8, 16, 32, 64, 128].map(|n| (n, Trapezoid.resolution(n, 1))).into();
+//! let rule = RuleInfo { label: "trapezoid".into(), is_random: false, min_budget: 2,
+//!     resolution: BTreeMap::from([(1, intervals.clone())]) };
+//! let table = rows(&[rule], &results, "exp", &[std::f64::consts::E - 1.0], None);
+//! assert_eq!(table.len(), 5);
+//! let against = Against::Resolution { dimension: 1, by_budget: Some(&intervals) };
+//! let slope = order(&table.iter().collect::<Vec<_>>(), against, 0.0).ok_or("no fit")?;
+//! assert!((slope + 2.0).abs() < 0.01, "{slope}");
+//! // The page itself: report.md, SVG plots, results.csv and index.html.
+//! let dir = std::env::temp_dir().join(format!("lightquad-doc-report-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir)?;
+//! exp.write_report(&dir, &results)?;
+//! assert!(std::fs::read_to_string(dir.join("report.md"))?.contains("trapezoid"));
+//! assert!(dir.join("results.csv").exists() && dir.join("index.html").exists());
+//! std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod csv;
+mod index;
+mod order;
+mod page;
+mod pictures;
+mod ranking;
+mod rows;
+mod section;
+
+use std::collections::BTreeMap;
+
+pub use index::write_index;
+pub use order::{Against, ERRATIC, FIT_ROWS, fit_floor, order, order_and_scatter, time_to};
+pub use page::{SHARED, provenance, write_experiment};
+pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIE_FACTOR, TIED, ranked, ranks};
+pub use rows::{FLAG_LEGEND, Row, RowFlag, rows};
+pub use section::{
+    Fit, Picture, Section, cell, display_line, extra_columns, label, off_cell, over_budget,
+    sections, show_value, skipped,
+};
+
+use super::reference::{Crosscheck, Reference};
+use crate::family::Display;
+
+/// What a report page shows of an experiment, whatever its family.
+#[derive(Debug, Clone)]
+pub struct Page<'a> {
+    /// Experiment name.
+    pub name: &'a str,
+    /// What it shows.
+    pub description: &'a str,
+    /// Its family.
+    pub family: &'static str,
+    /// Its equation IDs.
+    pub equations: &'a [String],
+    /// Budgets, ascending.
+    pub budgets: &'a [usize],
+    /// What a budget counts.
+    pub budget_unit: &'static str,
+    /// Why a row may count more evaluations than its budget
+    /// ([`Family::OVER_BUDGET`](crate::family::Family::OVER_BUDGET)).
+    pub over_budget: &'static str,
+    /// Repeats per (rule, budget).
+    pub repeats: usize,
+    /// The file's seed.
+    pub seed: u64,
+    /// How the family evaluates the scene, in words (may be empty).
+    pub settings: String,
+    /// The quantities, in the file's order.
+    pub quantities: Vec<&'static str>,
+    /// Each quantity's dimension (a budget of n is n^(1/D) nodes per axis).
+    pub dimensions: Vec<usize>,
+    /// Each quantity's display ([`Family::display`](crate::family::Family::display)).
+    pub displays: Vec<Option<Display>>,
+    /// Each quantity's image shape ([`Family::image`](crate::family::Family::image)).
+    pub images: Vec<Option<[usize; 2]>>,
+    /// The rules and estimators, in the file's order.
+    pub rules: Vec<RuleInfo>,
+    /// Target relative errors.
+    pub targets: &'a [f64],
+    /// The reference.
+    pub reference: &'a Reference,
+    /// The Mitsuba comparison rows (may be empty).
+    pub crosscheck: &'a [Crosscheck],
+    /// The family's section on this scene (e.g. printed formulas), if any.
+    pub scene_audit: Option<String>,
+}
+
+/// A rule or estimator as a report sees it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RuleInfo {
+    /// Its label (its name, with `#index` where the file names it twice).
+    pub label: String,
+    /// True for randomised rules (their estimate is a standard error).
+    pub is_random: bool,
+    /// The smallest budget it runs at (smaller budgets are skipped for it).
+    pub min_budget: usize,
+    /// Per dimension, the resolution per axis each budget buys
+    /// ([`crate::quadrature::Rule::resolution`]: intervals of a composite
+    /// rule, nodes or samples per axis otherwise); a missing entry is read as
+    /// `n^(1/D)`.
+    pub resolution: BTreeMap<usize, BTreeMap<usize, f64>>,
+}

@@ -1,0 +1,239 @@
+//! The Markdown page of one experiment (`report.md`), with its plots,
+//! images, `results.csv` and the HTML page beside it.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::Page;
+use super::csv::csv;
+use super::ranking::Summary;
+use super::rows::{FLAG_LEGEND, Row, RowFlag};
+use super::section::{
+    cell, display_line, extra_columns, label, off_cell, over_budget, sections, show_value, skipped,
+};
+use crate::experiment::reference::crosscheck_markdown;
+use crate::experiment::run::{JobResult, write_report_file};
+use crate::family::Display;
+
+/// Writes `report.md`, the SVG plots, `results.csv` and `index.html` of one
+/// experiment.
+pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Result<Summary, String> {
+    let sections = sections(page, results)?;
+    let mut md = header(page, results);
+    if let Some(audit) = &page.scene_audit {
+        let _ = writeln!(md, "{audit}");
+    }
+    let mut summary = Summary::new();
+    for (i, s) in sections.iter().enumerate() {
+        let q = s.quantity;
+        let reference = match &s.reference {
+            Ok(r) => r,
+            Err(why) => {
+                let _ = writeln!(
+                    md,
+                    "## {q} (no reference)\n\nNo reference, so no true errors, orders or times to target: \
+                     {why}. The jobs' values and estimated errors are in results.csv.\n"
+                );
+                continue;
+            }
+        };
+        let display = page.displays.get(i).copied().flatten();
+        let _ = writeln!(
+            md,
+            "## {q} (reference {reference})\n\n{}",
+            table(page, &s.rows, display.as_ref())
+        );
+        if let (Some(d), Some(values)) = (
+            extra_columns(&s.rows, display.as_ref()).1,
+            page.reference.values.get(q),
+        ) {
+            let _ = writeln!(md, "{}\n", display_line(d, q, values, &s.rows, page));
+        }
+        if let Some(line) = over_budget(page, &s.rows) {
+            let _ = writeln!(md, "{line}");
+        }
+        let _ = writeln!(
+            md,
+            "\n| rule | {} | fitted slope vs log evaluations (the cost) | {} |\n|---|---:|---:|{}",
+            s.slope_heading,
+            page.targets
+                .iter()
+                .map(|t| format!("time to {t:.0e} (s)"))
+                .collect::<Vec<_>>()
+                .join(" | "),
+            "---:|".repeat(page.targets.len())
+        );
+        for f in &s.fits {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} |",
+                f.label,
+                f.slope_budget,
+                f.slope_evaluations,
+                f.times.join(" | ")
+            );
+        }
+        let _ = writeln!(
+            md,
+            "\nTime to a target: the least median time among the rows from the budget on which \
+             the error stays at or below the target at every larger budget (an error that dips \
+             below it at one budget and rises again does not count; a row whose value underflows \
+             has no error and reaches nothing)."
+        );
+        md.push('\n');
+        for (what, file, text) in &s.plots {
+            write_report_file(&dir.join(file), text.as_bytes())?;
+            let _ = writeln!(md, "![error against {what}]({file})");
+        }
+        md.push('\n');
+        if !s.pictures.is_empty() {
+            md.push_str("### Images\n\n");
+        }
+        for p in &s.pictures {
+            for (file, bytes) in &p.files {
+                write_report_file(&dir.join(file), bytes)?;
+            }
+            let _ = write!(md, "![{}]({})", p.caption, p.png);
+            if let Some(e) = &p.error_png {
+                let _ = write!(md, " ![error map]({e})");
+            }
+            let _ = writeln!(md, " {} ([PFM]({}))\n", p.caption, p.pfm);
+        }
+        summary.push((q, s.ranking.clone()));
+    }
+    if !page.crosscheck.is_empty() {
+        let _ = writeln!(
+            md,
+            "## lightquad vs Mitsuba 3 vs closed form\n\n{}",
+            crosscheck_markdown(page.crosscheck)
+        );
+    }
+    let _ = writeln!(md, "{FLAG_LEGEND}");
+    write_report_file(&dir.join("report.md"), md.as_bytes())?;
+    write_report_file(&dir.join("results.csv"), csv(results).as_bytes())?;
+    crate::experiment::html::write_experiment(dir, page, results, &sections)?;
+    Ok(summary)
+}
+
+/// The page's title, settings, reference and provenance.
+fn header(page: &Page, results: &[JobResult]) -> String {
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# {}\n\n{}\n",
+        page.name,
+        crate::experiment::markdown::plain(page.description)
+    );
+    let settings = if page.settings.is_empty() {
+        String::new()
+    } else {
+        format!(", {}", page.settings)
+    };
+    let equations = if page.equations.is_empty() {
+        String::new()
+    } else {
+        format!(" Equations: {}.", page.equations.join(", "))
+    };
+    let shared = if page.quantities.len() > 1 {
+        SHARED
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        md,
+        "Family `{}`.{equations} Budgets {:?} ({}), {} repeat(s), seed {}{settings}.{shared}\n\n\
+         Reference: {}\n",
+        page.family, page.budgets, page.budget_unit, page.repeats, page.seed, page.reference.note
+    );
+    let skipped = skipped(page);
+    if !skipped.is_empty() {
+        let _ = writeln!(
+            md,
+            "Budgets below a rule's minimum are skipped for it: {}.\n",
+            skipped.join(", ")
+        );
+    }
+    if let Some(p) = provenance(results) {
+        let _ = writeln!(md, "{p}\n");
+    }
+    md
+}
+
+/// Said of an experiment of several quantities.
+pub const SHARED: &str = " Each quantity is evaluated and timed on its own (a job evaluates only \
+the terms that quantity needs), so its times are its own cost.";
+
+/// The version, commit, machine and experiment hash of a run, in words.
+pub fn provenance(results: &[JobResult]) -> Option<String> {
+    results.first().map(|r| {
+        format!(
+            "lightquad {} (commit {}), {}, experiment hash {}.",
+            r.version,
+            r.git_commit.as_deref().unwrap_or("unknown"),
+            r.machine,
+            r.experiment_hash
+        )
+    })
+}
+
+/// The table of one quantity: a row per (rule, budget); with several
+/// channels the largest channel error, and with a display the displayed
+/// values off the reference's.
+fn table(page: &Page, rows: &[Row], display: Option<&Display>) -> String {
+    let (multi, display) = extra_columns(rows, display);
+    let mut md = String::from(
+        "| rule | n | value (mean over repeats) | true error (root mean square over repeats; relative, absolute where the reference is 0) |",
+    );
+    if multi {
+        md.push_str(" largest channel error (same scale) |");
+    }
+    if let Some(d) = display {
+        let _ = write!(
+            md,
+            " {} values off the reference's (mean over repeats) |",
+            d.name
+        );
+    }
+    md.push_str(
+        " estimated error (mean over repeats, same scale; a standard error for random rules) | evaluations (mean) | median time (s) | flags |\n|---|---:|---:|---:|",
+    );
+    md.push_str(&"---:|".repeat(usize::from(multi) + usize::from(display.is_some())));
+    md.push_str("---:|---:|---:|---|\n");
+    for r in rows {
+        // A job's failure text may carry a user's strings (a results line
+        // edited by hand): escaped, so that it cannot break the table.
+        let flags: Vec<String> = r
+            .flags
+            .iter()
+            .map(|f| match f {
+                RowFlag::Failed(why) => {
+                    format!("failed: {}", crate::experiment::markdown::plain(why))
+                }
+                f => f.to_string(),
+            })
+            .collect();
+        let _ = write!(
+            md,
+            "| {} | {} | {} | {} |",
+            label(page, r.rule_index),
+            r.budget,
+            show_value(&r.value),
+            cell(r.rel_error),
+        );
+        if multi {
+            let _ = write!(md, " {} |", cell(r.max_error));
+        }
+        if display.is_some() {
+            let _ = write!(md, " {} |", off_cell(r.display_off));
+        }
+        let _ = writeln!(
+            md,
+            " {} | {:.0} | {:.2e} | {} |",
+            cell(r.rel_estimate),
+            r.evaluations,
+            r.seconds,
+            flags.join("; ")
+        );
+    }
+    md
+}

@@ -1,0 +1,90 @@
+//! The index's ranking of the rules by time to the middle target error, with
+//! ties within timing noise.
+
+/// Per-experiment summary for the index: per quantity, in the file's order,
+/// each rule's time to the middle target (None: not reached).
+pub type Summary = Vec<(&'static str, Vec<Ranked>)>;
+
+/// One rule in the index's ranking of a quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ranked {
+    /// The rule's label.
+    pub label: String,
+    /// Its time to the middle target (None: not reached).
+    pub seconds: Option<f64>,
+    /// A deterministic rule whose error is unresolved (exact, at rounding, or
+    /// at the reference's accuracy) already at its smallest budget: its rank
+    /// then says nothing about its speed on integrands in general.
+    pub exact_from_start: bool,
+}
+
+/// A ranking, fastest first; rules that never reached the target last, by name.
+pub fn ranked(ranking: &[Ranked]) -> Vec<Ranked> {
+    let mut ranked = ranking.to_vec();
+    ranked.sort_by(|a, b| match (a.seconds, b.seconds) {
+        (Some(x), Some(y)) => x.total_cmp(&y),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => a.label.cmp(&b.label),
+    });
+    ranked
+}
+
+/// Times closer than this factor are ranked as a tie: two runs of the
+/// bundled suite on one machine swapped rules whose times differed by 2%
+/// (5.6e-7 s and 5.7e-7 s), and timings on a shared machine move by 10-20%.
+pub const TIE_FACTOR: f64 = 1.25;
+
+/// The rank of each rule in `ranked` (sorted by [`ranked`]): 1, 2, ...,
+/// with a rule whose time is within [`TIE_FACTOR`] of the one before it
+/// sharing that one's rank (a tie within timing noise). Rules that did not
+/// reach the target rank after all that did.
+pub fn ranks(ranked: &[Ranked]) -> Vec<usize> {
+    let mut out: Vec<usize> = Vec::with_capacity(ranked.len());
+    for (i, r) in ranked.iter().enumerate() {
+        let tied = i > 0
+            && matches!(
+                (ranked[i - 1].seconds, r.seconds),
+                (Some(a), Some(b)) if b <= a * TIE_FACTOR
+            );
+        out.push(if tied { out[i - 1] } else { i + 1 });
+    }
+    out
+}
+
+/// Said of a rule whose rank it shares with the one before.
+pub const TIED: &str = "tied: within 25% of the time of the rule before, timing noise";
+
+/// Said of a rule ranked while exact from its first budget.
+pub const EXACT_FROM_START: &str = "at the error floor from its first budget: this integrand is \
+easy for it, the rank says little in general";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rule(label: &str, seconds: Option<f64>) -> Ranked {
+        Ranked {
+            label: label.into(),
+            seconds,
+            exact_from_start: false,
+        }
+    }
+
+    /// Times within 25% of the one before share its rank; a gap of more
+    /// starts a new rank at the position; rules that did not reach the
+    /// target are never tied.
+    #[test]
+    fn times_within_timing_noise_share_a_rank() {
+        let r = ranked(&[
+            rule("d", None),
+            rule("c", Some(2.0e-6)),
+            rule("b", Some(5.7e-7)),
+            rule("a", Some(5.6e-7)),
+            rule("e", None),
+        ]);
+        let labels: Vec<&str> = r.iter().map(|x| x.label.as_str()).collect();
+        assert_eq!(labels, ["a", "b", "c", "d", "e"]);
+        assert_eq!(ranks(&r), [1, 1, 3, 4, 5]);
+    }
+}
