@@ -1,0 +1,244 @@
+//! Stochastic transmittance estimators, the peers renderers use for V-tau:
+//! each draws free-flight distances against a majorant `sigma_bar >= sigma`
+//! on every smooth piece of the ray and returns the mean of `n` independent
+//! walks with its standard error.
+//!
+//! - Delta tracking (Woodcock): a tentative collision at `t` is real with
+//!   probability `sigma(t)/sigma_bar`; a walk scores 1 if it leaves the piece
+//!   without a real collision. Binary, unbiased.
+//! - Ratio tracking (Cramer 1978; Novák et al. 2014): a walk scores
+//!   `prod (1 - sigma(t_i)/mu)` over its tentative collisions, drawn at a
+//!   rate `mu = k sigma_bar` a few times the bound, which trades look-ups
+//!   for a much smaller variance (`k` and why: `ratio_rate_factor`).
+//! - Residual ratio tracking (Novák et al. 2014): with a control extinction
+//!   `sigma_c` (the span's mean, from a 4-point Gauss–Legendre rule),
+//!   `tau = exp(-sigma_c L) E[prod (1 - (sigma(t_i) - sigma_c)/sigma_r)]`,
+//!   tentative collisions drawn against the residual majorant
+//!   `sigma_r = max(sigma_bar - sigma_c, sigma_c) >= |sigma - sigma_c|`.
+//!
+//! Every piece of the medium along the ray is cut into 16 spans (32 for
+//! [`transmittance`]'s delta tracking, see `DELTA_SPANS`; one on a shadow
+//! ray, whose one walk pays for its set-up), each with its own majorant
+//! (and control);
+//! the per-walk scores of the spans multiply, and a free flight that leaves a
+//! span carries its unused optical depth into the next.
+//!
+//! [`radiance`](fn@radiance) extends delta tracking from `tau` to V-E, V-B, V-L and V-I
+//! the way a renderer estimates them (free-flight sampling against the
+//! majorant, emission and next-event light at the tentative collisions, the
+//! shadow ray's transmittance by ratio tracking); see there for the estimator
+//! and why it is unbiased.
+//!
+//! **Errors.** A tracking estimate's error is the standard error of its walks,
+//! except where that is known to mislead:
+//! - delta tracking's `tau` scores are 0 or 1: the error is the half-width
+//!   of the Wilson score interval at `z = 1.96`, divided by 1.96 (so
+//!   `value +- 1.96 error` is an interval as wide as Wilson's and the error
+//!   still reads as one standard error: it is the ordinary standard error up
+//!   to O(1/n) once `k` and `n - k` are large, and stays honest at `k = 0`
+//!   or `k = n`, where the sample standard error is 0);
+//! - any estimate whose walks all scored alike (zero sample variance, which
+//!   says nothing about outcomes not yet seen) carries `W(n) D`, with
+//!   `W(n) = z / (2 (n + z^2))` the Wilson half-width at `k = 0` divided by
+//!   `z` (an outcome not seen in `n` walks has a probability of order
+//!   `z^2 / (2 n)` or less) and `D` the largest change one unseen outcome
+//!   makes to a walk's score (see [`Tracked::all_alike`]), and is flagged.
+//!
+//! ```
+//! use lightquad::domain::Vec3;
+//! use lightquad::geometry::Ray;
+//! use lightquad::volume::ConstantSphere;
+//! use lightquad::volume::tracking::{Extinction, Tracker, transmittance};
+//! use rand::SeedableRng;
+//!
+//! // tau = exp(-sigma L) along the diameter (L = 2) of a unit sphere, sigma = 1.
+//! let sphere = ConstantSphere::new(Vec3::zeros(), 1.0, 1.0)?;
+//! let sigma = Extinction { medium: &sphere, lambda: 1.0 };
+//! let ray = Ray::new(Vec3::new(-3.0, 0.0, 0.0), Vec3::x())?;
+//! let exact = (-2.0f64).exp();
+//! let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+//! // Delta tracking scores 0 or 1: unbiased, within a few standard errors.
+//! let delta = transmittance(Tracker::Delta, sigma, &ray, 0.0, 10.0, 4000, &mut rng)?;
+//! assert!((delta.value - exact).abs() < 3.0 * delta.error && delta.error < 0.01);
+//! // Residual ratio tracking with the mean as its control is exact in a constant
+//! // medium: every walk scores alike, which the estimate flags.
+//! let rrt = transmittance(Tracker::ResidualRatio, sigma, &ray, 0.0, 10.0, 100, &mut rng)?;
+//! assert!((rrt.value - exact).abs() < 1e-14 && rrt.all_alike);
+//! # Ok::<(), lightquad::QuadError>(())
+//! ```
+
+mod lookups;
+mod radiance;
+mod scores;
+mod span;
+mod walks;
+
+pub use lookups::{Walks, expected_lookups};
+pub use radiance::{Radiance, Wanted, radiance};
+pub use scores::wilson_error;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use crate::error::QuadError;
+use crate::geometry::Ray;
+use crate::volume::medium::Medium;
+
+use scores::Scores;
+use span::{Crossing, DELTA_SPANS, SPANS, control_factor, spans};
+use walks::{delta_walks, walk};
+
+/// The `z` of the two-sided 95% intervals the errors stand for.
+const Z: f64 = 1.96;
+
+/// Tentative collisions allowed per walk and span before tracking gives up
+/// (its cost grows with the majorant's optical depth).
+const MAX_COLLISIONS: u64 = 10_000_000;
+
+/// Which tracking estimator; its serde form is the estimator's spec in an
+/// experiment file (`{"rule": "ratio-tracking"}`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "rule", deny_unknown_fields)]
+pub enum Tracker {
+    /// Delta (Woodcock) tracking.
+    #[serde(rename = "delta-tracking")]
+    Delta,
+    /// Ratio tracking.
+    #[serde(rename = "ratio-tracking")]
+    Ratio,
+    /// Residual ratio tracking with a control extinction per span (its mean).
+    #[serde(rename = "residual-ratio-tracking")]
+    ResidualRatio,
+}
+
+impl Tracker {
+    /// Registry name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Tracker::Delta => "delta-tracking",
+            Tracker::Ratio => "ratio-tracking",
+            Tracker::ResidualRatio => "residual-ratio-tracking",
+        }
+    }
+}
+
+/// Extinction `sigma = lambda v_r` of a medium.
+#[derive(Debug, Clone, Copy)]
+pub struct Extinction<'a> {
+    /// The density field `v_r`.
+    pub medium: &'a dyn Medium,
+    /// The factor `lambda`.
+    pub lambda: f64,
+}
+
+/// A tracking estimate: the mean of `walks` walks and its error (see the
+/// module documentation), with the density evaluations spent.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tracked {
+    /// The mean score.
+    pub value: f64,
+    /// One standard error widened to the Student-t interval
+    /// ([`Welford::interval_error`](crate::quadrature::monte_carlo::Welford::interval_error)), or its honest substitute (module documentation):
+    /// the Wilson half-width over 1.96 for 0/1 scores, `W(n) D` when every
+    /// walk scored alike.
+    pub error: f64,
+    /// Density evaluations spent (shared by every quantity of one set of walks).
+    pub evaluations: u64,
+    /// The number of walks.
+    pub walks: u64,
+    /// True when every walk scored the same: the sample variance is 0 and
+    /// `error` is the bound `W(n) D`, where `D` bounds how far one unseen
+    /// outcome moves a score: `max(x, 1 - x)` for a transmittance `x` (scores
+    /// of delta and ratio tracking lie in [0, 1], and a score in [0, 1]
+    /// equals 1 with probability at most its mean, so at the ends the bound
+    /// is the binomial one; residual ratio tracking's scores may pass 1, and
+    /// there it is a heuristic); for V-E, V-L and V-I the larger of `|x|`
+    /// and one tentative collision's largest score.
+    pub all_alike: bool,
+}
+
+/// Checks the common arguments of the estimators.
+fn check(lambda: f64, t0: f64, t1: f64, n: usize) -> Result<(), QuadError> {
+    if !(lambda.is_finite() && lambda >= 0.0) {
+        return Err(QuadError::invalid("lambda", lambda, "a finite number >= 0"));
+    }
+    if t0.is_nan() {
+        return Err(QuadError::invalid("t0", t0, "a number <= t1"));
+    }
+    if t1.is_nan() || t1 < t0 {
+        return Err(QuadError::invalid(
+            "t1",
+            t1,
+            format!("a number >= t0 = {t0}"),
+        ));
+    }
+    // The rules' budget limit holds for walks too: usize::MAX walks ran
+    // without end (the hostile review of issue 10).
+    let max = crate::quadrature::MAX_BUDGET;
+    if !(2..=max).contains(&n) {
+        return Err(QuadError::invalid(
+            "n",
+            n,
+            format!("2 to 2^40 = {max} walks (a standard error needs two)"),
+        ));
+    }
+    Ok(())
+}
+
+/// Estimates `tau(t0, t1)` along `ray` with `n` walks: the estimate, its
+/// error (module documentation) and the density evaluations spent.
+pub fn transmittance<Rg: rand::Rng + ?Sized>(
+    tracker: Tracker,
+    sigma: Extinction,
+    ray: &Ray,
+    t0: f64,
+    t1: f64,
+    n: usize,
+    rng: &mut Rg,
+) -> Result<Tracked, QuadError> {
+    check(sigma.lambda, t0, t1, n)?;
+    let mut evaluations = 0u64;
+    let per_piece = match tracker {
+        Tracker::Delta => DELTA_SPANS,
+        _ => SPANS,
+    };
+    let spans = spans(tracker, sigma, ray, (t0, t1), per_piece, &mut evaluations)?;
+    // A majorant of 0 everywhere: no collision is possible, every walk scores
+    // 1, and tau = 1 is exact (no Wilson bound, no flag).
+    if spans.iter().all(|s| s.bar == 0.0) {
+        return Ok(Tracked {
+            value: 1.0,
+            error: 0.0,
+            evaluations,
+            walks: n as u64,
+            all_alike: false,
+        });
+    }
+    let (control, crossings) = (control_factor(&spans), Crossing::of(&spans));
+    if tracker == Tracker::Delta {
+        // Scores are 0 or 1: a count of the walks that got through is all
+        // the Wilson error needs.
+        let through = delta_walks(sigma, ray, &crossings, n, &mut evaluations, rng)?;
+        let n = n as u64;
+        return Ok(Tracked {
+            value: through as f64 / n as f64,
+            error: wilson_error(through, n)?,
+            evaluations,
+            walks: n,
+            all_alike: through == 0 || through == n,
+        });
+    }
+    let mut scores = Scores::default();
+    for _ in 0..n {
+        scores.add(walk(
+            sigma,
+            ray,
+            control,
+            &crossings,
+            &mut evaluations,
+            rng,
+        )?);
+    }
+    // Scores in [0, 1] (residual ratio: a heuristic, see Tracked::all_alike).
+    Ok(scores.tracked(evaluations, |x| x.max(1.0 - x)))
+}
