@@ -319,7 +319,7 @@ def table(rows, args):
         "lightquad's spans (16; 32 for delta tracking of V-tau; one on a shadow ray) each have "
         "their own, and "
         "ratio tracking draws at "
-        "k = min(2D, 256/D) times it (src/volume/tracking.rs). Mitsuba computes in "
+        "k = min(2D, 256/D) times it (src/volume/tracking/span.rs). Mitsuba computes in "
         "float32 (an independent check put its ratio tracking 0.1%, 2.3 SE, below "
         "the exact tau at 2e7 walks; within the noise at a 1e-3 target); with "
         "--quick the fixed costs dominate and the plain ratio says little.",

@@ -1,4 +1,4 @@
-//! The Whitted family of the experiment layer (src/whitted/experiment.rs).
+//! The Whitted family of the experiment layer (src/whitted/experiment/).
 //!
 //! Layers: (1) the bundled `w-*` experiments validate and run on the real
 //! binary, report every quantity, and cover every W-* equation ID; (2) the

@@ -8,8 +8,8 @@
 //! square.
 //!
 //! A module a step: [`rows`](fn@rows) aggregates the jobs into a table's rows
-//! and flags them; [`order`](fn@order) fits orders and times to targets through
-//! them; a [`Section`] gathers what one quantity shows (both pages print it);
+//! and flags them; [`order`](fn@order) fits orders and [`time_to`] finds times to
+//! targets through them; a [`Section`] gathers what one quantity shows (both pages print it);
 //! the Markdown page, `results.csv` and the index are written from those, and
 //! [`ranked`] orders the rules for the index.
 //!
@@ -57,11 +57,12 @@ use std::collections::BTreeMap;
 pub use index::write_index;
 pub use order::{Against, ERRATIC, FIT_ROWS, fit_floor, order, order_and_scatter, time_to};
 pub use page::{SHARED, provenance, write_experiment};
+pub use pictures::Picture;
 pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIE_FACTOR, TIED, ranked, ranks};
 pub use rows::{FLAG_LEGEND, Row, RowFlag, rows};
 pub use section::{
-    Fit, Picture, Section, cell, display_line, extra_columns, label, off_cell, over_budget,
-    sections, show_value, skipped,
+    Fit, Section, cell, display_line, extra_columns, label, off_cell, over_budget, sections,
+    show_value, skipped,
 };
 
 use super::reference::{Crosscheck, Reference};

@@ -3,7 +3,25 @@
 
 use super::Page;
 use super::rows::Row;
-use super::section::{Picture, cell, label, off_cell};
+use super::section::{cell, label, off_cell};
+
+/// An image the report shows, with its files (PNG, PFM, and the error heat
+/// map's PNG where it is a rule's).
+#[derive(Debug, Clone)]
+pub struct Picture {
+    /// What it is, with its errors.
+    pub caption: String,
+    /// Its width in pixels.
+    pub width: usize,
+    /// The PNG's file name (W-Grey's 8-bit mapping).
+    pub png: String,
+    /// The PFM's file name (32-bit floats).
+    pub pfm: String,
+    /// The error heat map's PNG file name, for a rule's image.
+    pub error_png: Option<String>,
+    /// The files' names and bytes.
+    pub files: Vec<(String, Vec<u8>)>,
+}
 
 /// The reference's image and each rule's mean image at its largest budget,
 /// with heat maps of `|image - reference|` (the largest channel per pixel),

@@ -4,7 +4,7 @@
 
 use super::Page;
 use super::order::{Against, ERRATIC, FIT_ROWS, fit_floor, order_and_scatter, time_to};
-use super::pictures::pictures;
+use super::pictures::{Picture, pictures};
 use super::ranking::Ranked;
 use super::rows::{FLOOR, Row, RowFlag, rows, scale_of};
 use crate::experiment::plot;
@@ -52,24 +52,6 @@ pub struct Section {
     /// For an image-valued quantity: the reference's image and each rule's
     /// at its largest budget, with error heat maps.
     pub pictures: Vec<Picture>,
-}
-
-/// An image the report shows, with its files (PNG, PFM, and the error heat
-/// map's PNG where it is a rule's).
-#[derive(Debug, Clone)]
-pub struct Picture {
-    /// What it is, with its errors.
-    pub caption: String,
-    /// Its width in pixels.
-    pub width: usize,
-    /// The PNG's file name (W-Grey's 8-bit mapping).
-    pub png: String,
-    /// The PFM's file name (32-bit floats).
-    pub pfm: String,
-    /// The error heat map's PNG file name, for a rule's image.
-    pub error_png: Option<String>,
-    /// The files' names and bytes.
-    pub files: Vec<(String, Vec<u8>)>,
 }
 
 /// A rule's fitted slopes and times to the targets, as shown.

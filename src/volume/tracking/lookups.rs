@@ -116,7 +116,7 @@ pub fn expected_lookups(scene: &VolumeScene, walks: Walks) -> Result<f64, QuadEr
 
 /// The bound of [`expected_lookups`] on a delta-tracking walk's tentative
 /// collisions on each of `spans` at the rate `rate(span)`.
-pub(super) fn delta_lookups(
+fn delta_lookups(
     sigma: Extinction,
     ray: &Ray,
     spans: &[Span],

@@ -88,9 +88,6 @@ use scores::Scores;
 use span::{Crossing, DELTA_SPANS, SPANS, control_factor, spans};
 use walks::{delta_walks, walk};
 
-/// The `z` of the two-sided 95% intervals the errors stand for.
-const Z: f64 = 1.96;
-
 /// Tentative collisions allowed per walk and span before tracking gives up
 /// (its cost grows with the majorant's optical depth).
 const MAX_COLLISIONS: u64 = 10_000_000;

@@ -5,11 +5,14 @@
 use crate::error::QuadError;
 use crate::quadrature::monte_carlo::Welford;
 
-use super::{Tracked, Z};
+use super::Tracked;
+
+/// The `z` of the two-sided 95% intervals the errors stand for.
+const Z: f64 = 1.96;
 
 /// `W(n) = z / (2 (n + z^2))`: the half-width of the Wilson score interval
 /// for 0 successes in `n` trials, `z^2 / (2 (n + z^2))`, divided by `z`.
-pub(super) fn wilson_unseen(n: u64) -> f64 {
+fn wilson_unseen(n: u64) -> f64 {
     let n = n as f64;
     Z / (2.0 * (n + Z * Z))
 }
@@ -34,9 +37,9 @@ pub fn wilson_error(k: u64, n: u64) -> Result<f64, QuadError> {
 /// Walk scores summed as the tracking errors need them.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Scores {
-    pub(super) walks: Welford<f64>,
-    pub(super) first: Option<f64>,
-    pub(super) alike: bool,
+    walks: Welford<f64>,
+    first: Option<f64>,
+    alike: bool,
 }
 
 impl Scores {

@@ -83,7 +83,7 @@ pub(super) const DELTA_SPANS: usize = 32;
 /// and 5.02 with 8: a looser bound's extra look-ups cost less than the
 /// bounds. (With one span, the up-front refusal of `spans` limits a shadow
 /// chord's bound to an optical depth of 5e6, where 4 spans allowed 2e7.)
-pub(super) const SHADOW_SPANS: usize = 1;
+const SHADOW_SPANS: usize = 1;
 
 /// The spans of `[t0, t1]` along `ray`: each piece of the medium's extent is
 /// cut into `per_piece` equal spans with a majorant of their own (tight
@@ -166,7 +166,7 @@ pub(super) fn spans(
 /// Most tentative collisions per walk that [`ratio_rate_factor`] spends to
 /// cut ratio tracking's variance (where the bound's own optical depth is
 /// smaller).
-pub(super) const RATIO_COLLISIONS: f64 = 256.0;
+const RATIO_COLLISIONS: f64 = 256.0;
 
 /// `k`: ratio tracking draws its tentative collisions at `k` times the span's
 /// bound `sigma_bar`, `k = min(2 D, 256 / D)` floored at 1, where `D = int
@@ -184,7 +184,7 @@ pub(super) const RATIO_COLLISIONS: f64 = 256.0;
 /// about 256 look-ups (or `D`, where the bound alone needs more): past a
 /// depth of about 11 the variance is large for every affordable `k`.
 /// Scores stay in `[0, 1]` since `mu >= sigma`.
-pub(super) fn ratio_rate_factor(depth: f64) -> f64 {
+fn ratio_rate_factor(depth: f64) -> f64 {
     if depth > 0.0 {
         (2.0 * depth).min(RATIO_COLLISIONS / depth).max(1.0)
     } else {

@@ -19,7 +19,7 @@ pub(super) fn free_flight<Rg: rand::Rng + ?Sized>(rng: &mut Rg) -> f64 {
 }
 
 /// One ratio-tracking walk's transmittance score over `crossings`, the spans
-/// with a positive rate (module documentation): at each tentative collision
+/// with a positive rate ([module documentation](super)): at each tentative collision
 /// it is multiplied by `1 - (sigma - sigma_c) / mu`, with `sigma_c` the span's
 /// control (residual ratio tracking; 0 for plain ratio tracking), and
 /// `control` is the factor `exp(-int sigma_c)` of the controls (1 with none).
@@ -62,18 +62,18 @@ pub(super) fn walk<Rg: rand::Rng + ?Sized>(
 /// accumulated optical depth `e` in the rate: the crossings' ends, and for
 /// each of `cells` equal steps of depth the crossing its start lands in
 /// (a table look-up and a step or two instead of a search).
-pub(super) struct Course {
-    pub(super) ends: Vec<f64>,
-    pub(super) first: Vec<usize>,
+struct Course {
+    ends: Vec<f64>,
+    first: Vec<usize>,
     /// Cells per unit of depth.
-    pub(super) scale: f64,
+    scale: f64,
 }
 
 impl Course {
     /// Cells per crossing in the table.
     const CELLS: usize = 4;
 
-    pub(super) fn new(crossings: &[Crossing]) -> Course {
+    fn new(crossings: &[Crossing]) -> Course {
         let ends: Vec<f64> = crossings.iter().map(|c| c.end).collect();
         let total = ends.last().copied().unwrap_or(0.0);
         let cells = Self::CELLS * ends.len().max(1);
@@ -92,7 +92,7 @@ impl Course {
     /// where `e` is past the last end. Exact whatever the table's rounding:
     /// the steps from its entry compare with the ends themselves.
     #[inline]
-    pub(super) fn find(&self, e: f64) -> usize {
+    fn find(&self, e: f64) -> usize {
         // A saturating cast: e >= 0 (NaN, which cannot occur, gives 0).
         let cell = ((e * self.scale) as usize).min(self.first.len() - 1);
         let mut i = self.first[cell];
@@ -136,7 +136,7 @@ pub(super) fn delta_walks<Rg: rand::Rng + ?Sized>(
     rng: &mut Rg,
 ) -> Result<u64, QuadError> {
     /// Walks in flight: their tentative collisions are looked up in one
-    /// batch ([`Medium::densities`]).
+    /// batch ([`Medium::densities`](crate::volume::medium::Medium::densities)).
     const BATCH: usize = 64;
     /// A walk in flight: its accumulated depth, the crossing of its last
     /// tentative collision and how many it has had there.
@@ -216,7 +216,7 @@ mod tests {
     /// crossings, or a crossing several cells), at the ends themselves, just
     /// beside them, past the last and at 0.
     #[test]
-    pub(super) fn course_find_is_the_count_of_ends_at_or_below() {
+    fn course_find_is_the_count_of_ends_at_or_below() {
         let widths = [1e-9, 0.5, 3.0, 1e-6, 0.25, 7.0, 1e-3, 0.125];
         let mut a = 0.0;
         let spans: Vec<Span> = widths

@@ -1,5 +1,7 @@
-//! A file's scene checked and built: every bound and fault named by its JSON
-//! path, and a scene whose coordinates and sizes f64 cannot resolve refused.
+//! A file's scene checked and built: a value out of bounds is refused, named
+//! by its JSON path; an object f64 may not resolve (too small beside its
+//! distance from the eye, or too large) or a material that sends back more
+//! than it receives is built, with a warning naming it.
 
 use super::Built;
 use super::spec::{LightSpec, MAX_COORDINATE, MaterialSpec, ObjectSpec, SceneSpec};
@@ -26,17 +28,17 @@ pub const RESOLVED_SCENE: &str = "a scene whose coordinates and sizes f64 resolv
      around the camera, a sphere of radius 1e-20 seen from 1e19 or an eye 1e16 from the scene \
      are not)";
 
-pub(super) fn vec3(v: [f64; 3]) -> Vec3 {
+fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
 }
 
-pub(super) fn rgb(v: [f64; 3]) -> Rgb {
+fn rgb(v: [f64; 3]) -> Rgb {
     Rgb::new(v[0], v[1], v[2])
 }
 
 /// Refuses a number beyond [`MAX_COORDINATE`] among `values`, the array
 /// (or the one number) at `path`, at its own path (`scene.camera.eye[0]`).
-pub(super) fn bounded(path: &str, values: &[f64]) -> Result<(), SpecError> {
+fn bounded(path: &str, values: &[f64]) -> Result<(), SpecError> {
     match values
         .iter()
         .enumerate()
@@ -58,7 +60,7 @@ pub(super) fn bounded(path: &str, values: &[f64]) -> Result<(), SpecError> {
     }
 }
 
-pub(super) fn material(spec: &MaterialSpec) -> Material {
+fn material(spec: &MaterialSpec) -> Material {
     Material {
         k_a: spec.k_a,
         k_d: spec.k_d,
@@ -70,7 +72,7 @@ pub(super) fn material(spec: &MaterialSpec) -> Material {
     }
 }
 
-pub(super) fn object(spec: &ObjectSpec, at: &str) -> Result<Object, SpecError> {
+fn object(spec: &ObjectSpec, at: &str) -> Result<Object, SpecError> {
     let (shape, m, fields): (_, _, Vec<(&str, &[f64])>) = match spec {
         ObjectSpec::Sphere(s) => (
             Shape::sphere(vec3(s.centre), s.radius),

@@ -10,12 +10,12 @@ use crate::whitted::scene::{Camera, Object, Scene};
 
 /// The film region whose primary rays meet a shape, when it is a convex
 /// polygon or a half-plane of the film.
-pub(super) enum Footprint {
+enum Footprint {
     Polygon(Vec<[f64; 2]>),
     HalfPlane(HalfPlane),
 }
 
-pub(super) fn footprint(cam: &Camera, shape: &Shape) -> Option<Footprint> {
+fn footprint(cam: &Camera, shape: &Shape) -> Option<Footprint> {
     match *shape {
         Shape::Triangle { vertices, .. } => {
             let mut poly = Vec::with_capacity(3);
@@ -49,7 +49,7 @@ pub(super) fn footprint(cam: &Camera, shape: &Shape) -> Option<Footprint> {
     }
 }
 
-/// The closed form of `q` (module documentation).
+/// The closed form of `q` (the family's [module documentation](super), **Closed forms**).
 pub(super) fn closed_form(built: &Built, q: WhittedQuantity) -> Option<Vec<f64>> {
     let scene = &built.scene;
     let [object] = scene.objects.as_slice() else {
@@ -94,7 +94,7 @@ pub(super) fn closed_form(built: &Built, q: WhittedQuantity) -> Option<Vec<f64>>
 /// The intensity of `object` where it is seen, when it is the same at every
 /// point: `I_a k_a C` with no light term (no lights, or `k_d = k_s = 0`) and
 /// no mirror or transmitted ray (`k_s = k_t = 0`, or `max_depth = 0`).
-pub(super) fn flat_intensity(scene: &Scene, object: &Object) -> Option<Rgb> {
+fn flat_intensity(scene: &Scene, object: &Object) -> Option<Rgb> {
     let m = &object.material;
     let lit = !scene.lights.is_empty() && (m.k_d > 0.0 || m.k_s > 0.0);
     let recursive = scene.max_depth > 0 && (m.k_s > 0.0 || m.k_t > 0.0);
