@@ -1,0 +1,206 @@
+//! The cost guards: a job's and an experiment's estimated evaluations, bytes
+//! and jobs against their limits, refused before anything runs.
+
+use super::min_budget;
+use crate::error::SpecError;
+use crate::experiment::spec::ExperimentSpec;
+use crate::family::{Family, Method};
+
+/// The most integrand evaluations one job may cost by its family's estimate
+/// ([`Family::cost`]): 1e11, minutes to hours at a nanosecond or more per
+/// evaluation. `run --no-cost-limit` lifts it ([`lift_cost_limit`]).
+pub const MAX_JOB_EVALUATIONS: f64 = 1e11;
+
+/// The most bytes one job may hold by its family's estimate
+/// ([`Family::memory`]): 4 GiB, so that the default of one job per core fits
+/// a machine of 8 GiB a core (Gauss–Legendre at 1e8 nodes needs about 5.6
+/// GB). `--no-cost-limit` lifts it too.
+pub const MAX_JOB_BYTES: f64 = 4.0 * (1u64 << 30) as f64;
+
+/// The most work a whole experiment may cost by its family's estimates
+/// (every rule at every budget it runs, every repeat): 1e12 simple
+/// evaluations, hours on a few cores. 300 rules at 185 budgets and 1000
+/// repeats passed the per-job guard: 55 million jobs, 3e14 evaluations.
+pub const MAX_EXPERIMENT_EVALUATIONS: f64 = 1e12;
+
+/// The most jobs one experiment may have (rules x budgets x repeats).
+pub const MAX_JOBS: f64 = 1e6;
+
+/// The most bytes of results one experiment may write, estimated at 400
+/// bytes a job and 48 a channel (value and error): 2 GB. An image of
+/// 1024 x 1024 pixels wrote 106 MB of results.jsonl for a few jobs.
+pub const MAX_RESULTS_BYTES: f64 = 2e9;
+
+static COST_LIMIT_LIFTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Lets experiments whose jobs cost more than [`MAX_JOB_EVALUATIONS`] through
+/// (the command line's `--no-cost-limit`), for this process.
+pub fn lift_cost_limit() {
+    COST_LIMIT_LIFTED.store(true, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether `--no-cost-limit` was passed ([`lift_cost_limit`]).
+pub fn cost_limit_lifted() -> bool {
+    COST_LIMIT_LIFTED.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Refuses an experiment whose costliest job (the largest budget each rule
+/// runs at, every quantity) would pass [`MAX_JOB_EVALUATIONS`], with the
+/// estimate: the nested depth scheme at a budget of 1e6 was accepted and ran
+/// for about 22 hours.
+pub(super) fn check_cost<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    budgets: &[usize],
+) -> Result<(), SpecError> {
+    if cost_limit_lifted() {
+        return Ok(());
+    }
+    // The converged reference runs before the report: adaptive
+    // Gauss–Kronrod capped at 15 + 30 n evaluations a piece, at n and 2n at
+    // least (then doubled until it converges; its tolerance usually stops it
+    // far below the cap, so the cap of the first two evaluations is the
+    // bound checked). A scene of radius 1e308 with n = 1e5 passed and ran
+    // without end.
+    if let crate::experiment::spec::ReferenceSpec::Converged(c) = &spec.reference
+        && let Ok(gk) = crate::quadrature::AnyRule::by_name("gauss-kronrod")
+    {
+        // Its range first: an n beyond it is refused whatever the cost limit
+        // (the cost was reported first, and lifting the limit then met the
+        // range).
+        crate::experiment::reference::check_converged_n(c.n)?;
+        let budget = c.n.saturating_mul(60).saturating_add(15);
+        let method = Method::Rule(gk);
+        let cost: f64 = 1.5
+            * spec
+                .quantities
+                .iter()
+                .map(|&q| F::cost(scene, &method, budget, q))
+                .sum::<f64>();
+        if cost.is_nan() || cost > MAX_JOB_EVALUATIONS {
+            return Err(SpecError::at(
+                "reference.n",
+                format!(
+                    "the converged reference's first evaluations, at n = {} and {}, cost up \
+                     to about {cost:.1e} integrand evaluations: expected at most \
+                     {MAX_JOB_EVALUATIONS:.0e} (lower n, or pass --no-cost-limit to check and \
+                     run to go ahead)",
+                    c.n,
+                    2 * c.n
+                ),
+            ));
+        }
+    }
+    let Some(&largest) = budgets.last() else {
+        return Ok(());
+    };
+    for (i, m) in spec.rules.iter().enumerate() {
+        let cost: f64 = spec
+            .quantities
+            .iter()
+            .map(|&q| F::cost(scene, m, largest, q))
+            .sum();
+        if cost.is_nan() || cost > MAX_JOB_EVALUATIONS {
+            // Where even the least budget the rule runs at costs too much,
+            // the scene makes the rule too dear (ratio tracking through a
+            // blob of amplitude 1e307 collides about that often a walk):
+            // lowering the budget, the advice given, could not help. (The
+            // experiment's own smallest budget said so of any single budget.)
+            let least = min_budget::<F>(scene, m, &spec.quantities);
+            let at_least: f64 = spec
+                .quantities
+                .iter()
+                .map(|&q| F::cost(scene, m, least, q))
+                .sum();
+            let advice = if at_least.is_nan() || at_least > MAX_JOB_EVALUATIONS {
+                format!(
+                    "even at budget {least} it costs about {at_least:.1e}, so this scene makes the \
+                     rule too dear at any budget: remove rules[{i}] or change the scene (a \
+                     tracking walk through a deep or loose majorant makes many look-ups)"
+                )
+            } else {
+                "lower the budget".to_string()
+            };
+            return Err(SpecError::at(
+                "budgets",
+                format!(
+                    "a job of rules[{i}] ({}) at budget {largest} costs about {cost:.1e} integrand \
+                     evaluations: expected at most {MAX_JOB_EVALUATIONS:.0e} per job ({advice}, \
+                     or pass --no-cost-limit to check and run to go ahead)",
+                    m.label()
+                ),
+            ));
+        }
+        let bytes = spec
+            .quantities
+            .iter()
+            .map(|&q| F::memory(scene, m, largest, q))
+            .fold(0.0, f64::max);
+        if bytes.is_nan() || bytes > MAX_JOB_BYTES {
+            return Err(SpecError::at(
+                "budgets",
+                format!(
+                    "a job of rules[{i}] ({}) at budget {largest} needs about {:.1} GB of memory: \
+                     expected at most {:.1} GB per job (lower the budget, or pass --no-cost-limit \
+                     to check and run to go ahead)",
+                    m.label(),
+                    bytes / 1e9,
+                    MAX_JOB_BYTES / 1e9
+                ),
+            ));
+        }
+    }
+    // The whole experiment: every rule at each budget it runs, every repeat.
+    let repeats = spec.repeats as f64;
+    let (mut jobs, mut total) = (0.0, 0.0);
+    for m in &spec.rules {
+        let need = min_budget::<F>(scene, m, &spec.quantities);
+        for &b in budgets.iter().filter(|&&b| b >= need) {
+            jobs += repeats;
+            total += repeats
+                * spec
+                    .quantities
+                    .iter()
+                    .map(|&q| F::cost(scene, m, b, q))
+                    .sum::<f64>();
+        }
+    }
+    let channels: f64 = spec
+        .quantities
+        .iter()
+        .map(|&q| F::channels(scene, q) as f64)
+        .sum();
+    let written = jobs * (400.0 + 48.0 * channels);
+    let whole = "rules x budgets x repeats";
+    let lower =
+        "(fewer rules, budgets or repeats, or pass --no-cost-limit to check and run to go ahead)";
+    if total.is_nan() || total > MAX_EXPERIMENT_EVALUATIONS {
+        return Err(SpecError::at(
+            "budgets",
+            format!(
+                "the experiment's {jobs:.0} jobs ({whole}) cost about {total:.1e} integrand \
+                 evaluations in all: expected at most {MAX_EXPERIMENT_EVALUATIONS:.0e} {lower}"
+            ),
+        ));
+    }
+    if jobs > MAX_JOBS {
+        return Err(SpecError::at(
+            "budgets",
+            format!(
+                "the experiment has {jobs:.0} jobs ({whole}): expected at most {MAX_JOBS:.0e} {lower}"
+            ),
+        ));
+    }
+    if written > MAX_RESULTS_BYTES {
+        return Err(SpecError::at(
+            "budgets",
+            format!(
+                "the experiment's {jobs:.0} jobs of {channels:.0} channels each would write about \
+                 {:.1} GB of results: expected at most {:.1} GB {lower}",
+                written / 1e9,
+                MAX_RESULTS_BYTES / 1e9
+            ),
+        ));
+    }
+    Ok(())
+}
