@@ -1,10 +1,11 @@
 //! The cost guards: a job's and an experiment's estimated evaluations, bytes
 //! and jobs against their limits, refused before anything runs.
 
-use super::min_budget;
 use crate::error::SpecError;
 use crate::experiment::spec::ExperimentSpec;
 use crate::family::{Family, Method};
+
+use super::min_budget;
 
 /// The most integrand evaluations one job may cost by its family's estimate
 /// ([`Family::cost`]): 1e11, minutes to hours at a nanosecond or more per

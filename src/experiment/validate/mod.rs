@@ -30,6 +30,7 @@ use std::collections::BTreeMap;
 use super::reference::{Known, known_values};
 use super::source::Origin;
 use super::spec::{Budgets, ExperimentSpec};
+
 pub use crate::error::SpecError;
 use crate::family::{Estimator, Family, Method, Quantity};
 use crate::quadrature::Rule;
@@ -43,12 +44,15 @@ pub use cost::{
     MAX_EXPERIMENT_EVALUATIONS, MAX_JOB_BYTES, MAX_JOB_EVALUATIONS, MAX_JOBS, MAX_RESULTS_BYTES,
     cost_limit_lifted, lift_cost_limit,
 };
+
 pub use parse::{deserialize, parse_and_load, parse_json};
 
 /// Largest budget accepted (per smooth piece).
 pub const MAX_BUDGET: i64 = 100_000_000;
+
 /// Most budgets a range may expand to.
 const MAX_BUDGETS: usize = 200;
+
 /// A validated experiment of family `F`, ready to run.
 #[derive(Debug)]
 pub struct Experiment<F: Family> {
@@ -66,6 +70,7 @@ pub struct Experiment<F: Family> {
     /// Where its file came from: Mitsuba values are looked for relative to it.
     pub origin: Origin,
 }
+
 /// Validates a parsed experiment whose file hashes to `hash`, as if its file
 /// were in the working folder.
 pub fn validate<F: Family>(
@@ -74,6 +79,7 @@ pub fn validate<F: Family>(
 ) -> Result<Experiment<F>, SpecError> {
     validate_from(spec, hash, Origin::default())
 }
+
 /// Validates a parsed experiment whose file hashes to `hash` and came from
 /// `origin` (a Mitsuba values file is looked for relative to it).
 pub fn validate_from<F: Family>(
@@ -120,6 +126,7 @@ pub fn validate_from<F: Family>(
         origin,
     })
 }
+
 /// The smallest budget `method` needs for every quantity of the experiment.
 pub fn min_budget<F: Family>(
     scene: &F::Scene,
@@ -132,10 +139,12 @@ pub fn min_budget<F: Family>(
         .max()
         .unwrap_or(1)
 }
+
 /// The longest experiment name: it names a folder, and file systems refuse
 /// names past 255 bytes (a 300-character name passed `check` and failed the
 /// run with an empty folder left).
 pub const MAX_NAME: usize = 100;
+
 /// Name, family tag, equation IDs, quantities, repeats and targets.
 fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
     let name_ok = !spec.name.is_empty()
@@ -210,6 +219,7 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
     }
     Ok(())
 }
+
 /// Every rule's parameters, and that every rule and estimator can compute
 /// every quantity asked for (a rule in the quantity's dimension; an
 /// estimator only the quantities it estimates).
@@ -278,6 +288,7 @@ fn check_methods<F: Family>(spec: &ExperimentSpec<F>, scene: &F::Scene) -> Resul
     }
     Ok(())
 }
+
 /// The budgets, ascending and distinct.
 fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
     let check = |path: String, n: i64| -> Result<usize, SpecError> {
@@ -318,6 +329,7 @@ fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
     out.dedup();
     Ok(out)
 }
+
 /// `from, from * factor, ... <= to`, each at least one above the last (so
 /// factors near 1 still advance), at most [`MAX_BUDGETS`] of them.
 fn geometric(from: usize, to: usize, factor: f64) -> Result<Vec<usize>, SpecError> {
@@ -345,6 +357,7 @@ fn geometric(from: usize, to: usize, factor: f64) -> Result<Vec<usize>, SpecErro
         v.push(next);
     }
 }
+
 /// Literal reference values, checked: finite, one per quantity.
 pub fn literal_values<Q: Quantity>(
     values: &BTreeMap<Q, super::spec::Literal>,

@@ -1,5 +1,6 @@
-//! Bounds of the terms from the scene's numbers alone, which refuse a scene
-//! whose I would pass the f64 range before any job runs.
+//! Bounds from the scene's numbers alone: of the terms I_E, I_B and I_L,
+//! which refuse the quantity I (the terms may still be asked for alone) where
+//! their sum could pass the f64 range, and a bound rounded down to print.
 
 use std::sync::Arc;
 

@@ -2,6 +2,9 @@
 //! layer sees it: the scene format of an experiment file (`"family":
 //! "volume"`), its quantities, the tracking estimators beside the rules, the
 //! closed forms and the converged reference.
+//! The family and its quantities are here; a job's evaluation is in
+//! `estimate`, the closed forms in `closed_form`, the scene's term bounds in
+//! `bounds`, and the file's format in `spec`.
 //!
 //! ```
 //! use lightquad::family::{Family, Method};
