@@ -1,0 +1,326 @@
+//! The sum over one axis of nodes, [`product_sum`]'s in one dimension and
+//! [`line_sum_par`]'s across threads: groups of values summed between the
+//! integrand's calls, in lanes.
+//!
+//! [`product_sum`]: super::product_sum
+
+use crate::error::QuadError;
+use crate::sum::{Kernel, KernelTask, LaneValues, Lanes, with_kernel};
+use crate::value::Value;
+
+use super::{ProductSum, UnitNodes, in_range, non_finite};
+
+/// Nodes per span of [`line_sum_par`]: a multiple of `BLOCK`, fixed, so
+/// the spans, and with them the result, do not depend on the number of
+/// threads. Some 0.2 ms of `cos(50 x)`, long against rayon's hand-over of
+/// a span (microseconds) and short enough that 1e6 nodes make 62 spans for
+/// two to eight threads to share evenly.
+pub const PAR_SPAN: usize = 1 << 14;
+
+/// [`product_sum`] on one axis, its nodes shared among rayon's threads:
+/// the axis is cut into spans of [`PAR_SPAN`] nodes, each summed as
+/// [`product_sum`] sums a whole axis (the same blocks, the same lanes, the
+/// same compensated sum), and the spans' sums are merged in node order
+/// ([`Lanes::merge`]). So the value is the same, bit for bit, whatever the
+/// number of threads, and the same as [`product_sum`]'s up to `n <=
+/// PAR_SPAN`; above, it differs from it in rounding only (the lanes restart
+/// at every span; both are compensated sums).
+///
+/// `f` is called from several threads at once, at nodes in no particular
+/// order. An error (a non-finite value, a sum out of range, or the
+/// integrand's own) is the one [`product_sum`] would give: that of the
+/// first span, in node order, that fails, and in it of the first failing
+/// block. Spans after a failed span that have not started yet are skipped;
+/// spans before it all run, and spans already started run to their end. A
+/// panic of `f` is an outcome of its span like an error: it reaches the
+/// caller only where no span before it failed, as with [`product_sum`]
+/// (the panic hook may still print the message of one that is then
+/// dropped).
+///
+/// ```
+/// use lightquad::quadrature::gauss_legendre::unit_nodes;
+/// use lightquad::quadrature::nodes::line_sum_par;
+///
+/// // int_0^1 cos(50 u) du = sin(50)/50 with a million Gauss nodes.
+/// let nodes = unit_nodes(1_000_000)?;
+/// let sum = line_sum_par(&nodes, |u| Ok((50.0 * u).cos()))?;
+/// assert!((sum.value - 50f64.sin() / 50.0).abs() < 1e-17);
+/// assert_eq!(sum.evaluations, 1_000_000);
+/// # Ok::<(), lightquad::error::QuadError>(())
+/// ```
+///
+/// [`product_sum`]: super::product_sum
+pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
+    a: &UnitNodes,
+    f: F,
+) -> Result<ProductSum<V>, QuadError> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    // The lowest span that has failed (or panicked) so far: later spans
+    // need not run.
+    let failed = AtomicUsize::new(usize::MAX);
+    let spans: Vec<Option<SpanOutcome<V>>> = (0..a.len().div_ceil(PAR_SPAN))
+        .into_par_iter()
+        .map(|k| {
+            if k > failed.load(Ordering::Relaxed) {
+                return None;
+            }
+            let range = k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len());
+            // `f` is only borrowed, and a span that panicked is never
+            // read: nothing broken by the panic is seen again.
+            let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                LineSum::of_span(a, range, &f)
+            }));
+            if !matches!(span, Ok(Ok(_))) {
+                failed.fetch_min(k, Ordering::Relaxed);
+            }
+            Some(span)
+        })
+        .collect();
+    let mut total = LineSum::new();
+    // In node order: the first failed span is reached before any skipped
+    // one (a span is skipped only after one before it failed), and a panic
+    // resumes only when no span before it failed.
+    for span in spans.into_iter().flatten() {
+        match span {
+            Ok(span) => total.merge(&span?),
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
+    }
+    in_range(total.finish(a))
+}
+
+/// What one span of [`line_sum_par`] came to: its sums, the integrand's
+/// error, or the payload of its panic.
+type SpanOutcome<V> = std::thread::Result<Result<LineSum<V>, QuadError>>;
+
+/// Nodes per block of [`LineSum::add_span`]: the values of a block are
+/// checked finite at once, and the companions summed. 256 rather than 64:
+/// each block's check and hand-over cost some 1.3% of the evaluations of
+/// `cos(50 x)` at 64 (paired rounds of `examples/gl_race.rs`, lightquad over
+/// bilby 1.047, 1.058, 1.047 at 64 against 1.034, 1.046, 1.032 at 256, when
+/// the block was summed after it was evaluated). The buffer is 2 KiB for a
+/// scalar, 12 KiB for the largest value.
+const BLOCK: usize = 256;
+
+/// Nodes per group of [`LineSum::add_span`]: the integrand is evaluated
+/// at a group, then the group before it is summed. A multiple of
+/// [`crate::sum::LANES`], so a block's lanes take the same terms as when
+/// the block is summed at once (the same bits).
+const GROUP: usize = 16;
+
+const _: () = assert!(BLOCK.is_multiple_of(GROUP) && GROUP.is_multiple_of(crate::sum::LANES));
+
+// A span of `line_sum_par` is whole blocks, so its blocks are `product_sum`'s.
+
+const _: () = assert!(PAR_SPAN.is_multiple_of(BLOCK));
+
+/// The running sums of [`product_sum`] on one axis (and of each span of
+/// [`line_sum_par`]): the weighted sum and its companions in lanes, `sum |w
+/// y|` and the largest term.
+///
+/// [`product_sum`]: super::product_sum
+#[derive(Clone, Copy)]
+pub(super) struct LineSum<V: Value> {
+    value: Lanes<V>,
+    companions: [Lanes<V>; 3],
+    magnitude: LaneValues<V>,
+    largest: LaneValues<V>,
+}
+
+impl<V: Value> LineSum<V> {
+    pub(super) fn new() -> Self {
+        Self {
+            value: Lanes::new(),
+            companions: [Lanes::new(); 3],
+            magnitude: LaneValues::zero(),
+            largest: LaneValues::zero(),
+        }
+    }
+
+    /// Adds the nodes `range` of `a`. The integrand is evaluated at a
+    /// group of [`GROUP`] nodes, then the group before it is summed, in
+    /// [`crate::sum::LANES`] independent lanes (the compensated sum, `sum |w
+    /// y|` and the largest term in one pass), all in one function compiled
+    /// for the lanes' kernel ([`with_kernel`]): AVX where the CPU has it.
+    ///
+    /// Why this shape, measured on `cos(50 x)` at n = 1e6 against bilby's
+    /// plain loop (`examples/gl_race.rs`):
+    /// - An integrand that calls a function (`cos`) clobbers every
+    ///   floating-point register, so sums carried across each call are
+    ///   stored and reloaded at every node: 1.13 to 1.18 times the bare
+    ///   evaluations, term by term.
+    /// - A whole block of 256 values summed after it is evaluated kept the
+    ///   sums in registers, but the pass (a chain of dependent additions)
+    ///   then ran alone, not in the shadow of the calls: 1.02 to 1.03 times
+    ///   bilby, with the pass in AVX called once a block.
+    /// - Groups of 16, summed between the calls in the same function, hide
+    ///   the pass behind the calls: 1.00 to 1.01 times bilby (groups of 8
+    ///   and of 32 came out at 1.03).
+    /// - The integrand is taken by value: through a reference, each node
+    ///   reloaded the captures' addresses before their values (2.5%).
+    /// - In [`line_sum_par`]'s spans the compiler had left the pass a call
+    ///   once a group (a `#[inline]` function compiled for AVX; it may not
+    ///   be `inline(always)`): 1.01 to 1.05 times gauss-quad's parallel sum.
+    ///   The pass is now an `inline(always)` closure: 0.98 to 1.00.
+    ///
+    /// The values are checked finite once a block of [`BLOCK`] nodes,
+    /// through the block's `sum |w y|` (a NaN or infinite value makes it
+    /// non-finite, and then the block is searched for the first such node):
+    /// a check at every node cost about 5% of the evaluations of `cos(50
+    /// x)`. So `f` may be called at up to 255 nodes after a non-finite value,
+    /// and an error `f` returns at one of them is reported instead of that
+    /// value (reporting the value first, with the loop that took, cost
+    /// another 8% at n = 1e6). `magnitude` is summed a block at a time, so it
+    /// can differ from a term-by-term sum in its last few bits. The
+    /// companions' lanes take a block at a time.
+    #[inline(always)]
+    pub(super) fn add_span(
+        &mut self,
+        a: &UnitNodes,
+        range: std::ops::Range<usize>,
+        f: impl FnMut(f64) -> Result<V, QuadError>,
+    ) -> Result<(), QuadError> {
+        with_kernel(Span {
+            sums: self,
+            a,
+            range,
+            f,
+        })
+    }
+
+    /// The sums over the nodes `range` of `a`. Not inlined: in rayon's
+    /// deeply inlined worker the integrand was left a call of its own at
+    /// every node.
+    #[inline(never)]
+    fn of_span(
+        a: &UnitNodes,
+        range: std::ops::Range<usize>,
+        f: &impl Fn(f64) -> Result<V, QuadError>,
+    ) -> Result<Self, QuadError> {
+        let mut sum = Self::new();
+        sum.add_span(a, range, f)?;
+        Ok(sum)
+    }
+
+    /// Adds the sums of a span that follows the spans already added.
+    fn merge(&mut self, other: &Self) {
+        self.value.merge(&other.value);
+        for (lanes, more) in self.companions.iter_mut().zip(&other.companions) {
+            lanes.merge(more);
+        }
+        self.magnitude.add(&other.magnitude);
+        self.largest.max_with(&other.largest);
+    }
+
+    /// The sums over every node of `a`, once all are added.
+    pub(super) fn finish(&self, a: &UnitNodes) -> ProductSum<V> {
+        let [c, c4, c8] = &self.companions;
+        ProductSum {
+            value: self.value.total(),
+            companion: a.companion.as_ref().map(|_| c.total()),
+            companion4: a.companion4.as_ref().map(|_| c4.total()),
+            companion8: a.companion8.as_ref().map(|_| c8.total()),
+            magnitude: self.magnitude.sum(),
+            largest: self.largest.max(),
+            evaluations: a.u.len() as u64,
+        }
+    }
+}
+
+/// [`LineSum::add_span`] as a [`KernelTask`]: the nodes `range` of `a`
+/// added to `sums`.
+struct Span<'a, V: Value, F> {
+    sums: &'a mut LineSum<V>,
+    a: &'a UnitNodes,
+    range: std::ops::Range<usize>,
+    f: F,
+}
+
+impl<V: Value, F: FnMut(f64) -> Result<V, QuadError>> KernelTask<V> for Span<'_, V, F> {
+    type Output = Result<(), QuadError>;
+
+    /// The integrand at a group of [`GROUP`] nodes, then the group's
+    /// products into the lanes, group after group; the finite check and
+    /// the companions a block of [`BLOCK`] nodes at a time.
+    #[inline(always)]
+    fn run(self, kernel: impl Kernel<V>) -> Self::Output {
+        let Self {
+            sums,
+            a,
+            range,
+            mut f,
+        } = self;
+        let companions = [
+            a.companion.as_deref(),
+            a.companion4.as_deref(),
+            a.companion8.as_deref(),
+        ];
+        let (u, w) = (&a.u[range.clone()], &a.w[range.clone()]);
+        // Local copies of the sums, which the compiler keeps apart from `sums`.
+        let LineSum {
+            mut value,
+            companions: mut others,
+            mut magnitude,
+            mut largest,
+        } = *sums;
+        let mut ys = [V::zero(); BLOCK];
+        for (block, (us, ws)) in u.chunks(BLOCK).zip(w.chunks(BLOCK)).enumerate() {
+            let ys = &mut ys[..us.len()];
+            let mut block_magnitude = LaneValues::zero();
+            // The integrand a group of `GROUP` nodes at a time (a loop of
+            // known length, unrolled), and the group before it summed after
+            // it: by then the values' stores have left the store buffer, and
+            // a load of four of them as one vector does not wait on them.
+            let (groups, tail) = us.as_chunks::<GROUP>();
+            let mut pending = 0..0;
+            for (g, ug) in groups.iter().enumerate() {
+                let start = g * GROUP;
+                for (y, &u) in ys[start..start + GROUP].iter_mut().zip(ug) {
+                    *y = f(u)?;
+                }
+                value.add_products_scaled_in(
+                    kernel,
+                    &ys[pending.clone()],
+                    &ws[pending],
+                    &mut block_magnitude,
+                    &mut largest,
+                );
+                pending = start..start + GROUP;
+            }
+            let start = groups.len() * GROUP;
+            for (y, &u) in ys[start..].iter_mut().zip(tail) {
+                *y = f(u)?;
+            }
+            for group in [pending, start..us.len()] {
+                value.add_products_scaled_in(
+                    kernel,
+                    &ys[group.clone()],
+                    &ws[group],
+                    &mut block_magnitude,
+                    &mut largest,
+                );
+            }
+            if !block_magnitude.all_finite()
+                && let Some((u, y)) = us.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
+            {
+                return Err(non_finite(&[*u], y));
+            }
+            magnitude.add(&block_magnitude);
+            let start = range.start + block * BLOCK;
+            for (lanes, c) in others.iter_mut().zip(companions) {
+                if let Some(c) = c {
+                    lanes.add_products_in(kernel, ys, &c[start..start + us.len()]);
+                }
+            }
+        }
+        *sums = LineSum {
+            value,
+            companions: others,
+            magnitude,
+            largest,
+        };
+        Ok(())
+    }
+}

@@ -1,0 +1,233 @@
+//! Weighted node sets on the unit interval and the one shared summation that
+//! turns (tensor products of) them into an integral.
+//!
+//! `line` sums one axis (in groups between the integrand's calls, in lanes,
+//! and across threads in [`line_sum_par`]); `composite` holds the
+//! trapezoid and Simpson rules as data ([`Composite`]); `estimate` turns
+//! nested sums into Richardson's error estimate ([`richardson`]) and checks
+//! that no single node carries the sum ([`dominated`]).
+
+use crate::error::QuadError;
+use crate::sum::Compensated;
+use crate::value::Value;
+
+mod composite;
+mod estimate;
+mod line;
+
+pub use composite::{CHECKED_POINTS, Composite, MAX_POINTS, coarse_weights};
+pub(crate) use estimate::ROUNDING_ULPS;
+pub use estimate::{DOMINANT_SHARE, dominated, richardson};
+use line::LineSum;
+pub use line::{PAR_SPAN, line_sum_par};
+
+/// A 1-D rule on `[0, 1]`: nodes `u_i` and weights `w_i` with `sum w_i = 1`
+/// (so the rule estimates `int_0^1 f(u) du` by `sum w_i f(u_i)`), and optional
+/// companion weights on the same nodes for an embedded error estimate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnitNodes {
+    /// Nodes in `[0, 1]`, ascending.
+    pub u: Vec<f64>,
+    /// Weights, summing to 1.
+    pub w: Vec<f64>,
+    /// Weights of a lower-order companion rule on the same nodes (zero where
+    /// the companion has no node), when the rule has one.
+    pub companion: Option<Vec<f64>>,
+    /// Weights of the companion's own companion (a composite rule's `4h`
+    /// rule), when the node set nests it.
+    pub companion4: Option<Vec<f64>>,
+    /// Weights of the `8h` rule (zero off its nodes), when the node set
+    /// has it: a third difference lets [`richardson`] check that the order
+    /// it sees holds over two ratios.
+    pub companion8: Option<Vec<f64>>,
+}
+
+impl UnitNodes {
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.u.len()
+    }
+
+    /// True when the rule has no nodes.
+    pub fn is_empty(&self) -> bool {
+        self.u.is_empty()
+    }
+}
+
+/// The result of one pass over a tensor-product node set.
+#[derive(Debug, Clone, Copy)]
+pub struct ProductSum<V: Value> {
+    /// `sum_i prod_d w_{i_d} f(u_i)`.
+    pub value: V,
+    /// The same sum with the companion weights, when every axis has them.
+    pub companion: Option<V>,
+    /// The same sum with the `companion4` weights, when every axis has them.
+    pub companion4: Option<V>,
+    /// The same sum with the `companion8` weights, when every axis has them.
+    pub companion8: Option<V>,
+    /// `max_i |prod_d w_{i_d} f(u_i)|`: the largest single term. When it is a
+    /// large share of `magnitude` the sum rests on one node
+    /// ([`dominated`]).
+    pub largest: V,
+    /// `sum_i |prod_d w_{i_d} f(u_i)|`, the scale of the sum's rounding error:
+    /// a difference of two rules below a small multiple of `eps` times it is
+    /// rounding, not truncation. A plain sum: its own `n eps` relative error
+    /// does not matter for a scale.
+    pub magnitude: V,
+    /// Integrand evaluations.
+    pub evaluations: u64,
+}
+
+/// Sums `f` over the tensor product of `axes` with compensated summation.
+///
+/// With [`line_sum_par`], the only place where a deterministic rule meets
+/// the integrand.
+/// A non-finite integrand value stops the sum with an error naming the point
+/// (on one axis, at the end of the block of 256 nodes it is in). Finite
+/// values within rounding of `f64::MAX`, whose sum passes it on the way,
+/// are summed on one axis (see [`crate::sum::Lanes::total`]); in two and
+/// more dimensions such a sum is [`QuadError::SumOutOfRange`], never a sum
+/// that is not finite.
+pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
+    axes: [&UnitNodes; D],
+    mut f: F,
+) -> Result<ProductSum<V>, QuadError> {
+    let with_companion = axes.iter().all(|a| a.companion.is_some());
+    let with_companion4 = axes.iter().all(|a| a.companion4.is_some());
+    let with_companion8 = axes.iter().all(|a| a.companion8.is_some());
+    let mut acc = Compensated::<V>::new();
+    let mut acc_c = Compensated::<V>::new();
+    let mut acc_c4 = Compensated::<V>::new();
+    let mut acc_c8 = Compensated::<V>::new();
+    let mut magnitude = V::zero();
+    let mut largest = V::zero();
+    let mut evaluations = 0u64;
+    if axes.iter().any(|a| a.is_empty()) {
+        return Ok(ProductSum {
+            value: V::zero(),
+            companion: with_companion.then(V::zero),
+            companion4: with_companion4.then(V::zero),
+            companion8: with_companion8.then(V::zero),
+            magnitude,
+            largest,
+            evaluations,
+        });
+    }
+
+    if D == 1 {
+        return line_sum(axes[0], move |u| {
+            let mut p = [0.0; D];
+            p[0] = u;
+            f(p)
+        });
+    }
+    // D dimensions: walk the index odometer.
+    let mut idx = [0usize; D];
+    loop {
+        let mut p = [0.0; D];
+        let mut w = 1.0;
+        let mut wc = 1.0;
+        let mut wc4 = 1.0;
+        let mut wc8 = if with_companion8 { 1.0 } else { 0.0 };
+        for d in 0..D {
+            p[d] = axes[d].u[idx[d]];
+            w *= axes[d].w[idx[d]];
+            if with_companion {
+                wc *= axes[d].companion.as_ref().map_or(0.0, |c| c[idx[d]]);
+            }
+            if with_companion4 {
+                wc4 *= axes[d].companion4.as_ref().map_or(0.0, |c| c[idx[d]]);
+            }
+            if with_companion8 && wc8 != 0.0 {
+                wc8 *= axes[d].companion8.as_ref().map_or(0.0, |c| c[idx[d]]);
+            }
+        }
+        let y = f(p)?;
+        evaluations += 1;
+        if !y.all_finite() {
+            return Err(non_finite(&p, &y));
+        }
+        let wy = y.map(|v| v * w);
+        acc.add(wy);
+        magnitude = magnitude.zip(wy, |m, v| m + v.abs());
+        largest = largest.zip(wy, |m, v| m.max(v.abs()));
+        if with_companion8 && wc8 != 0.0 {
+            acc_c8.add(y.map(|v| v * wc8));
+        }
+        if with_companion {
+            acc_c.add(y.map(|v| v * wc));
+        }
+        if with_companion4 && wc4 != 0.0 {
+            acc_c4.add(y.map(|v| v * wc4));
+        }
+        // Advance the odometer, last axis fastest.
+        let mut d = D;
+        loop {
+            if d == 0 {
+                return in_range(ProductSum {
+                    value: acc.total(),
+                    companion: with_companion.then(|| acc_c.total()),
+                    companion4: with_companion4.then(|| acc_c4.total()),
+                    companion8: with_companion8.then(|| acc_c8.total()),
+                    magnitude,
+                    largest,
+                    evaluations,
+                });
+            }
+            d -= 1;
+            idx[d] += 1;
+            if idx[d] < axes[d].u.len() {
+                break;
+            }
+            idx[d] = 0;
+        }
+    }
+}
+
+/// [`product_sum`] on one axis: [`LineSum::add_span`] over all its nodes.
+fn line_sum<V: Value>(
+    a: &UnitNodes,
+    f: impl FnMut(f64) -> Result<V, QuadError>,
+) -> Result<ProductSum<V>, QuadError> {
+    let mut sum = LineSum::new();
+    sum.add_span(a, 0..a.len(), f)?;
+    in_range(sum.finish(a))
+}
+
+/// `sum` with `magnitude` at most `f64::MAX`, or
+/// [`QuadError::SumOutOfRange`] where a weighted sum of its finite terms is
+/// not finite. Weights that sum to 1 keep an integral within the range of
+/// the values, but not every running sum: the sum of `f64::MAX` on 1e5
+/// Gauss nodes came out NaN, where the integral is `f64::MAX`
+/// ([`crate::sum::Lanes::total`] now finds it; the odometer's single
+/// running sum of [`product_sum`] in two and more dimensions can still
+/// pass the range). `sum |w f|` passes `f64::MAX` only by rounding (it is
+/// at most `max |f|` times the weights' sum, 1), so it is kept at
+/// `f64::MAX`: a scale of rounding, not a value.
+fn in_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError> {
+    let sums = [
+        Some(sum.value),
+        sum.companion,
+        sum.companion4,
+        sum.companion8,
+    ];
+    if sums.iter().flatten().all(Value::all_finite) {
+        Ok(ProductSum {
+            magnitude: sum.magnitude.map(|m| m.min(f64::MAX)),
+            ..sum
+        })
+    } else {
+        Err(QuadError::SumOutOfRange {
+            value: format!("{:?}", sum.value),
+            largest: format!("{:?}", sum.largest),
+        })
+    }
+}
+
+/// The error for a non-finite integrand value at unit-cube point `p`.
+pub fn non_finite<V: Value>(p: &[f64], y: &V) -> QuadError {
+    QuadError::NonFiniteIntegrand {
+        point: p.to_vec(),
+        value: format!("{y:?}"),
+    }
+}
