@@ -1,5 +1,5 @@
 //! [`AnyRule`]: any rule selected at run time, by name or by its serde
-//! form, products included.
+//! form, products included, and [`BaseRule::by_name`], which it builds on.
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};

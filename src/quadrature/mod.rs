@@ -55,7 +55,6 @@ mod replay;
 pub use any::AnyRule;
 pub use limits::{MAX_BUDGET, MAX_RULE_BYTES, integer_root, per_axis};
 pub(crate) use limits::{check_budget, check_tolerances};
-
 pub use product::Product;
 
 use schemars::JsonSchema;

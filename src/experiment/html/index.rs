@@ -17,14 +17,6 @@ use super::{document, num_cell, rule_cell};
 /// own, leaving the earlier pages unlinked).
 pub const EARLIER: &str = "Also in this folder, from earlier runs and not part of this one (their pages are as those runs left them)";
 
-/// SVG text without an XML declaration, to sit inside HTML.
-pub(super) fn strip_xml_declaration(svg: &str) -> &str {
-    match svg.trim_start().strip_prefix("<?xml") {
-        Some(rest) => rest.split_once("?>").map_or(svg, |(_, body)| body),
-        None => svg,
-    }
-}
-
 /// Writes `<out>/index.html`: every experiment linked, per quantity the rules
 /// ranked by time to the middle target (a chart and a sortable table), the
 /// Mitsuba comparison and the families' audits.

@@ -91,6 +91,7 @@ figcaption { color: var(--muted); font-size: .9rem; }
 ul.toc { columns: 3 18rem; padding-left: 1.2rem; }
 .chart svg { max-width: 100%; height: auto; }
 "#;
+
 /// Sorts a table by the clicked header: numerically where the column's cells
 /// are numbers (a cell's `data-sort` first), cells with no number ("—",
 /// "not reached") last either way; a second click reverses.
@@ -138,6 +139,7 @@ const JS: &str = r#"
   });
 })();
 "#;
+
 /// A whole page around `body`.
 fn document(title: &str, body: &str) -> String {
     format!(
@@ -147,6 +149,7 @@ fn document(title: &str, body: &str) -> String {
         escape(title)
     )
 }
+
 /// A rule's name with its colour swatch.
 fn rule_cell(label: &str) -> String {
     format!(
@@ -156,6 +159,7 @@ fn rule_cell(label: &str) -> String {
         escape(label)
     )
 }
+
 /// A numeric cell: `text` shown, `value` sorted by.
 fn num_cell(text: &str, value: f64) -> String {
     if value.is_finite() {
@@ -166,13 +170,4 @@ fn num_cell(text: &str, value: f64) -> String {
     } else {
         format!("<td class=\"num\">{}</td>", escape(text))
     }
-}
-/// A header cell with its long meaning as a tooltip.
-fn th(short: &str, long: &str, numeric: bool) -> String {
-    format!(
-        "<th{} title=\"{}\">{}</th>",
-        if numeric { " class=\"num\"" } else { "" },
-        escape(long),
-        escape(short)
-    )
 }

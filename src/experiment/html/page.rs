@@ -1,5 +1,6 @@
 //! One experiment's page, `<out>/<name>/index.html`: its facts, equations,
-//! sections and pictures.
+//! table of contents and cross-check; each quantity's section comes from
+//! `section`.
 
 use std::fmt::Write as _;
 use std::path::Path;

@@ -1,14 +1,13 @@
-//! One section of an experiment's page: the table of a quantity's rows,
-//! its flags and its plot.
+//! One quantity's section of an experiment's page: its plots, images,
+//! fitted orders and times, and the table of its rows with their flags.
 
 use std::fmt::Write as _;
 
 use crate::experiment::markdown::escape;
 use crate::experiment::report::{Page, Row, RowFlag, Section, cell, label, show_value};
 
-use super::index::strip_xml_declaration;
 use super::page::q_anchor;
-use super::{num_cell, rule_cell, th};
+use super::{num_cell, rule_cell};
 
 /// True for flags that say a row is not to be trusted as it stands.
 fn alarming(f: &RowFlag) -> bool {
@@ -233,4 +232,22 @@ fn row(page: &Page, r: &Row, multi: bool, display: bool) -> String {
         num_cell(&format!("{:.2e}", r.seconds), r.seconds),
         escape(&flags.join("; "))
     )
+}
+
+/// A header cell with its long meaning as a tooltip.
+fn th(short: &str, long: &str, numeric: bool) -> String {
+    format!(
+        "<th{} title=\"{}\">{}</th>",
+        if numeric { " class=\"num\"" } else { "" },
+        escape(long),
+        escape(short)
+    )
+}
+
+/// SVG text without an XML declaration, to sit inside HTML.
+fn strip_xml_declaration(svg: &str) -> &str {
+    match svg.trim_start().strip_prefix("<?xml") {
+        Some(rest) => rest.split_once("?>").map_or(svg, |(_, body)| body),
+        None => svg,
+    }
 }

@@ -8,8 +8,7 @@ use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
 
-use super::estimate::richardson;
-use super::{UnitNodes, product_sum};
+use super::{UnitNodes, product_sum, richardson};
 
 /// Fewest points per axis at which a composite rule's estimate is trusted.
 /// Below it the rule has at most 8 intervals; a narrow peak between its

@@ -74,8 +74,9 @@ pub fn dominated<V: Value>(largest: V, magnitude: V, max_weight: f64) -> bool {
 /// Where `Q_h`, `Q_2h` and `Q_4h` agree to rounding (`|d_1|, |d_2| <= 128
 /// eps sum |w f|`) the rule has converged, and the coarsest difference,
 /// which may still be large, is capped as Gauss–Legendre caps its drowned
-/// differences ([`crate::quadrature::gauss_legendre::hybrid_estimate`]): `max(eps M,
-/// min(E, m 128 eps M))`, `m` the `points` per axis. The trapezoid on a
+/// differences
+/// ([`crate::quadrature::gauss_legendre::hybrid_estimate`]):
+/// `max(eps M, min(E, m 128 eps M))`, `m` the `points` per axis. The trapezoid on a
 /// periodic integrand converges faster than any power, and an `8h` rule
 /// with a finer tail is not exact for it. Two rules agreeing are not
 /// enough: by the symmetry of `sin`, `Q_h` and `Q_2h` of the trapezoid on

@@ -113,8 +113,19 @@ const GROUP: usize = 16;
 const _: () = assert!(BLOCK.is_multiple_of(GROUP) && GROUP.is_multiple_of(crate::sum::LANES));
 
 // A span of `line_sum_par` is whole blocks, so its blocks are `product_sum`'s.
-
 const _: () = assert!(PAR_SPAN.is_multiple_of(BLOCK));
+
+/// [`product_sum`] on one axis: [`LineSum::add_span`] over all its nodes.
+///
+/// [`product_sum`]: super::product_sum
+pub(super) fn line_sum<V: Value>(
+    a: &UnitNodes,
+    f: impl FnMut(f64) -> Result<V, QuadError>,
+) -> Result<ProductSum<V>, QuadError> {
+    let mut sum = LineSum::new();
+    sum.add_span(a, 0..a.len(), f)?;
+    in_range(sum.finish(a))
+}
 
 /// The running sums of [`product_sum`] on one axis (and of each span of
 /// [`line_sum_par`]): the weighted sum and its companions in lanes, `sum |w
@@ -122,7 +133,7 @@ const _: () = assert!(PAR_SPAN.is_multiple_of(BLOCK));
 ///
 /// [`product_sum`]: super::product_sum
 #[derive(Clone, Copy)]
-pub(super) struct LineSum<V: Value> {
+struct LineSum<V: Value> {
     value: Lanes<V>,
     companions: [Lanes<V>; 3],
     magnitude: LaneValues<V>,
@@ -130,7 +141,7 @@ pub(super) struct LineSum<V: Value> {
 }
 
 impl<V: Value> LineSum<V> {
-    pub(super) fn new() -> Self {
+    fn new() -> Self {
         Self {
             value: Lanes::new(),
             companions: [Lanes::new(); 3],
@@ -176,7 +187,7 @@ impl<V: Value> LineSum<V> {
     /// can differ from a term-by-term sum in its last few bits. The
     /// companions' lanes take a block at a time.
     #[inline(always)]
-    pub(super) fn add_span(
+    fn add_span(
         &mut self,
         a: &UnitNodes,
         range: std::ops::Range<usize>,
@@ -215,7 +226,7 @@ impl<V: Value> LineSum<V> {
     }
 
     /// The sums over every node of `a`, once all are added.
-    pub(super) fn finish(&self, a: &UnitNodes) -> ProductSum<V> {
+    fn finish(&self, a: &UnitNodes) -> ProductSum<V> {
         let [c, c4, c8] = &self.companions;
         ProductSum {
             value: self.value.total(),

@@ -18,7 +18,7 @@ mod line;
 pub use composite::{CHECKED_POINTS, Composite, MAX_POINTS, coarse_weights};
 pub(crate) use estimate::ROUNDING_ULPS;
 pub use estimate::{DOMINANT_SHARE, dominated, richardson};
-use line::LineSum;
+use line::line_sum;
 pub use line::{PAR_SPAN, line_sum_par};
 
 /// A 1-D rule on `[0, 1]`: nodes `u_i` and weights `w_i` with `sum w_i = 1`
@@ -182,16 +182,6 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
             idx[d] = 0;
         }
     }
-}
-
-/// [`product_sum`] on one axis: [`LineSum::add_span`] over all its nodes.
-fn line_sum<V: Value>(
-    a: &UnitNodes,
-    f: impl FnMut(f64) -> Result<V, QuadError>,
-) -> Result<ProductSum<V>, QuadError> {
-    let mut sum = LineSum::new();
-    sum.add_span(a, 0..a.len(), f)?;
-    in_range(sum.finish(a))
 }
 
 /// `sum` with `magnitude` at most `f64::MAX`, or
