@@ -1,0 +1,346 @@
+//! The files of a run: the results file read back (only the lines that are
+//! results of this experiment's jobs) and written whole or not at all, the
+//! report files written atomically, stale reports and temporaries cleared.
+
+use std::collections::BTreeSet;
+use std::fs::{self, File, OpenOptions};
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::experiment::validate::Experiment;
+use crate::family::{Family, Quantity};
+
+use super::{JobKey, JobResult, job_seed, jobs};
+
+/// The results read back from a file (`--resume`, `merge`) that are results
+/// of `exp`'s jobs as this version runs them: a job of its list, by the rule
+/// its index names, with the job's own seed (an edited seed was reused), with exactly its quantities, each with its channel count
+/// of finite values and of errors (or a failure). Returns them and how many
+/// were not: a hand-edited line with `"rule_index": 99` was reused as a job
+/// of a rule the file does not have, and one with two channels of a scalar
+/// shown as a value with no error (the hostile probe of issue 10).
+pub fn reusable<F: Family>(
+    exp: &Experiment<F>,
+    results: Vec<JobResult>,
+) -> (Vec<JobResult>, usize) {
+    let jobs: BTreeSet<JobKey> = jobs(exp, None).into_iter().collect();
+    let fits = |r: &JobResult| {
+        let job = r.experiment == exp.spec.name
+            && r.family == F::NAME
+            && jobs.contains(&r.key())
+            && r.seed == job_seed(exp.spec.seed, r.rule_index, r.budget, r.repeat)
+            && exp
+                .spec
+                .rules
+                .get(r.rule_index)
+                .is_some_and(|m| m.label() == r.rule);
+        let shaped = r.failure.is_some()
+            || (r.quantities.len() == exp.spec.quantities.len()
+                && exp.spec.quantities.iter().all(|q| {
+                    let want = F::channels(&exp.scene, *q);
+                    r.quantities.get(q.name()).is_some_and(|m| {
+                        m.value.len() == want
+                            && m.error.len() == want
+                            && m.value.iter().all(|x| x.is_finite())
+                            && !m.error.iter().any(|e| *e < 0.0)
+                    })
+                }));
+        job && shaped && r.seconds.is_finite()
+    };
+    let before = results.len();
+    let kept: Vec<JobResult> = results.into_iter().filter(fits).collect();
+    let dropped = before - kept.len();
+    (kept, dropped)
+}
+
+/// Reads the complete, parseable lines of a results file for `hash`.
+pub fn read_results(path: &Path, hash: Option<&str>) -> Vec<JobResult> {
+    read_results_counted(path, hash).0
+}
+
+/// Lines of a results file that were not read back.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Unread {
+    /// Lines that are not a job's result (torn by a kill, edited, not UTF-8).
+    pub unreadable: usize,
+    /// Results of another version of the experiment file (another hash).
+    pub other_version: usize,
+}
+
+/// [`read_results`], and how many lines it passed over: each line on its
+/// own, so one bad line (torn, or not UTF-8) no longer ends the reading and
+/// silently drops every line after it.
+pub fn read_results_counted(path: &Path, hash: Option<&str>) -> (Vec<JobResult>, Unread) {
+    let mut unread = Unread::default();
+    let Ok(file) = File::open(path) else {
+        return (Vec::new(), unread);
+    };
+    let mut out = Vec::new();
+    for line in BufReader::new(file).split(b'\n') {
+        let Ok(line) = line else {
+            unread.unreadable += 1;
+            break;
+        };
+        if line.iter().all(u8::is_ascii_whitespace) {
+            continue;
+        }
+        match serde_json::from_slice::<JobResult>(&line) {
+            Err(_) => unread.unreadable += 1,
+            Ok(r) if hash.is_some_and(|h| r.experiment_hash != h) => unread.other_version += 1,
+            Ok(r) => out.push(r),
+        }
+    }
+    (out, unread)
+}
+
+/// How many lines of a results file are results of the experiment file
+/// hashing to `hash`: each line is read for its hash alone (an image's
+/// results run to a hundred megabytes, and only the count is said).
+pub(super) fn results_of(path: &Path, hash: &str) -> usize {
+    #[derive(Deserialize)]
+    struct HashOnly {
+        experiment_hash: String,
+    }
+    let Ok(file) = File::open(path) else {
+        return 0;
+    };
+    BufReader::new(file)
+        .split(b'\n')
+        .map_while(Result::ok)
+        .filter(|line| {
+            serde_json::from_slice::<HashOnly>(line).is_ok_and(|h| h.experiment_hash == hash)
+        })
+        .count()
+}
+
+/// Writes `text` to `path` atomically (a temporary file, then a rename), so a
+/// reader never sees a half-written file.
+pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
+    // A name no other process or thread writing beside us can pick (shards of
+    // one run may share an output folder).
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let unique = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = path
+        .file_name()
+        .map_or("out".into(), |n| n.to_string_lossy().to_string());
+    let tmp = path.with_file_name(format!(".{name}.{}.{unique}.tmp", std::process::id()));
+    let written = File::create(&tmp)
+        .and_then(|mut f| {
+            f.write_all(text)?;
+            f.sync_all()
+        })
+        .and_then(|()| fs::rename(&tmp, path));
+    // A write that failed (a full disk) leaves no temporary file behind.
+    if written.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    written
+}
+
+/// Writes every `(path, bytes)` or none. A regular file (or one not there
+/// yet) is written to a temporary file beside it, renamed into place only
+/// when every file is written; a link is followed to the file it names. A
+/// path that is not a regular file (`/dev/full`, a pipe) is written in
+/// place, never renamed over, after the temporary files and before the
+/// renames. On failure the temporary files are removed (and any renamed
+/// already), and the error comes with the index of the file it concerns.
+pub fn write_all_or_none<'a>(
+    files: impl IntoIterator<Item = (&'a Path, &'a [u8])>,
+) -> Result<(), (usize, std::io::Error)> {
+    let files: Vec<(PathBuf, &[u8])> = files
+        .into_iter()
+        .map(|(path, bytes)| {
+            let linked = fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+            let path = match linked.then(|| fs::canonicalize(path)) {
+                Some(Ok(target)) => target,
+                _ => path.to_path_buf(),
+            };
+            (path, bytes)
+        })
+        .collect();
+    let special = |path: &Path| fs::metadata(path).is_ok_and(|m| !m.is_file());
+    let mut temporary: Vec<(usize, PathBuf)> = Vec::with_capacity(files.len());
+    let clean = |temporary: &[(usize, PathBuf)]| {
+        for (_, t) in temporary {
+            let _ = fs::remove_file(t);
+        }
+    };
+    for (k, (path, bytes)) in files.iter().enumerate() {
+        if special(path) {
+            continue;
+        }
+        let name = path
+            .file_name()
+            .map_or("out".into(), |n| n.to_string_lossy().to_string());
+        // The final name is in the temporary one, so that a name the
+        // folder refuses (too long) fails here, before any rename.
+        let tmp = path.with_file_name(format!(".{name}.{}.{k}.tmp", std::process::id()));
+        let written = File::create(&tmp).and_then(|mut f| {
+            f.write_all(bytes)?;
+            f.sync_all()
+        });
+        temporary.push((k, tmp));
+        if let Err(e) = written {
+            clean(&temporary);
+            return Err((k, e));
+        }
+    }
+    for (k, (path, bytes)) in files.iter().enumerate() {
+        if special(path)
+            && let Err(e) = OpenOptions::new()
+                .write(true)
+                .open(path)
+                .and_then(|mut f| f.write_all(bytes))
+        {
+            clean(&temporary);
+            return Err((k, e));
+        }
+    }
+    for (done, (k, tmp)) in temporary.iter().enumerate() {
+        if let Err(e) = fs::rename(tmp, &files[*k].0) {
+            // Neither the rest nor the ones already in place.
+            clean(&temporary[done..]);
+            for (renamed, _) in &temporary[..done] {
+                let _ = fs::remove_file(&files[*renamed].0);
+            }
+            return Err((*k, e));
+        }
+    }
+    Ok(())
+}
+
+thread_local! {
+    /// The files written since [`ReportFiles::begin`] on this thread.
+    static WRITTEN: std::cell::RefCell<Option<Vec<PathBuf>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// A report written whole or not at all: the files [`write_report_file`]
+/// writes on this thread between [`begin`](Self::begin) and
+/// [`finish`](Self::finish) are removed again when the guard is dropped
+/// unfinished (a full disk at the index left the plots and pages written
+/// before it, with no index). Results files are not report files and stay.
+#[derive(Debug)]
+pub struct ReportFiles {
+    finished: bool,
+}
+
+impl ReportFiles {
+    /// Starts recording the report files written on this thread.
+    pub fn begin() -> Self {
+        WRITTEN.with(|w| *w.borrow_mut() = Some(Vec::new()));
+        ReportFiles { finished: false }
+    }
+
+    /// Keeps every file written: the report is complete.
+    pub fn finish(mut self) {
+        self.finished = true;
+        WRITTEN.with(|w| *w.borrow_mut() = None);
+    }
+}
+
+impl Drop for ReportFiles {
+    fn drop(&mut self) {
+        if self.finished {
+            return;
+        }
+        for path in WRITTEN.with(|w| w.borrow_mut().take()).unwrap_or_default() {
+            let _ = fs::remove_file(path);
+        }
+    }
+}
+
+/// [`write_atomic`] for a report's files, its failure in words with the
+/// file named (a full disk said only "No space left on device"); recorded
+/// for [`ReportFiles`].
+pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    WRITTEN.with(|w| {
+        if let Some(list) = w.borrow_mut().as_mut() {
+            list.push(path.to_path_buf());
+        }
+    });
+    write_atomic(path, bytes).map_err(|e| {
+        format!(
+            "cannot write {}: {}",
+            path.display(),
+            crate::experiment::source::describe(&e)
+        )
+    })
+}
+
+/// Whether `name` is one of [`write_atomic`]'s temporary files
+/// (`.<name>.<pid>.<n>.tmp`).
+fn is_temporary(name: &str) -> bool {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let Some(inner) = name.strip_prefix('.').and_then(|n| n.strip_suffix(".tmp")) else {
+        return false;
+    };
+    let mut parts = inner.rsplitn(3, '.');
+    matches!(
+        (parts.next(), parts.next(), parts.next()),
+        (Some(n), Some(pid), Some(file)) if digits(n) && digits(pid) && !file.is_empty()
+    )
+}
+
+/// The extensions of the files a report writes into an experiment's folder
+/// (its pages, its table of results, its plots and images); the results and
+/// the experiment file are not among them.
+const REPORT_EXTENSIONS: [&str; 6] = ["md", "html", "csv", "svg", "png", "pfm"];
+
+/// Removes what an earlier run's report wrote: the index of `out` and the
+/// report files of the experiment folders `names`. A run that is killed
+/// before its own report is written then leaves no report, rather than the
+/// earlier one looking complete beside the new results (and no image of a
+/// rule the experiment no longer has).
+pub fn clear_reports<'a>(out: &Path, names: impl IntoIterator<Item = &'a str>) {
+    for index in ["index.md", "index.html"] {
+        let _ = fs::remove_file(out.join(index));
+    }
+    for name in names {
+        let Ok(entries) = fs::read_dir(out.join(name)) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let path = e.path();
+            let report = path
+                .extension()
+                .and_then(|x| x.to_str())
+                .is_some_and(|x| REPORT_EXTENSIONS.contains(&x));
+            if report && path.is_file() {
+                let _ = fs::remove_file(&path);
+            }
+        }
+    }
+}
+
+/// Removes the temporary files that runs killed while writing left in `out`
+/// and its experiment folders; for a caller that holds the folder's lock
+/// alone (no other run writes there).
+pub fn remove_stale_temporaries(out: &Path) {
+    let Ok(top) = fs::read_dir(out) else {
+        return;
+    };
+    let mut dirs = vec![out.to_path_buf()];
+    dirs.extend(top.flatten().map(|e| e.path()).filter(|p| p.is_dir()));
+    for dir in dirs {
+        let Ok(entries) = fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            if e.file_name().to_str().is_some_and(is_temporary) && e.path().is_file() {
+                let _ = fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
+/// The results file of experiment `name` under `out`: `results.jsonl`, or a
+/// shard's own file.
+pub fn results_path(out: &Path, name: &str, shard: Option<(usize, usize)>) -> PathBuf {
+    out.join(name).join(match shard {
+        None => "results.jsonl".to_string(),
+        Some((k, n)) => format!("results.shard-{k}-of-{n}.jsonl"),
+    })
+}
