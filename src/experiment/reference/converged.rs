@@ -1,0 +1,231 @@
+//! The converged reference: the family's most accurate deterministic
+//! evaluation at `n` nodes, checked against twice as many, doubling until
+//! it settles.
+
+use std::collections::BTreeMap;
+
+use crate::error::SpecError;
+use crate::experiment::validate::Experiment;
+use crate::family::{Family, Measured, Quantity};
+
+use super::{Reference, names, relative_distance, rms};
+
+/// The largest `n` of a converged reference.
+pub const MAX_CONVERGED_N: usize = 100_000;
+
+/// Checks a converged reference's `n`: an integer in `2..=MAX_CONVERGED_N`.
+pub fn check_converged_n(n: usize) -> Result<(), SpecError> {
+    if (2..=MAX_CONVERGED_N).contains(&n) {
+        Ok(())
+    } else {
+        Err(SpecError::at(
+            "reference.n",
+            format!("{n} is not an integer in 2..={MAX_CONVERGED_N}"),
+        ))
+    }
+}
+
+/// The family's converged values of every quantity of the experiment with
+/// `n` nodes per piece.
+pub fn converged<F: Family>(
+    exp: &Experiment<F>,
+    n: usize,
+) -> Result<BTreeMap<F::Quantity, Vec<f64>>, String> {
+    converged_measured(exp, n).map(|out| out.into_iter().map(|(q, m)| (q, m.value)).collect())
+}
+
+/// The family's converged evaluation with its error estimates.
+pub(super) fn converged_measured<F: Family>(
+    exp: &Experiment<F>,
+    n: usize,
+) -> Result<BTreeMap<F::Quantity, Measured>, String> {
+    F::converged(&exp.scene, n, &exp.spec.quantities).map_err(|e| e.to_string())
+}
+
+/// The tightest relative change the converged reference asks for: the
+/// evaluation's own rounding (sums of thousands of terms, each with a
+/// relative error near 1e-16) leaves changes near 1e-14, so a goal below
+/// this would never be met; errors under it are flagged as at the
+/// reference's accuracy, and the note says when the floor was used.
+pub const CONVERGED_FLOOR: f64 = 1e-13;
+
+/// Doublings of `n` the converged reference may take past the spec's `n`.
+const MAX_DOUBLINGS: u32 = 6;
+
+/// The converged reference: the family's converged evaluation at `n`, `2n`,
+/// `4n`, ... nodes per piece until every quantity's relative change from one
+/// to the next is at most `goal` (a hundredth of the tightest target, but not
+/// below [`CONVERGED_FLOOR`]) or `n` has doubled [`MAX_DOUBLINGS`] times. Each quantity
+/// keeps the finest value and, as its accuracy, its own last change (at
+/// least [`CONVERGED_FLOOR`], the evaluation's own rounding); one that
+/// did not get below the goal is named in the note. A quantity the family
+/// could not compute, or whose value is not finite, has no reference.
+pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> Reference {
+    let tightest = exp
+        .spec
+        .targets
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let goal = (tightest / 100.0).max(CONVERGED_FLOOR);
+    let failed = |e: String| {
+        let why = format!("the converged evaluation failed: {e}");
+        Reference {
+            values: BTreeMap::new(),
+            missing: names::<F>(exp, &why),
+            note: format!("none: {why}."),
+            accuracy: BTreeMap::new(),
+            channel_accuracy: BTreeMap::new(),
+        }
+    };
+    let mut coarse = match converged_measured(exp, n) {
+        Ok(a) => a,
+        Err(e) => return failed(e),
+    };
+    let mut m = n;
+    let (fine, changes, per_channel) = loop {
+        m *= 2;
+        let fine = match converged_measured(exp, m) {
+            Ok(b) => b,
+            Err(e) => return failed(e),
+        };
+        let changes: BTreeMap<String, f64> = exp
+            .spec
+            .quantities
+            .iter()
+            .filter_map(|q| {
+                let (x, y) = (coarse.get(q)?, fine.get(q)?);
+                // The change from the coarser evaluation, or the finer one's
+                // own error estimate where that is larger (an adaptive rule
+                // that met its tolerance twice changes by nothing).
+                let change = relative_distance(&x.value, &y.value);
+                let size = rms(y.value.iter().copied());
+                let own = rms(y.error.iter().copied()) / size;
+                let own = if own.is_finite() && size > 0.0 {
+                    own
+                } else {
+                    0.0
+                };
+                Some((q.name().to_string(), change.max(own)))
+            })
+            .collect();
+        let done = changes.values().all(|c| *c <= goal);
+        if done || m >= n << MAX_DOUBLINGS {
+            // Each channel's change or own error estimate, the larger.
+            let per_channel: BTreeMap<String, Vec<f64>> = exp
+                .spec
+                .quantities
+                .iter()
+                .filter_map(|q| {
+                    let (x, y) = (coarse.get(q)?, fine.get(q)?);
+                    let each = (0..y.value.len())
+                        .map(|c| {
+                            let change = match x.value.get(c) {
+                                Some(&a) => (a - y.value[c]).abs(),
+                                None => f64::NAN,
+                            };
+                            let own = y.error.get(c).copied().filter(|e| e.is_finite());
+                            // Never below the rounding floor (as the whole
+                            // quantity's): a background channel of 0.1 every
+                            // ray sees alike changed by 0, yet the rules'
+                            // weights summed it to 0.09999999999999999, a
+                            // display step below the reference's 25.5.
+                            own.map_or(change, |e| change.max(e.abs()))
+                                .max(CONVERGED_FLOOR * y.value[c].abs())
+                        })
+                        .collect();
+                    Some((q.name().to_string(), each))
+                })
+                .collect();
+            break (fine, changes, per_channel);
+        }
+        coarse = fine;
+    };
+    let mut values = BTreeMap::new();
+    let mut missing = BTreeMap::new();
+    let mut accuracy = BTreeMap::new();
+    for q in &exp.spec.quantities {
+        let name = q.name().to_string();
+        match fine.get(q).map(|m| &m.value) {
+            Some(y) if y.iter().all(|v| v.is_finite()) => {
+                values.insert(name.clone(), y.clone());
+                // Never below the floor: a change of 5.4e-14 on the voxel
+                // grid's I_L stood for an error of 7.8e-14 (an independent
+                // 40-digit evaluation), rounding that the change cannot see.
+                let change = changes.get(&name).copied().unwrap_or(f64::NAN);
+                let stated = if change.is_nan() {
+                    change
+                } else {
+                    change.max(CONVERGED_FLOOR)
+                };
+                accuracy.insert(name, stated);
+            }
+            Some(y) => {
+                missing.insert(name, format!("its converged value {y:?} is not finite"));
+            }
+            None => {
+                missing.insert(
+                    name,
+                    "the family's converged evaluation did not produce it".into(),
+                );
+            }
+        }
+    }
+    // A converged evaluation that doubts its own error estimate (the
+    // rendering family's, across outlines it does not split at) is not
+    // called converged, whatever its change between budgets.
+    let doubted: Vec<String> = exp
+        .spec
+        .quantities
+        .iter()
+        .filter(|q| {
+            fine.get(q)
+                .is_some_and(|m| m.flags.contains(&crate::family::Flag::UnreliableEstimate))
+        })
+        .map(|q| q.name().to_string())
+        .collect();
+    let mut unconverged: Vec<String> = accuracy
+        .iter()
+        .filter(|(q, c)| (c.is_nan() || **c > goal) && !doubted.contains(q))
+        .map(|(q, c)| format!("{q} ({c:.1e})"))
+        .collect();
+    unconverged.extend(doubted.iter().map(|q| {
+        format!(
+            "{q} (unverified: its evaluation crosses discontinuities it does not split at, where \
+             the change between budgets can understate the error)"
+        )
+    }));
+    let floor = if goal == CONVERGED_FLOOR {
+        format!(
+            " (the goal: a hundredth of the tightest target, {tightest:.0e}, but not below \
+             {CONVERGED_FLOOR:.0e}, the evaluation's own rounding)"
+        )
+    } else {
+        String::new()
+    };
+    let verdict = if unconverged.is_empty() {
+        format!("every quantity converged to {goal:.0e} or better{floor}")
+    } else {
+        format!(
+            "NOT converged to {goal:.0e}{floor}: {}; errors below that are not resolved",
+            unconverged.join(", ")
+        )
+    };
+    let changes_text = accuracy
+        .iter()
+        .map(|(q, c)| format!("{q} {c:.1e}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Reference {
+        values,
+        missing,
+        note: format!(
+            "the {} family's converged evaluation at n = {m}; relative change from n = {} \
+             (or its own error estimate, where larger): {changes_text} ({verdict}).",
+            F::NAME,
+            m / 2
+        ),
+        accuracy,
+        channel_accuracy: per_channel,
+    }
+}
