@@ -109,37 +109,40 @@
 //! }
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
-
-use std::cell::Cell;
-use std::f64::consts::PI;
+//!
+//! `evaluate` computes a job's quantity by its method, `terms` says in the
+//! report what the scene evaluates, `reference` holds the closed forms and
+//! the converged value, and `spec` the scene format.
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::brdf::{Brdf, Ggx, Lambert, NormalizedPhong, Phong, Sample};
-use super::emitter::{AnyEmitter, Emitter, LightSampling};
-use super::forms::{self, Irradiance, Kernel, Reach, Reflected};
-use super::mis::{Heuristic, mis};
+use super::forms::Reach;
+use super::mis::Heuristic;
 use super::receiver::Receiver;
 use super::scene::Scene;
-use crate::domain::{HemisphereMap, Vec3, integrate_over};
+use crate::domain::Vec3;
 use crate::error::{QuadError, SpecError};
-use crate::estimate::Estimate;
 use crate::family::{self, Family, Measured, Method, Outcome};
-use crate::quadrature::Rule;
 
+mod evaluate;
 mod reference;
-mod spec;
 
+mod spec;
+mod terms;
+
+pub use evaluate::evaluate_counted;
 pub use reference::lit_triangles;
-use reference::{closed_form, converged_value, exact_cone};
+use reference::{closed_form, converged_value};
+use spec::build;
 pub(crate) use spec::renamed;
 pub use spec::{
     BrdfSpec, CapLightSpec, DiskLightSpec, DiskSpec, EmitterSpec, EnvironmentSpec, GgxSpec,
     LambertSpec, MAX_COORDINATE, OccluderSpec, PhongSpec, ReceiverSpec, RectangleLightSpec,
     RectangleSpec, SceneSpec, SphereLightSpec, SphereSpec, TriangleLightSpec, TriangleSpec,
 };
-use spec::{build, needs_visibility};
+use terms::{settings, terms_section};
 
 /// The rendering family.
 #[derive(Debug, Clone, Copy)]
@@ -512,275 +515,3 @@ impl Family for Rendering {
 /// `{"type": "converged", "n": n}`: 400 (the default) gives 40000, about
 /// 2350 Genz–Malik boxes.
 pub const CONVERGED_PER_N: usize = 100;
-
-/// One quantity by `method` at `budget`, with the work it took beside the
-/// integrand evaluations ([`Work`]).
-pub fn evaluate_counted(
-    built: &Built,
-    method: &Method<Mis>,
-    budget: usize,
-    rng: &mut rand_pcg::Pcg64,
-    q: RenderingQuantity,
-) -> Result<(Measured, Work), QuadError> {
-    let shadow_rays = Cell::new(0);
-    let estimate = match method {
-        Method::Rule(rule) => by_rule(built, rule, q, budget, rng, &shadow_rays)?,
-        Method::Estimator(mis) => by_mis(built, *mis, q, budget, rng)?,
-    };
-    Ok((
-        Measured::from(estimate),
-        Work {
-            shadow_rays: shadow_rays.get(),
-        },
-    ))
-}
-
-/// The reflected-radiance kernel of the scene's BRDF for its viewer, or
-/// the error naming what is missing.
-fn reflected_kernel(built: &Built) -> Result<Reflected<'_, AnyBrdf>, QuadError> {
-    let (Some(brdf), Some(wo)) = (built.brdf.as_ref(), built.toward_viewer) else {
-        return Err(QuadError::invalid("brdf", "none", NEEDS_BRDF));
-    };
-    Reflected::new(brdf, &built.receiver, wo)
-}
-
-/// `q` by a quadrature rule.
-fn by_rule<R: Rule>(
-    built: &Built,
-    rule: &R,
-    q: RenderingQuantity,
-    n: usize,
-    rng: &mut rand_pcg::Pcg64,
-    shadow_rays: &Cell<u64>,
-) -> Result<Estimate<f64>, QuadError> {
-    if !q.reflected() {
-        return by_form(built, &Irradiance, q.form(), rule, n, rng, shadow_rays);
-    }
-    let kernel = reflected_kernel(built)?;
-    if q.form() == Form::Brdf {
-        return forms::brdf_sampled(rule, &built.scene, &built.receiver, &kernel, n, rng);
-    }
-    by_form(built, &kernel, q.form(), rule, n, rng, shadow_rays)
-}
-
-/// The form `form` of the integral of kernel `K` ([`forms`]).
-fn by_form<K: Kernel, R: Rule>(
-    built: &Built,
-    kernel: &K,
-    form: Form,
-    rule: &R,
-    n: usize,
-    rng: &mut rand_pcg::Pcg64,
-    shadow_rays: &Cell<u64>,
-) -> Result<Estimate<f64>, QuadError> {
-    let (scene, receiver) = (&built.scene, &built.receiver);
-    match form {
-        Form::Hemisphere => forms::hemispherical(
-            rule,
-            scene,
-            receiver,
-            kernel,
-            HemisphereMap::Uniform,
-            n,
-            rng,
-        ),
-        Form::Cosine => forms::hemispherical(
-            rule,
-            scene,
-            receiver,
-            kernel,
-            HemisphereMap::Projected,
-            n,
-            rng,
-        ),
-        Form::Cone => forms::cone(rule, scene, receiver, kernel, n, rng),
-        Form::Area => area_counted(built, kernel, rule, n, rng, shadow_rays),
-        Form::Brdf => Err(QuadError::invalid(
-            "quantity",
-            "a BRDF-sampled irradiance",
-            "L_brdf (irradiance has no BRDF to sample)",
-        )),
-    }
-}
-
-/// R-A as [`forms::area`] evaluates it, each shadow ray counted (by
-/// wrapping [`forms::area_visibility`]).
-fn area_counted<K: Kernel, R: Rule>(
-    built: &Built,
-    kernel: &K,
-    rule: &R,
-    n: usize,
-    rng: &mut rand_pcg::Pcg64,
-    shadow_rays: &Cell<u64>,
-) -> Result<Estimate<f64>, QuadError> {
-    let (scene, receiver) = (&built.scene, &built.receiver);
-    let mut total = Estimate::zero();
-    for (k, e) in scene.emitters().iter().enumerate() {
-        let domain = e.surface(receiver)?;
-        let skip = if e.at_infinity() { None } else { Some(k) };
-        let tested = scene.has_blockers(skip);
-        let base = forms::area_visibility(scene, receiver.point(), k);
-        let visible = |y: Vec3| {
-            if tested {
-                shadow_rays.set(shadow_rays.get() + 1);
-            }
-            base(y)
-        };
-        let g = forms::area_integrand_with(scene, receiver, kernel, k, visible)?;
-        total = total.combine(integrate_over(rule, &domain, n, rng, g)?);
-    }
-    Ok(total)
-}
-
-/// `q` by MIS: light samples by the quantity's form, BRDF samples of the
-/// scene's BRDF (of a white Lambertian one, times `pi`, for irradiance).
-fn by_mis(
-    built: &Built,
-    mis_kind: Mis,
-    q: RenderingQuantity,
-    n: usize,
-    rng: &mut rand_pcg::Pcg64,
-) -> Result<Estimate<f64>, QuadError> {
-    let sampling = match q.form() {
-        Form::Area => LightSampling::Area,
-        Form::Cone => LightSampling::Cone,
-        _ => {
-            return Err(QuadError::invalid(
-                "quantity",
-                family::Quantity::name(&q),
-                "one of E_area, E_cone, L_area, L_cone for MIS (its light strategy is the form)",
-            ));
-        }
-    };
-    let (scene, receiver) = (&built.scene, &built.receiver);
-    let heuristic = mis_kind.heuristic();
-    if q.reflected() {
-        let kernel = reflected_kernel(built)?;
-        return mis(scene, receiver, &kernel, sampling, heuristic, n, rng);
-    }
-    let white = Lambert::new(1.0)?;
-    let kernel = Reflected::new(&white, receiver, receiver.normal())?;
-    Ok(mis(scene, receiver, &kernel, sampling, heuristic, n, rng)?.scaled(PI))
-}
-
-fn settings(spec: &SceneSpec) -> String {
-    let (e, o) = (spec.emitters.len(), spec.occluders.len());
-    let visibility = if needs_visibility(spec) {
-        format!(
-            "visibility V (R-A's shadow rays, the V of R-3P's g) evaluated: one shadow ray per \
-             area-form evaluation whose other factors are non-zero, tested against {o} \
-             occluder(s) and the other finite emitters"
-        )
-    } else {
-        "visibility V (R-A's shadow rays, the V of R-3P's g) not evaluated: no occluder, and no \
-         emitter can shadow another, so V = 1 and no shadow ray is cast"
-            .to_string()
-    };
-    format!(
-        "{e} emitter(s), {o} occluder(s); {visibility}; the R-H forms find L_i by one ray per \
-         evaluation against the emitters and occluders (none where the kernel times cos theta \
-         is 0); the cone and area forms spend the budget on each emitter; MIS draws one light \
-         and one BRDF sample per unit of budget"
-    )
-}
-
-/// The report's section on this scene: the forms and the terms each
-/// evaluates.
-fn terms_section(built: &Built) -> String {
-    use std::fmt::Write as _;
-    let scene = &built.scene;
-    let mut s = String::from("## Forms and terms of this scene\n\n");
-    let names: Vec<&str> = scene
-        .emitters()
-        .iter()
-        .map(|e| match e {
-            AnyEmitter::Rectangle(_) => "rectangle",
-            AnyEmitter::Disk(_) => "disk",
-            AnyEmitter::Triangle(_) => "triangle",
-            AnyEmitter::Sphere(_) => "sphere",
-            AnyEmitter::Environment(_) => "environment",
-            AnyEmitter::Cap(_) => "cap",
-        })
-        .collect();
-    let cones: Vec<&str> = scene
-        .emitters()
-        .iter()
-        .map(|e| {
-            if exact_cone(e, &built.receiver) {
-                "exact"
-            } else {
-                "bounding"
-            }
-        })
-        .collect();
-    let _ = writeln!(
-        s,
-        "Emitters: {} (cones from the receiver: {}); occluders: {}.\n",
-        names.join(", "),
-        cones.join(", "),
-        scene.occluders().len()
-    );
-    let shadow: Vec<String> = scene
-        .emitters()
-        .iter()
-        .enumerate()
-        .map(|(k, e)| {
-            let skip = if e.at_infinity() { None } else { Some(k) };
-            if scene.has_blockers(skip) {
-                format!("emitter {k}: tested")
-            } else {
-                format!("emitter {k}: not evaluated (nothing can block it; 0 shadow rays)")
-            }
-        })
-        .collect();
-    s.push_str("| quantity | form | domain | integrand | terms evaluated per node |\n");
-    s.push_str("|---|---|---|---|---|\n");
-    let brdf = built.brdf.is_some();
-    let kernel = |q: RenderingQuantity| if q.reflected() { "f_r " } else { "" };
-    for &q in <RenderingQuantity as family::Quantity>::all() {
-        if q.reflected() && !brdf {
-            continue;
-        }
-        let k = kernel(q);
-        let (form, domain, integrand, terms) = match q.form() {
-            Form::Hemisphere => (
-                "R-H",
-                "hemisphere, uniform map",
-                format!("2 pi {k}L_i cos theta"),
-                "L_i: one ray against every surface",
-            ),
-            Form::Cosine => (
-                "R-H",
-                "hemisphere, projected (Malley) map",
-                format!("pi {k}L_i"),
-                "L_i: one ray against every surface",
-            ),
-            Form::Brdf => (
-                "R-H",
-                "BRDF-sampled map",
-                "f_r L_i cos theta / pdf".to_string(),
-                "L_i: one ray against every surface",
-            ),
-            Form::Cone => (
-                "R-H per emitter",
-                "the emitter's cone of directions",
-                format!("{k}L_i^k cos theta J"),
-                "L_i^k: one ray against every surface",
-            ),
-            Form::Area => (
-                "R-A (R-S, g of R-3P) per emitter",
-                "the emitter's surface, its map's Jacobian",
-                format!("L_e {k}cos theta cos theta' / r^2 V J"),
-                "V: a shadow ray where tested (below)",
-            ),
-        };
-        let name = family::Quantity::name(&q);
-        let _ = writeln!(s, "| {name} | {form} | {domain} | {integrand} | {terms} |");
-    }
-    let _ = writeln!(
-        s,
-        "\nJ is the Jacobian of the domain's map. Visibility of the area forms: {}.",
-        shadow.join("; ")
-    );
-    s
-}

@@ -19,7 +19,8 @@ use crate::rendering::order;
 use crate::rendering::receiver::Receiver;
 use crate::rendering::scene::Scene;
 
-use super::{AnyBrdf, Built, RenderingQuantity, reflected_kernel};
+use super::evaluate::reflected_kernel;
+use super::{AnyBrdf, Built, RenderingQuantity};
 
 /// True when the emitter's cone from the receiver is exactly the emitter
 /// ([`Emitter::cone`]): a sphere, a cap light, the environment's
