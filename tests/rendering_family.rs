@@ -1,4 +1,4 @@
-//! The rendering family of the experiment layer (src/rendering/experiment.rs)
+//! The rendering family of the experiment layer (src/rendering/experiment/)
 //! against independent references.
 //!
 //! Layers: (1) the bundled `r-*` experiments validate and run on the real

@@ -1,5 +1,6 @@
 //! Reading experiment files: a path or a bundled source to its bytes and
-//! its loaded experiment, and the experiment files of a folder.
+//! its loaded experiment, several files loaded at once (their names checked
+//! unique), and the experiment files of a folder.
 
 use std::collections::BTreeSet;
 use std::fs;
@@ -8,9 +9,9 @@ use std::path::{Path, PathBuf};
 use crate::experiment::registry::{Loaded, Registry};
 use crate::experiment::run::file_hash;
 use crate::experiment::source::Source;
+use crate::experiment::validate::{self, SpecError};
 
 use super::{RunError, io};
-use crate::experiment::validate::{self, SpecError};
 
 /// Reads, parses and validates one experiment file of any family in `registry`.
 pub fn load(registry: &Registry, path: &Path) -> Result<Box<dyn Loaded>, RunError> {

@@ -10,8 +10,7 @@ use crate::experiment::run::{self, JobResult, write_atomic};
 
 use super::input::load;
 use super::output::{keep_values, lock_output, writable};
-use super::write_reports;
-use super::{RunError, io};
+use super::{RunError, io, write_reports};
 
 /// Joins the shards' results under `inputs` (written by `run --shard k/n` into
 /// the same or copied folders) into one results file and report per experiment.

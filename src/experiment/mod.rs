@@ -32,13 +32,17 @@
 //! ```
 //!
 //! Beside the public modules: `input` reads experiment files, `output`
-//! locks and checks the output folder, and `merge` gathers shards' results.
+//! locks and checks the output folder, and `merge` gathers shards' results;
+//! running and reporting are here.
 
 pub mod expected;
 pub mod fit;
 pub mod html;
+mod input;
 pub mod markdown;
 pub mod memory;
+mod merge;
+mod output;
 pub mod plot;
 mod progress;
 pub mod reference;
@@ -49,10 +53,6 @@ pub mod source;
 pub mod spec;
 pub mod tagged;
 pub mod validate;
-
-mod input;
-mod merge;
-mod output;
 
 use std::collections::BTreeSet;
 use std::fs;

@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use crate::experiment::registry::Loaded;
 use crate::experiment::run::write_atomic;
+use crate::experiment::source;
 
 use super::{RunError, io};
-use crate::experiment::source;
 
 /// Holds `<out>/.lightquad.lock` locked for as long as the run writes there
 /// (`run --shard` runs share it, each holding its shard's own lock alone, so

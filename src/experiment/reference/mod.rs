@@ -26,28 +26,28 @@
 //!
 //! `converged` builds the converged reference, `mitsuba` reads the Mitsuba
 //! harness's values files, and `crosscheck` makes the "lightquad vs Mitsuba
-//! vs closed form" rows.
+//! vs closed form" rows; `Known`, `Reference`, the values known at load
+//! and the distances are here.
 
 use std::collections::BTreeMap;
 
-use super::spec::{
-    ConvergedReference, ExperimentSpec, MitsubaReference, ReferenceSpec, ValueReference,
-};
 use crate::error::SpecError;
 use crate::experiment::source::{Origin, Values, find_values};
+use crate::experiment::spec::{
+    ConvergedReference, ExperimentSpec, MitsubaReference, ReferenceSpec, ValueReference,
+};
 use crate::experiment::validate::{Experiment, literal_values};
 use crate::family::{Family, Quantity};
-
-use converged::converged_reference;
-use mitsuba::{not_values, stale_values, values_from_json};
 
 mod converged;
 mod crosscheck;
 mod mitsuba;
 
+use converged::converged_reference;
 pub use converged::{CONVERGED_FLOOR, MAX_CONVERGED_N, check_converged_n, converged};
 pub use crosscheck::{CROSSCHECK_INTRO, Crosscheck, crosscheck, crosscheck_markdown};
 pub use mitsuba::mitsuba_values;
+use mitsuba::{not_values, stale_values, values_from_json};
 
 /// Reference values known when an experiment is loaded.
 #[derive(Debug, Clone, PartialEq)]

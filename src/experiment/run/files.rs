@@ -1,6 +1,7 @@
-//! The files of a run: the results file read back (only the lines that are
-//! results of this experiment's jobs) and written whole or not at all, the
-//! report files written atomically, stale reports and temporaries cleared.
+//! The files of a run: the results file's path and its lines read back
+//! (only those that are results of this experiment's jobs), files written
+//! atomically or all or none, report files removed again when a report is
+//! left unfinished, stale reports and temporaries cleared.
 
 use std::collections::BTreeSet;
 use std::fs::{self, File, OpenOptions};

@@ -31,7 +31,9 @@
 //!
 //! `files` holds what a run reads and writes on disk: the results file read
 //! back (and which of its lines are this experiment's jobs), atomic and
-//! all-or-nothing writes, the report files and the clearing of stale ones.
+//! all-or-nothing writes, the report files and the clearing of stale ones;
+//! the jobs, their seeds and timing, and running them (with `--resume`) are
+//! here.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs::{self, OpenOptions};
@@ -51,7 +53,6 @@ use crate::family::{Family, Measured, Quantity};
 mod files;
 
 use files::results_of;
-
 pub use files::{
     ReportFiles, Unread, clear_reports, read_results, read_results_counted,
     remove_stale_temporaries, results_path, reusable, write_all_or_none, write_atomic,

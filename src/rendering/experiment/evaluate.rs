@@ -1,6 +1,7 @@
-//! One job's quantity by its method: a rule over one of the forms (R-H,
-//! R-3P, R-A and the cone form) or multiple importance sampling, with the
-//! work it took beside the integrand's evaluations.
+//! One job's quantity by its method: a rule over one of the forms (R-H by
+//! its uniform, projected or BRDF-sampled map, the cone form, R-A) or
+//! multiple importance sampling, with the work it took beside the
+//! integrand's evaluations.
 
 use std::cell::Cell;
 use std::f64::consts::PI;
@@ -49,7 +50,7 @@ pub(super) fn reflected_kernel(built: &Built) -> Result<Reflected<'_, AnyBrdf>, 
 }
 
 /// `q` by a quadrature rule.
-pub(super) fn by_rule<R: Rule>(
+fn by_rule<R: Rule>(
     built: &Built,
     rule: &R,
     q: RenderingQuantity,
@@ -68,7 +69,7 @@ pub(super) fn by_rule<R: Rule>(
 }
 
 /// The form `form` of the integral of kernel `K` ([`forms`]).
-pub(super) fn by_form<K: Kernel, R: Rule>(
+fn by_form<K: Kernel, R: Rule>(
     built: &Built,
     kernel: &K,
     form: Form,
@@ -138,7 +139,7 @@ fn area_counted<K: Kernel, R: Rule>(
 
 /// `q` by MIS: light samples by the quantity's form, BRDF samples of the
 /// scene's BRDF (of a white Lambertian one, times `pi`, for irradiance).
-pub(super) fn by_mis(
+fn by_mis(
     built: &Built,
     mis_kind: Mis,
     q: RenderingQuantity,

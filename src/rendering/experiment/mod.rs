@@ -112,7 +112,8 @@
 //!
 //! `evaluate` computes a job's quantity by its method, `terms` says in the
 //! report what the scene evaluates, `reference` holds the closed forms and
-//! the converged value, and `spec` the scene format.
+//! the converged value, and `spec` the scene format; the family, its
+//! quantities and BRDFs are here.
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -128,7 +129,6 @@ use crate::family::{self, Family, Measured, Method, Outcome};
 
 mod evaluate;
 mod reference;
-
 mod spec;
 mod terms;
 

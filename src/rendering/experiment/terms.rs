@@ -1,7 +1,7 @@
 //! What a scene evaluates, in words for the report: its emitters and
 //! occluders, whether visibility is evaluated, and the forms and terms.
 
-use crate::family::{self};
+use crate::family;
 use crate::rendering::emitter::{AnyEmitter, Emitter};
 
 use super::reference::exact_cone;

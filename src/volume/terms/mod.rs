@@ -52,7 +52,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! `pieces` cuts a ray's segment into the smooth pieces the rules integrate.
+//! `pieces` cuts a ray's segment into the smooth pieces the rules
+//! integrate; the terms and `evaluate` are here.
 
 use std::cell::Cell;
 use std::collections::BTreeMap;

@@ -1,6 +1,8 @@
-//! A ray's segment cut into pieces where the medium's density is smooth up
-//! to and including their ends: knots of the density bracketed and bisected,
-//! the pieces of two media united, and pieces graded toward a stiff edge.
+//! A ray's segment cut into pieces where the integrand is smooth up to and
+//! including their ends: where the density crosses a transfer table's knots
+//! (in closed form where the medium has them, else bracketed and bisected),
+//! the medium's and an emission field's supports united, and pieces graded
+//! at optical depths 1, 2, 4, ... from their start.
 
 use crate::domain::Segment;
 use crate::error::QuadError;
