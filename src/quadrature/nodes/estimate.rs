@@ -76,9 +76,9 @@ pub fn dominated<V: Value>(largest: V, magnitude: V, max_weight: f64) -> bool {
 /// which may still be large, is capped as Gauss–Legendre caps its drowned
 /// differences
 /// ([`crate::quadrature::gauss_legendre::hybrid_estimate`]):
-/// `max(eps M, min(E, m 128 eps M))`, `m` the `points` per axis. The trapezoid on a
-/// periodic integrand converges faster than any power, and an `8h` rule
-/// with a finer tail is not exact for it. Two rules agreeing are not
+/// `max(eps M, min(E, m 128 eps M))`, `m` the `points` per axis. The
+/// trapezoid on a periodic integrand converges faster than any power, and
+/// an `8h` rule with a finer tail is not exact for it. Two rules agreeing are not
 /// enough: by the symmetry of `sin`, `Q_h` and `Q_2h` of the trapezoid on
 /// `1/(1 + 0.99 sin 2 pi x)` at 47 points agree to 1e-11 while both are off
 /// by 2e-2 (with the cap on `d_1` alone the estimate was 9.4e-12). Where
