@@ -470,9 +470,8 @@ fn add_channel_portable<V: Value, const SCALED: bool>(
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use std::arch::x86_64::{
-        __m256d, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_add_pd, _mm256_andnot_pd,
-        _mm256_castpd256_pd128, _mm256_extractf128_pd, _mm256_max_pd, _mm256_mul_pd,
-        _mm256_set1_pd, _mm256_setr_pd, _mm256_sub_pd,
+        __m256d, _mm256_add_pd, _mm256_andnot_pd, _mm256_max_pd, _mm256_mul_pd, _mm256_set1_pd,
+        _mm256_setr_pd, _mm256_sub_pd,
     };
 
     use wide::f64x4;
@@ -544,23 +543,26 @@ mod avx {
         }
     }
 
+    /// The four lanes of `v` as one AVX register, and back
+    /// ([`from_avx`]): the same 32 bytes, cast (`bytemuck`, no `unsafe`).
+    /// The compiler then keeps a sum's lanes as one 256-bit value from
+    /// group to group. Rebuilt from `to_array` with `_mm256_setr_pd` and
+    /// taken apart lane by lane, they were kept as `wide`'s two SSE2 halves
+    /// and put together again at every group: some 20 shuffles a group
+    /// once the pass was unrolled (`nodes::line::group_before`). With both,
+    /// lightquad went from 1.0059 to 0.9987 times bilby
+    /// (`examples/gl_race.rs`, median of 8 processes each).
     #[target_feature(enable = "avx")]
     #[inline]
     fn to_avx(v: f64x4) -> __m256d {
-        let [a, b, c, d] = v.to_array();
-        _mm256_setr_pd(a, b, c, d)
+        bytemuck::cast(v)
     }
 
+    /// [`to_avx`] back.
     #[target_feature(enable = "avx")]
     #[inline]
     fn from_avx(v: __m256d) -> f64x4 {
-        let (low, high) = (_mm256_castpd256_pd128(v), _mm256_extractf128_pd::<1>(v));
-        f64x4::new([
-            _mm_cvtsd_f64(low),
-            _mm_cvtsd_f64(_mm_unpackhi_pd(low, low)),
-            _mm_cvtsd_f64(high),
-            _mm_cvtsd_f64(_mm_unpackhi_pd(high, high)),
-        ])
+        bytemuck::cast(v)
     }
 }
 
