@@ -550,8 +550,8 @@ mod avx {
     /// taken apart lane by lane, they were kept as `wide`'s two SSE2 halves
     /// and put together again at every group: some 20 shuffles a group
     /// once the pass was unrolled (`nodes::line::group_before`). With both,
-    /// lightquad went from 1.0059 to 0.9987 times bilby
-    /// (`examples/gl_race.rs`, median of 8 processes each).
+    /// lightquad went from 1.0050 to 0.9988 times bilby
+    /// (`examples/gl_race.rs`, medians of 10 processes each).
     #[target_feature(enable = "avx")]
     #[inline]
     fn to_avx(v: f64x4) -> __m256d {

@@ -177,9 +177,9 @@ impl<V: Value> LineSum<V> {
     ///   The pass is now an `inline(always)` closure: 0.98 to 1.00.
     /// - The pass over a group as arrays of known length
     ///   ([`group_before`]), unrolled, the lanes held as one 256-bit value
-    ///   from group to group (`sum::avx::to_avx`): 0.9975 to 1.0008 times
-    ///   bilby (median 0.9987) in 8 processes, where the pass as a loop over
-    ///   a range had 1.0052 to 1.0081 (median 1.0059) in 8 processes
+    ///   from group to group (`sum::avx::to_avx`): 0.9963 to 1.0020 times
+    ///   bilby (median 0.9988) in 10 processes, where the pass as a loop
+    ///   over a range had 1.0035 to 1.0066 (median 1.0050) in 10 processes
     ///   alternating with them.
     ///
     /// The values are checked finite once a block of [`BLOCK`] nodes,
