@@ -544,7 +544,7 @@ mod avx {
     }
 
     /// The four lanes of `v` as one AVX register, and back
-    /// ([`from_avx`]): the same 32 bytes, cast (`bytemuck`, no `unsafe`).
+    /// ([`from_avx`]): the same 32 bytes, `wide`'s own conversion (a cast).
     /// The compiler then keeps a sum's lanes as one 256-bit value from
     /// group to group. Rebuilt from `to_array` with `_mm256_setr_pd` and
     /// taken apart lane by lane, they were kept as `wide`'s two SSE2 halves
@@ -555,14 +555,14 @@ mod avx {
     #[target_feature(enable = "avx")]
     #[inline]
     fn to_avx(v: f64x4) -> __m256d {
-        bytemuck::cast(v)
+        v.into()
     }
 
     /// [`to_avx`] back.
     #[target_feature(enable = "avx")]
     #[inline]
     fn from_avx(v: __m256d) -> f64x4 {
-        bytemuck::cast(v)
+        v.into()
     }
 }
 

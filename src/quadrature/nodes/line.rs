@@ -258,9 +258,9 @@ struct Span<'a, V: Value, F> {
 impl<V: Value, F: FnMut(f64) -> Result<V, QuadError>> KernelTask<V> for Span<'_, V, F> {
     type Output = Result<(), QuadError>;
 
-    /// The integrand at a group of [`GROUP`] nodes, then the group's
-    /// products into the lanes, group after group; the finite check and
-    /// the companions a block of [`BLOCK`] nodes at a time.
+    /// The integrand at a group of [`GROUP`] nodes, then the products of
+    /// the group before it into the lanes, group after group; the finite
+    /// check and the companions a block of [`BLOCK`] nodes at a time.
     #[inline(always)]
     fn run(self, kernel: impl Kernel<V>) -> Self::Output {
         let Self {
