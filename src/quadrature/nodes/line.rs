@@ -12,10 +12,16 @@ use super::{ProductSum, UnitNodes, in_range, non_finite};
 
 /// Nodes per span of [`line_sum_par`]: a multiple of `BLOCK`, fixed, so
 /// the spans, and with them the result, do not depend on the number of
-/// threads. Some 0.2 ms of `cos(50 x)`, long against rayon's hand-over of
-/// a span (microseconds) and short enough that 1e6 nodes make 62 spans for
-/// two to eight threads to share evenly.
-pub const PAR_SPAN: usize = 1 << 14;
+/// threads. Some 36 µs of `cos(50 x)`, long against rayon's hand-over of
+/// a span and the integrand's clone (well under a microsecond each), and
+/// short enough that threads share the spans evenly: 1e6 nodes make 245
+/// spans, 1e5 make 25. Each span is a task of its own, so a thread left
+/// without work waits at most for the spans already under way. On two
+/// threads at n = 1e6, spans of 16384 nodes (62 spans) took 1.0068 times
+/// gauss-quad's parallel sum, spans of 4096 1.0010 (medians of 6
+/// processes each of `gl_race 201 --parallel`, run alternately; see
+/// benches/README.md, session 42).
+pub const PAR_SPAN: usize = 1 << 12;
 
 /// [`product_sum`] on one axis, its nodes shared among rayon's threads:
 /// the axis is cut into spans of [`PAR_SPAN`] nodes, each summed as
@@ -27,15 +33,24 @@ pub const PAR_SPAN: usize = 1 << 14;
 /// at every span; both are compensated sums).
 ///
 /// `f` is called from several threads at once, at nodes in no particular
-/// order. An error (a non-finite value, a sum out of range, or the
+/// order. Each span calls a clone of its own (245 clones at n = 1e6): a
+/// closure that borrows what it reads, the usual kind, clones as a few
+/// pointers; one that owns large data had better borrow it. Called
+/// through a shared reference instead, the integrand reloaded its
+/// captures' addresses at every node, which cost 1.5% of the time of
+/// `cos(50 x)` at n = 1e6: 1.0221 times gauss-quad's parallel sum by
+/// reference, 1.0068 by clone (spans of 16384 nodes, medians of 6
+/// processes of `gl_race`).
+///
+/// An error (a non-finite value, a sum out of range, or the
 /// integrand's own) is the one [`product_sum`] would give: that of the
 /// first span, in node order, that fails, and in it of the first failing
 /// block. Spans after a failed span that have not started yet are skipped;
 /// spans before it all run, and spans already started run to their end. A
-/// panic of `f` is an outcome of its span like an error: it reaches the
-/// caller only where no span before it failed, as with [`product_sum`]
-/// (the panic hook may still print the message of one that is then
-/// dropped).
+/// panic of `f`, or of its `clone`, is an outcome of its span like an
+/// error: it reaches the caller only where no span before it failed, as
+/// with [`product_sum`] (the panic hook may still print the message of one
+/// that is then dropped).
 ///
 /// ```
 /// use lightquad::quadrature::gauss_legendre::unit_nodes;
@@ -50,7 +65,7 @@ pub const PAR_SPAN: usize = 1 << 14;
 /// ```
 ///
 /// [`product_sum`]: super::product_sum
-pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
+pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync + Clone>(
     a: &UnitNodes,
     f: F,
 ) -> Result<ProductSum<V>, QuadError> {
@@ -62,15 +77,17 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     let failed = AtomicUsize::new(usize::MAX);
     let spans: Vec<Option<SpanOutcome<V>>> = (0..a.len().div_ceil(PAR_SPAN))
         .into_par_iter()
+        .with_max_len(1)
         .map(|k| {
             if k > failed.load(Ordering::Relaxed) {
                 return None;
             }
             let range = k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len());
-            // `f` is only borrowed, and a span that panicked is never
-            // read: nothing broken by the panic is seen again.
+            // A span panics with its own clone of `f`, which the unwinding
+            // drops, and a span that panicked is never read: nothing
+            // broken by the panic is seen again.
             let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                LineSum::of_span(a, range, &f)
+                LineSum::of_span(a, range, f.clone())
             }));
             if !matches!(span, Ok(Ok(_))) {
                 failed.fetch_min(k, Ordering::Relaxed);
@@ -207,14 +224,16 @@ impl<V: Value> LineSum<V> {
         })
     }
 
-    /// The sums over the nodes `range` of `a`. Not inlined: in rayon's
+    /// The sums over the nodes `range` of `a`, `f` the span's own clone of
+    /// the integrand (a reference to it reloaded the captures at every
+    /// node, see [`line_sum_par`]). Not inlined: in rayon's
     /// deeply inlined worker the integrand was left a call of its own at
     /// every node.
     #[inline(never)]
     fn of_span(
         a: &UnitNodes,
         range: std::ops::Range<usize>,
-        f: &impl Fn(f64) -> Result<V, QuadError>,
+        f: impl Fn(f64) -> Result<V, QuadError>,
     ) -> Result<Self, QuadError> {
         let mut sum = Self::new();
         sum.add_span(a, range, f)?;
