@@ -13,13 +13,14 @@ use super::{ProductSum, UnitNodes, in_range, non_finite};
 /// Nodes per span of [`line_sum_par`]: a multiple of `BLOCK`, fixed, so
 /// the spans, and with them the result, do not depend on the number of
 /// threads. Some 36 µs of `cos(50 x)`, long against rayon's hand-over of
-/// a span and the integrand's clone (well under a microsecond each), and
-/// short enough that threads share the spans evenly: 1e6 nodes make 245
-/// spans, 1e5 make 25. Each span is a task of its own, so a thread left
-/// without work waits at most for the spans already under way. On two
-/// threads at n = 1e6, spans of 16384 nodes (62 spans) took 1.0068 times
-/// gauss-quad's parallel sum, spans of 4096 1.0010 (medians of 6
-/// processes each of `gl_race 201 --parallel`, run alternately; see
+/// a span (well under a microsecond), and short enough that threads share
+/// the spans evenly: 1e6 nodes make 245 spans, 1e5 make 25. Each span is a
+/// task of its own, so a thread left without work waits at most for the
+/// spans already under way. At n = 1e5 on two threads, 7 spans of 16384
+/// split at best 4 to 3 (the sum 1.14 times an even share), 25 spans of
+/// 4096 split 13 to 12 (1.04). At n = 1e6 on two threads the two sizes
+/// measured the same (`gl_race 201 --parallel`, 4 processes each, 1.0164
+/// to 1.0241 against 1.0170 to 1.0230 times gauss-quad's parallel sum;
 /// benches/README.md, session 42).
 pub const PAR_SPAN: usize = 1 << 12;
 
@@ -33,24 +34,23 @@ pub const PAR_SPAN: usize = 1 << 12;
 /// at every span; both are compensated sums).
 ///
 /// `f` is called from several threads at once, at nodes in no particular
-/// order. Each span calls a clone of its own (245 clones at n = 1e6): a
-/// closure that borrows what it reads, the usual kind, clones as a few
-/// pointers; one that owns large data had better borrow it. Called
-/// through a shared reference instead, the integrand reloaded its
-/// captures' addresses at every node, which cost 1.5% of the time of
-/// `cos(50 x)` at n = 1e6: 1.0221 times gauss-quad's parallel sum by
-/// reference, 1.0068 by clone (spans of 16384 nodes, medians of 6
-/// processes of `gl_race`).
+/// order, each span through a shared reference. That costs about 1.5% of
+/// the time of `cos(50 x)` at n = 1e6: through the reference, the loop
+/// reloads the closure's captured addresses at every node. A clone of `f`
+/// per span (an `F: Clone` bound) removed that, and was not kept: a
+/// closure that owns what it reads (a table, a lazily filled cache, a
+/// `Mutex`) would have been cloned, or filled, once per span, or not
+/// accepted at all (benches/README.md, session 42).
 ///
 /// An error (a non-finite value, a sum out of range, or the
 /// integrand's own) is the one [`product_sum`] would give: that of the
 /// first span, in node order, that fails, and in it of the first failing
 /// block. Spans after a failed span that have not started yet are skipped;
 /// spans before it all run, and spans already started run to their end. A
-/// panic of `f`, or of its `clone`, is an outcome of its span like an
-/// error: it reaches the caller only where no span before it failed, as
-/// with [`product_sum`] (the panic hook may still print the message of one
-/// that is then dropped).
+/// panic of `f` is an outcome of its span like an error: it reaches the
+/// caller only where no span before it failed, as with [`product_sum`]
+/// (the panic hook may still print the message of one that is then
+/// dropped).
 ///
 /// ```
 /// use lightquad::quadrature::gauss_legendre::unit_nodes;
@@ -65,7 +65,7 @@ pub const PAR_SPAN: usize = 1 << 12;
 /// ```
 ///
 /// [`product_sum`]: super::product_sum
-pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync + Clone>(
+pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     a: &UnitNodes,
     f: F,
 ) -> Result<ProductSum<V>, QuadError> {
@@ -83,11 +83,10 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync + Clone>
                 return None;
             }
             let range = k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len());
-            // A span panics with its own clone of `f`, which the unwinding
-            // drops, and a span that panicked is never read: nothing
-            // broken by the panic is seen again.
+            // `f` is only borrowed, and a span that panicked is never
+            // read: nothing broken by the panic is seen again.
             let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                LineSum::of_span(a, range, f.clone())
+                LineSum::of_span(a, range, &f)
             }));
             if !matches!(span, Ok(Ok(_))) {
                 failed.fetch_min(k, Ordering::Relaxed);
@@ -224,16 +223,14 @@ impl<V: Value> LineSum<V> {
         })
     }
 
-    /// The sums over the nodes `range` of `a`, `f` the span's own clone of
-    /// the integrand (a reference to it reloaded the captures at every
-    /// node, see [`line_sum_par`]). Not inlined: in rayon's
+    /// The sums over the nodes `range` of `a`. Not inlined: in rayon's
     /// deeply inlined worker the integrand was left a call of its own at
     /// every node.
     #[inline(never)]
     fn of_span(
         a: &UnitNodes,
         range: std::ops::Range<usize>,
-        f: impl Fn(f64) -> Result<V, QuadError>,
+        f: &impl Fn(f64) -> Result<V, QuadError>,
     ) -> Result<Self, QuadError> {
         let mut sum = Self::new();
         sum.add_span(a, range, f)?;
