@@ -16,12 +16,13 @@ use super::{ProductSum, UnitNodes, in_range, non_finite};
 /// a span (well under a microsecond), and short enough that threads share
 /// the spans evenly: 1e6 nodes make 245 spans, 1e5 make 25. Each span is a
 /// task of its own, so a thread left without work waits at most for the
-/// spans already under way. At n = 1e5 on two threads, 7 spans of 16384
-/// split at best 4 to 3 (the sum 1.14 times an even share), 25 spans of
-/// 4096 split 13 to 12 (1.04). At n = 1e6 on two threads the two sizes
-/// measured the same (`gl_race 201 --parallel`, 4 processes each, 1.0164
-/// to 1.0241 against 1.0170 to 1.0230 times gauss-quad's parallel sum;
-/// benches/README.md, session 42).
+/// spans already under way, and a thread's share exceeds an even one by
+/// at most about one span: on two threads, 8% of the even share at n = 1e5
+/// with spans of 4096, where spans of 16384 could cost up to 33% (n =
+/// 49152, three spans, split 2 to 1). At n = 1e6 on two threads the two
+/// sizes measured the same (`gl_race 201 --parallel`, 4 processes each,
+/// 1.0164 to 1.0241 against 1.0170 to 1.0230 times gauss-quad's parallel
+/// sum; benches/README.md, session 42).
 pub const PAR_SPAN: usize = 1 << 12;
 
 /// [`product_sum`] on one axis, its nodes shared among rayon's threads:
