@@ -117,6 +117,17 @@ impl<V: Value> LaneValues<V> {
         }
     }
 
+    /// The lanes of the value's channels, channel 0 first: the part of
+    /// the array in use ([`LaneValues::used_mut`] to set them).
+    pub(crate) fn used(&self) -> &[f64x4] {
+        &self.channels[..V::CHANNELS]
+    }
+
+    /// [`LaneValues::used`], to be set.
+    pub(crate) fn used_mut(&mut self) -> &mut [f64x4] {
+        &mut self.channels[..V::CHANNELS]
+    }
+
     /// True when every lane of every channel is finite.
     pub fn all_finite(&self) -> bool {
         self.channels[..V::CHANNELS]
@@ -193,6 +204,16 @@ impl<V: Value> Lanes<V> {
             sum: LaneValues::zero(),
             carry: LaneValues::zero(),
         }
+    }
+
+    /// The lanes' sums and carries, in that order.
+    pub(crate) fn parts(&self) -> [&LaneValues<V>; 2] {
+        [&self.sum, &self.carry]
+    }
+
+    /// [`Lanes::parts`], to be set.
+    pub(crate) fn parts_mut(&mut self) -> [&mut LaneValues<V>; 2] {
+        [&mut self.sum, &mut self.carry]
     }
 
     /// Adds `w_i y_i` for every `i` of `ys` and `ws` (of equal length): each
@@ -367,23 +388,38 @@ fn pass_fn<V: Value, F: Fn(&[V], &[f64], usize, [&mut f64x4; 4], bool) + Copy>(f
 /// rather than called, once a short group, across the boundary between
 /// code for the baseline and code for AVX (which the compiler cannot
 /// inline).
-pub(crate) trait KernelTask<V: Value> {
+///
+/// `shared` is what the task reads through a shared reference, given to
+/// the function compiled for AVX as an argument of its own rather than
+/// inside `task`: the compiler then knows that nothing the task calls
+/// writes to it, and need not load what it read of it again after each
+/// call (an integrand's captures: once a group of nodes, not once a node).
+pub(crate) trait KernelTask<V: Value, S: ?Sized = ()> {
     type Output;
-    fn run(self, kernel: impl Kernel<V>) -> Self::Output;
+    fn run(self, kernel: impl Kernel<V>, shared: &S) -> Self::Output;
 }
 
 /// Runs `task` with the AVX pass where the CPU has AVX (checked at every
 /// call: a cached flag), the portable pass elsewhere.
 #[inline(always)]
 pub(crate) fn with_kernel<V: Value, T: KernelTask<V>>(task: T) -> T::Output {
+    with_kernel_sharing(task, &())
+}
+
+/// [`with_kernel`] for a task that reads `shared` ([`KernelTask`]).
+#[inline(always)]
+pub(crate) fn with_kernel_sharing<V: Value, S: ?Sized, T: KernelTask<V, S>>(
+    task: T,
+    shared: &S,
+) -> T::Output {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
         // SAFETY: `avx::run` is compiled for AVX, and the CPU has AVX:
         // checked just above.
         #[allow(unsafe_code)]
-        return unsafe { avx::run(task) };
+        return unsafe { avx::run(task, shared) };
     }
-    task.run(portable_kernel())
+    task.run(portable_kernel(), shared)
 }
 
 /// The portable pass as a [`Kernel`].
@@ -409,7 +445,7 @@ struct Products<'a, V: Value> {
 
 impl<V: Value> KernelTask<V> for Products<'_, V> {
     type Output = ();
-    fn run(self, kernel: impl Kernel<V>) {
+    fn run(self, kernel: impl Kernel<V>, _: &()) {
         match self.scale {
             Some((magnitude, largest)) => self
                 .lanes
@@ -479,8 +515,9 @@ mod avx {
     use super::{KernelTask, LANES, pass_fn};
     use crate::value::Value;
 
-    /// `task` with the AVX pass, compiled for AVX. The pass is a closure
-    /// defined here and `inline(always)` (AVX code once inlined here), which a
+    /// `task` with the AVX pass (and `shared`, as [`KernelTask`] says),
+    /// compiled for AVX. The pass is a closure defined here and
+    /// `inline(always)` (AVX code once inlined here), which a
     /// function compiled for AVX may not be: in one of two callers that
     /// asked the same, the compiler left a `#[inline]` pass a call of its
     /// own once a group (`line_sum_par`'s spans, not `product_sum`). The
@@ -492,8 +529,8 @@ mod avx {
     /// A NaN is a NaN to every caller in the crate, which stops at a value that is not
     /// finite.
     #[target_feature(enable = "avx")]
-    pub(super) fn run<V: Value, T: KernelTask<V>>(task: T) -> T::Output {
-        task.run(pass_fn(
+    pub(super) fn run<V: Value, S: ?Sized, T: KernelTask<V, S>>(task: T, shared: &S) -> T::Output {
+        let pass = pass_fn(
             #[inline(always)]
             |ys: &[V], ws: &[f64], c, [sum, carry, magnitude, largest]: [&mut f64x4; 4], scaled| {
                 let mut state = [
@@ -522,7 +559,8 @@ mod avx {
                 (*sum, *carry, *magnitude, *largest) =
                     (from_avx(s), from_avx(e), from_avx(m), from_avx(l));
             },
-        ))
+        );
+        task.run(pass, shared)
     }
 
     /// One group of four terms `t` into `[sum, carry, magnitude, largest]`,
@@ -594,7 +632,7 @@ mod tests {
 
     impl<V: Value> KernelTask<V> for Channel<'_, V> {
         type Output = ();
-        fn run(self, kernel: impl Kernel<V>) {
+        fn run(self, kernel: impl Kernel<V>, _: &()) {
             kernel.add_channel(self.ys, self.ws, self.c, self.lanes, self.scaled)
         }
     }

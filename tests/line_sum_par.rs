@@ -9,7 +9,9 @@
 use lightquad::error::QuadError;
 use lightquad::quadrature::gauss_legendre::unit_nodes;
 use lightquad::quadrature::nodes::{PAR_SPAN, ProductSum, line_sum_par, product_sum};
+use lightquad::quadrature::product::WithError;
 use lightquad::quadrature::{GaussLegendre, Rule, trapezoid};
+use lightquad::value::{Rgb, Value};
 use rand::SeedableRng;
 
 /// `int_0^1 cos(50 u) du = sin(50)/50` as `HI + LO` (half of
@@ -110,6 +112,74 @@ fn up_to_one_span_the_bits_are_product_sums() {
             let serial = product_sum([nodes.as_ref()], |p: [f64; 1]| f(p[0])).expect("sum");
             assert_eq!(all_bits(&par), all_bits(&serial), "n = {n}");
         }
+    }
+}
+
+/// Every field of channel `c` of `s`, as bits (the companions' included).
+fn channel_bits<V: Value>(s: &ProductSum<V>, c: usize) -> Vec<u64> {
+    let companions = [s.companion, s.companion4, s.companion8];
+    let mut all = vec![
+        s.value.channel(c).to_bits(),
+        s.magnitude.channel(c).to_bits(),
+        s.largest.channel(c).to_bits(),
+        s.evaluations,
+    ];
+    all.extend(
+        companions
+            .iter()
+            .map(|v| v.map_or(u64::MAX, |v| v.channel(c).to_bits())),
+    );
+    all
+}
+
+#[test]
+fn a_value_of_three_or_six_channels_is_summed_as_its_channels_alone() {
+    // Every channel of a value is summed by the same operations as a
+    // scalar: the same bits as line_sum_par of that channel on its own,
+    // for every field, across 9 spans, with and without companions.
+    let channel = |u: f64, c: usize| match c {
+        0 => u * u,
+        1 => (50.0 * u).cos(),
+        2 => -(3.0 * u).exp(),
+        3 => 1.0 / (1.0 + u),
+        4 => (1e3 * u).sin() * 1e-9,
+        _ => -u,
+    };
+    let gauss = unit_nodes(8 * PAR_SPAN + 77).expect("nodes");
+    let trapezoid = trapezoid::unit_nodes(8 * PAR_SPAN + 1).expect("nodes");
+    for nodes in [gauss, trapezoid.into()] {
+        let rgb = |u: f64| Rgb::new(channel(u, 0), channel(u, 1), channel(u, 2));
+        let three = in_pool(2, || line_sum_par(&nodes, |u| Ok(rgb(u)))).expect("sum");
+        let six = in_pool(3, || {
+            line_sum_par(&nodes, |u| {
+                Ok(WithError {
+                    value: rgb(u),
+                    error: Rgb::new(channel(u, 3), channel(u, 4), channel(u, 5)),
+                })
+            })
+        })
+        .expect("sum");
+        for c in 0..6 {
+            let alone = line_sum_par(&nodes, |u| Ok(channel(u, c))).expect("sum");
+            assert_eq!(
+                channel_bits(&six, c),
+                channel_bits(&alone, 0),
+                "channel {c} of 6"
+            );
+            if c < 3 {
+                assert_eq!(
+                    channel_bits(&three, c),
+                    channel_bits(&alone, 0),
+                    "channel {c} of 3"
+                );
+            }
+        }
+        // And the value against its closed form: int_0^1 u^2 du = 1/3.
+        assert!(
+            (three.value.x - 1.0 / 3.0).abs() < 1e-9,
+            "{:e}",
+            three.value.x
+        );
     }
 }
 

@@ -4,8 +4,10 @@
 //!
 //! [`product_sum`]: super::product_sum
 
+use wide::f64x4;
+
 use crate::error::QuadError;
-use crate::sum::{Kernel, KernelTask, LaneValues, Lanes, with_kernel};
+use crate::sum::{Kernel, KernelTask, LaneValues, Lanes, with_kernel, with_kernel_sharing};
 use crate::value::Value;
 
 use super::{ProductSum, UnitNodes, in_range, non_finite};
@@ -35,13 +37,16 @@ pub const PAR_SPAN: usize = 1 << 12;
 /// at every span; both are compensated sums).
 ///
 /// `f` is called from several threads at once, at nodes in no particular
-/// order, each span through a shared reference. That costs about 1.5% of
-/// the time of `cos(50 x)` at n = 1e6: through the reference, the loop
-/// reloads the closure's captured addresses at every node. A clone of `f`
-/// per span (an `F: Clone` bound) removed that, and was not kept: a
-/// closure that owns what it reads (a table, a lazily filled cache, a
-/// `Mutex`) would have been cloned, or filled, once per span, or not
-/// accepted at all (benches/README.md, session 42).
+/// order, each span through a shared reference. The reference reaches the
+/// span's loop as an argument of its own (`sum::with_kernel_sharing`), so
+/// the compiler knows the integrand's calls do not write to the closure
+/// and loads its captures once, not at every node: reloaded at every node
+/// through a reference inside the span's task, they cost about 1% of
+/// `cos(50 x)` at n = 1e6. (A clone of `f` per span, an `F: Clone` bound,
+/// did the same and was not kept: a closure that owns what it reads, a
+/// table, a lazily filled cache, a `Mutex`, would have been cloned, or
+/// filled, once per span, or not accepted at all; benches/README.md,
+/// session 42.)
 ///
 /// An error (a non-finite value, a sum out of range, or the
 /// integrand's own) is the one [`product_sum`] would give: that of the
@@ -76,10 +81,15 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     // The lowest span that has failed (or panicked) so far: later spans
     // need not run.
     let failed = AtomicUsize::new(usize::MAX);
-    let spans: Vec<Option<SpanOutcome<V>>> = (0..a.len().div_ceil(PAR_SPAN))
-        .into_par_iter()
+    // Each span's sums, the channels of `V` only ([`LineSum::store`]):
+    // `LineSum` is sized for the most channels a value may have, and
+    // moving it out of every span cost some 0.5% at n = 1e6.
+    let mut sums = vec![f64x4::ZERO; a.len().div_ceil(PAR_SPAN) * LineSum::<V>::STORED];
+    let spans: Vec<Option<SpanOutcome>> = sums
+        .par_chunks_mut(LineSum::<V>::STORED)
+        .enumerate()
         .with_max_len(1)
-        .map(|k| {
+        .map(|(k, slot)| {
             if k > failed.load(Ordering::Relaxed) {
                 return None;
             }
@@ -87,9 +97,9 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
             // `f` is only borrowed, and a span that panicked is never
             // read: nothing broken by the panic is seen again.
             let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                LineSum::of_span(a, range, &f)
+                LineSum::of_span(a, range, &f, slot)
             }));
-            if !matches!(span, Ok(Ok(_))) {
+            if !matches!(span, Ok(Ok(()))) {
                 failed.fetch_min(k, Ordering::Relaxed);
             }
             Some(span)
@@ -99,18 +109,25 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     // In node order: the first failed span is reached before any skipped
     // one (a span is skipped only after one before it failed), and a panic
     // resumes only when no span before it failed.
-    for span in spans.into_iter().flatten() {
+    for (span, slot) in spans
+        .into_iter()
+        .zip(sums.chunks_exact(LineSum::<V>::STORED))
+    {
         match span {
-            Ok(span) => total.merge(&span?),
-            Err(panic) => std::panic::resume_unwind(panic),
+            Some(Ok(span)) => {
+                span?;
+                total.merge(&LineSum::load(slot));
+            }
+            Some(Err(panic)) => std::panic::resume_unwind(panic),
+            None => {}
         }
     }
     in_range(total.finish(a))
 }
 
-/// What one span of [`line_sum_par`] came to: its sums, the integrand's
-/// error, or the payload of its panic.
-type SpanOutcome<V> = std::thread::Result<Result<LineSum<V>, QuadError>>;
+/// What one span of [`line_sum_par`] came to: its sums stored, the
+/// integrand's error, or the payload of its panic.
+type SpanOutcome = std::thread::Result<Result<(), QuadError>>;
 
 /// Nodes per block of [`LineSum::add_span`]: the values of a block are
 /// checked finite at once, and the companions summed. 256 rather than 64:
@@ -224,18 +241,68 @@ impl<V: Value> LineSum<V> {
         })
     }
 
-    /// The sums over the nodes `range` of `a`. Not inlined: in rayon's
-    /// deeply inlined worker the integrand was left a call of its own at
-    /// every node.
+    /// The sums over the nodes `range` of `a`, stored in `slot`
+    /// ([`LineSum::store`]). Not inlined: in rayon's deeply inlined worker
+    /// the integrand was left a call of its own at every node.
     #[inline(never)]
     fn of_span(
         a: &UnitNodes,
         range: std::ops::Range<usize>,
         f: &impl Fn(f64) -> Result<V, QuadError>,
-    ) -> Result<Self, QuadError> {
-        let mut sum = Self::new();
-        sum.add_span(a, range, f)?;
-        Ok(sum)
+        slot: &mut [f64x4],
+    ) -> Result<(), QuadError> {
+        let mut sums = Self::new();
+        with_kernel_sharing(
+            SharedSpan {
+                sums: &mut sums,
+                a,
+                range,
+            },
+            f,
+        )?;
+        sums.store(slot);
+        Ok(())
+    }
+
+    /// Vectors [`LineSum::store`] fills: ten [`LaneValues`] (the sums and
+    /// carries of the value and its three companions, the magnitude and
+    /// the largest term), each of the channels of `V`.
+    const STORED: usize = 10 * V::CHANNELS;
+
+    /// The ten [`LaneValues`] of the sums, in [`LineSum::STORED`]'s order.
+    fn parts(&self) -> [&LaneValues<V>; 10] {
+        let [v, vc] = self.value.parts();
+        let [c, cc] = self.companions[0].parts();
+        let [d, dc] = self.companions[1].parts();
+        let [e, ec] = self.companions[2].parts();
+        [v, vc, c, cc, d, dc, e, ec, &self.magnitude, &self.largest]
+    }
+
+    /// The sums in `slot`, [`LineSum::STORED`] vectors, the channels of
+    /// `V` only.
+    fn store(&self, slot: &mut [f64x4]) {
+        for (lanes, to) in self
+            .parts()
+            .into_iter()
+            .zip(slot.chunks_exact_mut(V::CHANNELS))
+        {
+            to.copy_from_slice(lanes.used());
+        }
+    }
+
+    /// The sums [`LineSum::store`] stored in `slot`.
+    fn load(slot: &[f64x4]) -> Self {
+        let mut sums = Self::new();
+        let [c, d, e] = &mut sums.companions;
+        let parts = [&mut sums.value, c, d, e]
+            .map(Lanes::parts_mut)
+            .into_iter()
+            .flatten()
+            .chain([&mut sums.magnitude, &mut sums.largest]);
+        for (lanes, from) in parts.zip(slot.chunks_exact(V::CHANNELS)) {
+            lanes.used_mut().copy_from_slice(from);
+        }
+        sums
     }
 
     /// Adds the sums of a span that follows the spans already added.
@@ -272,6 +339,24 @@ struct Span<'a, V: Value, F> {
     f: F,
 }
 
+/// [`Span`] with the integrand shared: [`LineSum::of_span`]'s, which
+/// reads it through a shared reference ([`KernelTask`]).
+struct SharedSpan<'a, V: Value> {
+    sums: &'a mut LineSum<V>,
+    a: &'a UnitNodes,
+    range: std::ops::Range<usize>,
+}
+
+impl<V: Value, F: Fn(f64) -> Result<V, QuadError>> KernelTask<V, F> for SharedSpan<'_, V> {
+    type Output = Result<(), QuadError>;
+
+    #[inline(always)]
+    fn run(self, kernel: impl Kernel<V>, f: &F) -> Self::Output {
+        let Self { sums, a, range } = self;
+        Span { sums, a, range, f }.run(kernel, &())
+    }
+}
+
 impl<V: Value, F: FnMut(f64) -> Result<V, QuadError>> KernelTask<V> for Span<'_, V, F> {
     type Output = Result<(), QuadError>;
 
@@ -279,7 +364,7 @@ impl<V: Value, F: FnMut(f64) -> Result<V, QuadError>> KernelTask<V> for Span<'_,
     /// the group before it into the lanes, group after group; the finite
     /// check and the companions a block of [`BLOCK`] nodes at a time.
     #[inline(always)]
-    fn run(self, kernel: impl Kernel<V>) -> Self::Output {
+    fn run(self, kernel: impl Kernel<V>, _: &()) -> Self::Output {
         let Self {
             sums,
             a,
