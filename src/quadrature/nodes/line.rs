@@ -21,10 +21,12 @@ use super::{ProductSum, UnitNodes, in_range, non_finite};
 /// spans already under way, and a thread's share exceeds an even one by
 /// at most about one span: on two threads, 8% of the even share at n = 1e5
 /// with spans of 4096, where spans of 16384 could cost up to 33% (n =
-/// 49152, three spans, split 2 to 1). At n = 1e6 on two threads the two
-/// sizes measured the same (`gl_race 201 --parallel`, 4 processes each,
-/// 1.0164 to 1.0241 against 1.0170 to 1.0230 times gauss-quad's parallel
-/// sum; benches/README.md, session 42).
+/// 49152, three spans, split 2 to 1). At n = 1e6 on two threads, spans
+/// of 8192 were some 0.3% faster than spans of 4096 (`gl_race 201
+/// --parallel`, medians 0.9991 and 1.0026 times gauss-quad's parallel sum
+/// in 10 processes each), spans of 2048 some 0.4% slower (1.0069 in 5);
+/// at n = 1e5 spans of 8192 would make 13, a share up to 15% over even
+/// (benches/README.md, session 43).
 pub const PAR_SPAN: usize = 1 << 12;
 
 /// [`product_sum`] on one axis, its nodes shared among rayon's threads:
@@ -83,7 +85,7 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     let failed = AtomicUsize::new(usize::MAX);
     // Each span's sums, the channels of `V` only ([`LineSum::store`]):
     // `LineSum` is sized for the most channels a value may have, and
-    // moving it out of every span cost some 0.5% at n = 1e6.
+    // moving it out of every span cost some 0.5 to 1% at n = 1e6.
     let mut sums = vec![f64x4::ZERO; a.len().div_ceil(PAR_SPAN) * LineSum::<V>::STORED];
     let spans: Vec<Option<SpanOutcome>> = sums
         .par_chunks_mut(LineSum::<V>::STORED)
