@@ -136,7 +136,8 @@ fn channel_bits<V: Value>(s: &ProductSum<V>, c: usize) -> Vec<u64> {
 fn a_value_of_three_or_six_channels_is_summed_as_its_channels_alone() {
     // Every channel of a value is summed by the same operations as a
     // scalar: the same bits as line_sum_par of that channel on its own,
-    // for every field, across 9 spans, with and without companions.
+    // for every field, across 9 spans, with and without companions; and
+    // within rounding of the serial sum, which stores no spans.
     let channel = |u: f64, c: usize| match c {
         0 => u * u,
         1 => (50.0 * u).cos(),
@@ -172,6 +173,38 @@ fn a_value_of_three_or_six_channels_is_summed_as_its_channels_alone() {
                     channel_bits(&alone, 0),
                     "channel {c} of 3"
                 );
+            }
+        }
+        // Against the serial sum, which keeps no spans: the same largest
+        // term, and every sum within rounding of its (the spans' lanes
+        // restart, so the last bits may differ).
+        let serial = product_sum([nodes.as_ref()], |p: [f64; 1]| {
+            let u = p[0];
+            Ok(WithError {
+                value: rgb(u),
+                error: Rgb::new(channel(u, 3), channel(u, 4), channel(u, 5)),
+            })
+        })
+        .expect("sum");
+        let near = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-14 * scale;
+        for c in 0..6 {
+            let scale = serial.magnitude.channel(c);
+            assert_eq!(
+                six.largest.channel(c),
+                serial.largest.channel(c),
+                "channel {c}"
+            );
+            assert!(near(six.magnitude.channel(c), scale, scale), "channel {c}");
+            for (par, ser) in [
+                (Some(six.value), Some(serial.value)),
+                (six.companion, serial.companion),
+                (six.companion4, serial.companion4),
+                (six.companion8, serial.companion8),
+            ] {
+                assert_eq!(par.is_some(), ser.is_some());
+                if let (Some(par), Some(ser)) = (par, ser) {
+                    assert!(near(par.channel(c), ser.channel(c), scale), "channel {c}");
+                }
             }
         }
         // And the value against its closed form: int_0^1 u^2 du = 1/3.
@@ -247,6 +280,139 @@ fn a_panic_after_an_earlier_failure_gives_the_failure_and_before_it_the_panic() 
             .expect("a formatted message");
         assert!(message.starts_with("integrand panicked at"), "{message}");
     }
+}
+
+/// A value of no channels, which `Value` allows.
+#[derive(Clone, Copy, Debug)]
+struct Nothing;
+
+impl Value for Nothing {
+    const CHANNELS: usize = 0;
+    fn zero() -> Self {
+        Nothing
+    }
+    fn channel(&self, i: usize) -> f64 {
+        unreachable!("channel {i} of a value of none")
+    }
+    fn from_fn(_: impl FnMut(usize) -> f64) -> Self {
+        Nothing
+    }
+    fn map(self, _: impl Fn(f64) -> f64) -> Self {
+        Nothing
+    }
+    fn zip(self, _: Self, _: impl Fn(f64, f64) -> f64) -> Self {
+        Nothing
+    }
+    fn all_finite(&self) -> bool {
+        true
+    }
+}
+
+#[test]
+fn a_value_of_no_channels_is_evaluated_at_every_node() {
+    // Across several spans, as product_sum: every node evaluated once, and
+    // the integrand's error at the first node that gives one.
+    let nodes = unit_nodes(3 * PAR_SPAN + 5).expect("nodes");
+    let calls = std::sync::atomic::AtomicUsize::new(0);
+    let sum = line_sum_par(&nodes, |_| {
+        calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Ok(Nothing)
+    })
+    .expect("sum");
+    assert_eq!(sum.evaluations as usize, nodes.len());
+    assert_eq!(calls.into_inner(), nodes.len());
+    let bad = nodes.u[2 * PAR_SPAN + 1];
+    let failed = line_sum_par(&nodes, |u| {
+        if u >= bad {
+            Err(QuadError::invalid("integrand", u, "below the bad node"))
+        } else {
+            Ok(Nothing)
+        }
+    });
+    let serial = product_sum([nodes.as_ref()], |p: [f64; 1]| {
+        if p[0] >= bad {
+            Err(QuadError::invalid("integrand", p[0], "below the bad node"))
+        } else {
+            Ok(Nothing)
+        }
+    });
+    assert_eq!(format!("{failed:?}"), format!("{serial:?}"));
+    assert!(failed.is_err());
+}
+
+/// A panic payload whose own `Drop` panics, counting its drops.
+struct Bomb;
+
+static BOMBS_DROPPED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+impl Drop for Bomb {
+    fn drop(&mut self) {
+        BOMBS_DROPPED.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        panic!("a panic payload's own drop panicked");
+    }
+}
+
+#[test]
+fn a_later_panic_whose_payload_panics_when_dropped_does_not_escape_the_error() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::time::{Duration, Instant};
+    // 49 spans. A NaN at the last node of span 0, which waits there until
+    // a span of the second half, on the other thread, has panicked with a
+    // `Bomb`: the caller gets the NaN, and the bombs are dropped without
+    // their panics escaping.
+    let nodes = unit_nodes(200_000).expect("nodes");
+    let nan_at = nodes.u[PAR_SPAN - 1];
+    let bombs_from = nodes.u[nodes.len() / 2];
+    let thrown = AtomicUsize::new(0);
+    let f = |u: f64| {
+        if u >= bombs_from {
+            thrown.fetch_add(1, Ordering::SeqCst);
+            std::panic::panic_any(Bomb);
+        }
+        if u == nan_at {
+            let start = Instant::now();
+            while thrown.load(Ordering::SeqCst) == 0 && start.elapsed() < Duration::from_secs(20) {
+                std::thread::yield_now();
+            }
+            return Ok(f64::NAN);
+        }
+        Ok(u)
+    };
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        in_pool(2, || line_sum_par(&nodes, f))
+    }));
+    match outcome {
+        Ok(Err(QuadError::NonFiniteIntegrand { point, .. })) => assert_eq!(point, vec![nan_at]),
+        Ok(other) => panic!("expected the NaN, got {other:?}"),
+        Err(_) => panic!("a panic escaped line_sum_par, which had an error to return"),
+    }
+    let thrown_first = thrown.swap(0, Ordering::SeqCst);
+    assert!(thrown_first >= 1, "no span of the second half ran");
+    // The same with a panic in place of the NaN: that panic reaches the
+    // caller (had a bomb been dropped as it unwound, the process would
+    // have aborted).
+    let g = |u: f64| {
+        if u == nan_at {
+            let _ = f(u);
+            panic!("integrand panicked at {u}");
+        }
+        f(u)
+    };
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        in_pool(2, || line_sum_par(&nodes, g))
+    }));
+    let payload = outcome.expect_err("the panic reaches the caller");
+    let message = payload
+        .downcast_ref::<String>()
+        .expect("a formatted message");
+    assert!(message.starts_with("integrand panicked at"), "{message}");
+    let thrown_second = thrown.load(Ordering::SeqCst);
+    assert!(thrown_second >= 1, "no span of the second half ran");
+    assert_eq!(
+        BOMBS_DROPPED.load(Ordering::SeqCst),
+        thrown_first + thrown_second,
+        "every bomb dropped once"
+    );
 }
 
 #[test]

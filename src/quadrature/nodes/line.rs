@@ -19,14 +19,15 @@ use super::{ProductSum, UnitNodes, in_range, non_finite};
 /// the spans evenly: 1e6 nodes make 245 spans, 1e5 make 25. Each span is a
 /// task of its own, so a thread left without work waits at most for the
 /// spans already under way, and a thread's share exceeds an even one by
-/// at most about one span: on two threads, 8% of the even share at n = 1e5
-/// with spans of 4096, where spans of 16384 could cost up to 33% (n =
-/// 49152, three spans, split 2 to 1). At n = 1e6 on two threads, spans
-/// of 8192 were some 0.3% faster than spans of 4096 (`gl_race 201
-/// --parallel`, medians 0.9991 and 1.0026 times gauss-quad's parallel sum
-/// in 10 processes each), spans of 2048 some 0.4% slower (1.0069 in 5);
-/// at n = 1e5 spans of 8192 would make 13, a share up to 15% over even
-/// (benches/README.md, session 43).
+/// at most about one span: on two threads at n = 1e5, 6.5% with spans of
+/// 4096 (13 whole spans of 25 on one thread), where spans of 16384 could
+/// cost up to 33% (n = 49152, three spans, split 2 to 1). At
+/// n = 1e6 on two threads, spans of 8192 were some 0.3% faster than spans
+/// of 4096 (`gl_race 201 --parallel`, medians 0.9991 and 1.0026 times
+/// gauss-quad's parallel sum in 10 processes each), spans of 2048 some
+/// 0.3% slower (1.0069 against 1.0038 in 5); at n = 1e5 spans of 8192
+/// would make 13, 7 on one thread, 15% over even (benches/README.md,
+/// session 43).
 pub const PAR_SPAN: usize = 1 << 12;
 
 /// [`product_sum`] on one axis, its nodes shared among rayon's threads:
@@ -42,9 +43,9 @@ pub const PAR_SPAN: usize = 1 << 12;
 /// order, each span through a shared reference. The reference reaches the
 /// span's loop as an argument of its own (`sum::with_kernel_sharing`), so
 /// the compiler knows the integrand's calls do not write to the closure
-/// and loads its captures once, not at every node: reloaded at every node
-/// through a reference inside the span's task, they cost about 1% of
-/// `cos(50 x)` at n = 1e6. (A clone of `f` per span, an `F: Clone` bound,
+/// and loads its captures once a group of nodes, not at every node:
+/// reloaded at every node through a reference inside the span's task,
+/// they cost 0.6 to 0.9% of `cos(50 x)` at n = 1e6. (A clone of `f` per span, an `F: Clone` bound,
 /// did the same and was not kept: a closure that owns what it reads, a
 /// table, a lazily filled cache, a `Mutex`, would have been cloned, or
 /// filled, once per span, or not accepted at all; benches/README.md,
@@ -58,7 +59,8 @@ pub const PAR_SPAN: usize = 1 << 12;
 /// panic of `f` is an outcome of its span like an error: it reaches the
 /// caller only where no span before it failed, as with [`product_sum`]
 /// (the panic hook may still print the message of one that is then
-/// dropped).
+/// dropped; a payload whose own `Drop` panics is dropped without that
+/// panic escaping).
 ///
 /// ```
 /// use lightquad::quadrature::gauss_legendre::unit_nodes;
@@ -80,6 +82,11 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
+    // A value of no channels has nothing to store ([`LineSum::STORED`] is
+    // 0): its nodes are evaluated, and their errors found, serially.
+    if V::CHANNELS == 0 {
+        return line_sum(a, f);
+    }
     // The lowest span that has failed (or panicked) so far: later spans
     // need not run.
     let failed = AtomicUsize::new(usize::MAX);
@@ -110,21 +117,41 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     let mut total = LineSum::new();
     // In node order: the first failed span is reached before any skipped
     // one (a span is skipped only after one before it failed), and a panic
-    // resumes only when no span before it failed.
-    for (span, slot) in spans
+    // resumes only when no span before it failed. The panics of the spans
+    // after the first failure are dropped, not resumed.
+    let mut spans = spans
         .into_iter()
-        .zip(sums.chunks_exact(LineSum::<V>::STORED))
-    {
-        match span {
-            Some(Ok(span)) => {
-                span?;
-                total.merge(&LineSum::load(slot));
-            }
-            Some(Err(panic)) => std::panic::resume_unwind(panic),
-            None => {}
+        .zip(sums.chunks_exact(LineSum::<V>::STORED));
+    let failure = spans.find_map(|(span, slot)| match span? {
+        Ok(Ok(())) => {
+            total.merge(&LineSum::load(slot));
+            None
+        }
+        Ok(Err(error)) => Some(Ok(error)),
+        Err(panic) => Some(Err(panic)),
+    });
+    let Some(failure) = failure else {
+        return in_range(total.finish(a));
+    };
+    for (span, _) in spans {
+        if let Some(Err(panic)) = span {
+            drop_panic(panic);
         }
     }
-    in_range(total.finish(a))
+    match failure {
+        Ok(error) => Err(error),
+        Err(panic) => std::panic::resume_unwind(panic),
+    }
+}
+
+/// Drops the payload of a panic that is not resumed. Its own `Drop` may
+/// panic too (a payload is any type): that panic is caught, and its
+/// payload, which could do the same, forgotten rather than dropped, so
+/// that no panic escapes from a call that returns an error.
+fn drop_panic(panic: Box<dyn std::any::Any + Send>) {
+    if let Err(again) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| drop(panic))) {
+        std::mem::forget(again);
+    }
 }
 
 /// What one span of [`line_sum_par`] came to: its sums stored, the
