@@ -974,3 +974,33 @@ fn small_rule_estimates_are_never_below_the_sums_rounding() {
         }
     }
 }
+
+/// A product whose inner rule reports no error estimate (an infinite
+/// error: one node per axis, or `error_estimate: false`) has an infinite
+/// error, and its value: `int int (x + y) dx dy = 1`, exact for
+/// Gauss–Legendre at any order. The outer rule's compensated sum of
+/// infinite errors is NaN (`inf - inf`), which was reported as an
+/// overflow of the value 1.0.
+#[test]
+fn a_product_over_an_inner_rule_without_an_error_estimate_has_an_infinite_error() {
+    use lightquad::quadrature::product::Product;
+    let without = GaussLegendre {
+        error_estimate: false,
+    };
+    for n in [1, 3, 100, 10_000] {
+        for inner in [GaussLegendre::default(), without] {
+            let product = Product {
+                outer: GaussLegendre::default(),
+                inner,
+            };
+            let est = product.integrate::<2, f64, _, _>(n, &mut rng(0), |p: [f64; 2]| p[0] + p[1]);
+            // One node per axis (n < 4) has no error estimate either way.
+            if n >= 4 && inner.error_estimate {
+                continue;
+            }
+            let est = est.unwrap_or_else(|e| panic!("n = {n}: {e}"));
+            assert!((est.value - 1.0).abs() < 1e-14, "n = {n}: {}", est.value);
+            assert_eq!(est.error, f64::INFINITY, "n = {n}");
+        }
+    }
+}

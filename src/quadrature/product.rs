@@ -211,9 +211,15 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
         // error. Otherwise the outer rule's estimate for g plus the integrated
         // inner estimates (for a deterministic outer rule over random inner
         // ones this adds standard errors linearly: conservative).
+        // An inner rule without an error estimate (one node, or
+        // `error_estimate: false`) reports an infinite error, and the
+        // outer rule's sum of infinite errors comes out NaN (in a
+        // compensated sum, `inf - inf`): the total error is then infinite,
+        // where a NaN was reported as an overflow of the value.
         let random_outer = outer.kind == ErrorKind::StandardError;
         let error = V::from_fn(|c| {
             let inner = outer.value.error.channel(c).abs();
+            let inner = if inner.is_nan() { f64::INFINITY } else { inner };
             if random_outer && inner_random {
                 outer.error.value.channel(c)
             } else {
