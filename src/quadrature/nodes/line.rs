@@ -21,13 +21,12 @@ use super::{ProductSum, UnitNodes, in_range, non_finite};
 /// spans already under way, and a thread's share exceeds an even one by
 /// at most about one span: on two threads at n = 1e5, 6.5% with spans of
 /// 4096 (13 whole spans of 25 on one thread), where spans of 16384 could
-/// cost up to 33% (n = 49152, three spans, split 2 to 1). At
-/// n = 1e6 on two threads, spans of 8192 were some 0.3% faster than spans
-/// of 4096 (`gl_race 201 --parallel`, medians 0.9991 and 1.0026 times
-/// gauss-quad's parallel sum in 10 processes each), spans of 2048 some
-/// 0.3% slower (1.0069 against 1.0038 in 5); at n = 1e5 spans of 8192
-/// would make 13, 7 on one thread, 15% over even (benches/README.md,
-/// session 43).
+/// cost up to 33% (n = 49152, three spans, split 2 to 1). At n = 1e6 on
+/// two threads, spans of 8192 were some 0.3% faster than spans of 4096
+/// (`gl_race 201 --parallel`, medians 0.9991 and 1.0026 times gauss-quad's
+/// parallel sum in 10 processes each), spans of 2048 some 0.3% slower
+/// (1.0069 against 1.0038 in 5); at n = 1e5 spans of 8192 would make 13,
+/// 7 on one thread, 15% over even (benches/README.md, session 43).
 pub const PAR_SPAN: usize = 1 << 12;
 
 /// [`product_sum`] on one axis, its nodes shared among rayon's threads:
@@ -45,11 +44,11 @@ pub const PAR_SPAN: usize = 1 << 12;
 /// the compiler knows the integrand's calls do not write to the closure
 /// and loads its captures once a group of nodes, not at every node:
 /// reloaded at every node through a reference inside the span's task,
-/// they cost 0.6 to 0.9% of `cos(50 x)` at n = 1e6. (A clone of `f` per span, an `F: Clone` bound,
-/// did the same and was not kept: a closure that owns what it reads, a
-/// table, a lazily filled cache, a `Mutex`, would have been cloned, or
-/// filled, once per span, or not accepted at all; benches/README.md,
-/// session 42.)
+/// they cost 0.6 to 0.9% of `cos(50 x)` at n = 1e6. (A clone of `f` per
+/// span, an `F: Clone` bound, did the same and was not kept: a closure
+/// that owns what it reads, a table, a lazily filled cache, a `Mutex`,
+/// would have been cloned, or filled, once per span, or not accepted at
+/// all; benches/README.md, session 42.)
 ///
 /// An error (a non-finite value, a sum out of range, or the
 /// integrand's own) is the one [`product_sum`] would give: that of the
