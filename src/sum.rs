@@ -62,10 +62,13 @@ impl<V: Value> Compensated<V> {
         self.carry = self.carry.zip(err, |c, e| c + e);
     }
 
-    /// The compensated total.
+    /// The compensated total `s + c`. A channel whose sum is infinite (or
+    /// NaN) is that sum: once an infinite term enters, TwoSum's carry is
+    /// `inf - inf`, NaN, and would turn the total of `+inf` terms into NaN.
     #[inline]
     pub fn total(&self) -> V {
-        self.sum.zip(self.carry, |s, c| s + c)
+        self.sum
+            .zip(self.carry, |s, c| if s.is_finite() { s + c } else { s })
     }
 }
 
@@ -327,18 +330,39 @@ impl<V: Value> Lanes<V> {
     }
 
     /// The compensated total of every lane: the sums, lane 0 first, then
-    /// the carries. A channel whose lanes are finite but whose total passes
-    /// `f64::MAX` on the way (each lane near a quarter of it: the sum of
-    /// values within rounding of `f64::MAX`) is totalled again from a
-    /// quarter of each lane, exact for normal numbers, and scaled back: a
-    /// total beyond the f64 range is infinite, one within it is found.
+    /// the carries. Two kinds of channel are totalled otherwise:
+    /// - one whose lanes are finite but whose total passes `f64::MAX` on
+    ///   the way (each lane near a quarter of it: the sum of values within
+    ///   rounding of `f64::MAX`) is totalled again from a quarter of each
+    ///   lane, exact for normal numbers, and scaled back: a total beyond
+    ///   the f64 range is infinite, one within it is found;
+    /// - one where a lane's sum is infinite (an infinite term, such as the
+    ///   error of a rule that has no estimate) is the plain sum of the
+    ///   lanes' sums: infinite when the infinities agree in sign, NaN when
+    ///   they do not. The carries are not added: TwoSum's carry is
+    ///   `inf - inf`, NaN, from the infinite term on.
+    ///
+    /// ```
+    /// use lightquad::sum::Lanes;
+    ///
+    /// let mut s = Lanes::<f64>::new();
+    /// s.add_products(&[1.0, f64::INFINITY, 2.0, f64::INFINITY, 3.0], &[1.0; 5]);
+    /// assert_eq!(s.total(), f64::INFINITY);
+    /// ```
     pub fn total(&self) -> V {
         let total = self.total_scaled(1.0);
-        if total.all_finite() {
+        if (0..V::CHANNELS).all(|c| total.channel(c).is_finite()) {
             return total;
         }
         let quarter = self.total_scaled(0.25);
-        total.zip(quarter, |t, q| if t.is_finite() { t } else { 4.0 * q })
+        V::from_fn(|c| {
+            let sums = self.sum.channels[c].to_array();
+            match total.channel(c) {
+                t if t.is_finite() => t,
+                _ if sums.iter().all(|s| s.is_finite()) => 4.0 * quarter.channel(c),
+                _ => sums.iter().fold(0.0, |t, s| t + s),
+            }
+        })
     }
 
     /// [`Lanes::total`] of every lane times `scale`.

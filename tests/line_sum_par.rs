@@ -508,3 +508,32 @@ fn sums_of_values_near_f64_max_are_found_or_an_error_never_a_nan() {
         .expect("a rule scales the integrand");
     assert!(near_max(e.value), "{:e}", e.value);
 }
+
+/// A value with its error estimate whose error is infinite at some nodes
+/// (an inner rule with no estimate): the summed error is `+inf`, on one
+/// thread and on several, serial or in spans, and the value is the
+/// closed form `int_0^1 cos(50 u) du = sin(50)/50`. (TwoSum's carry of an
+/// infinite term is NaN; the error channel was NaN.)
+#[test]
+fn an_infinite_error_at_some_nodes_sums_to_an_infinite_error() {
+    let nodes = unit_nodes(3 * PAR_SPAN + 5).expect("nodes");
+    let exact = EXACT_HI + EXACT_LO;
+    let f = |u: f64| {
+        Ok(WithError {
+            value: (50.0 * u).cos(),
+            error: if u > 0.7 { f64::INFINITY } else { 1e-3 },
+        })
+    };
+    for sum in [
+        product_sum([&nodes], |[u]| f(u)).expect("serial"),
+        in_pool(1, || line_sum_par(&nodes, f)).expect("one thread"),
+        in_pool(3, || line_sum_par(&nodes, f)).expect("three threads"),
+    ] {
+        assert!(
+            (sum.value.value - exact).abs() < 1e-17,
+            "{:e}",
+            sum.value.value
+        );
+        assert_eq!(sum.value.error, f64::INFINITY);
+    }
+}

@@ -247,3 +247,60 @@ proptest! {
         prop_assert!((v - exact_f).abs() <= bound, "{v:e} against exact {exact_f:e} (bound {bound:e})");
     }
 }
+
+/// Infinite terms (the error of a rule that has no estimate is infinite,
+/// and `Product` sums such errors) give the IEEE sum of the terms, not the
+/// NaN of TwoSum's carry (`inf - inf`): `+inf` where every infinity is
+/// `+inf`, whatever lanes or spans hold it, NaN where both signs occur. A
+/// finite channel beside an infinite one keeps its compensated total.
+#[test]
+fn infinite_terms_total_to_their_ieee_sum_not_a_nan() {
+    let inf = f64::INFINITY;
+    // The scalar sum.
+    let mut s = Compensated::<f64>::new();
+    for t in [1.0, inf, 2.0, inf] {
+        s.add(t);
+    }
+    assert_eq!(s.total(), inf);
+    s.add(-inf);
+    assert!(s.total().is_nan());
+    // One infinity in each position of the lanes, and in a leftover term.
+    for n in [1usize, 4, 5, 9, 64, 67] {
+        for at in 0..n {
+            let mut ys = vec![1.0; n];
+            ys[at] = inf;
+            let mut lanes = Lanes::<f64>::new();
+            lanes.add_products(&ys, &vec![0.5; n]);
+            assert_eq!(lanes.total(), inf, "n = {n}, +inf at {at}");
+            ys[at] = -inf;
+            let mut lanes = Lanes::<f64>::new();
+            lanes.add_products(&ys, &vec![0.5; n]);
+            assert_eq!(lanes.total(), -inf, "n = {n}, -inf at {at}");
+            // Both signs: NaN.
+            if n > 1 {
+                ys[(at + 1) % n] = inf;
+                let mut lanes = Lanes::<f64>::new();
+                lanes.add_products(&ys, &vec![0.5; n]);
+                assert!(lanes.total().is_nan(), "n = {n}, both signs");
+            }
+        }
+    }
+    // Spans merged in order, the infinity in the second of three.
+    let mut merged = Lanes::<f64>::new();
+    for ys in [[1.0, 2.0, 3.0, 4.0], [inf, 1.0, inf, 1.0], [5.0; 4]] {
+        let mut part = Lanes::<f64>::new();
+        part.add_products(&ys, &[1.0; 4]);
+        merged.merge(&part);
+    }
+    assert_eq!(merged.total(), inf);
+    // A value with its error: the error infinite at one term, the value's
+    // channel still the exact compensated 2 of `1e16 + 1 - 1e16 + 1`.
+    let ys: Vec<WithError<f64>> = [(1e16, 0.0), (1.0, inf), (-1e16, 0.0), (1.0, 0.0)]
+        .iter()
+        .map(|&(value, error)| WithError { value, error })
+        .collect();
+    let mut lanes = Lanes::<WithError<f64>>::new();
+    lanes.add_products(&ys, &[1.0; 4]);
+    let total = lanes.total();
+    assert_eq!((total.value, total.error), (2.0, inf));
+}

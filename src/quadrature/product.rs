@@ -213,9 +213,10 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
         // ones this adds standard errors linearly: conservative).
         // An inner rule without an error estimate (one node, or
         // `error_estimate: false`) reports an infinite error, and the
-        // outer rule's sum of infinite errors comes out NaN (in a
-        // compensated sum, `inf - inf`): the total error is then infinite,
-        // where a NaN was reported as an overflow of the value.
+        // outer rule's sum of them is infinite; an outer rule whose
+        // weights had both signs would sum them to `inf - inf`, NaN, which
+        // the guard would report as an overflow of the value: the total
+        // error is infinite then too.
         let random_outer = outer.kind == ErrorKind::StandardError;
         let error = V::from_fn(|c| {
             let inner = outer.value.error.channel(c).abs();
