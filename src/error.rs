@@ -91,12 +91,18 @@ pub enum QuadError {
     /// [`crate::quadrature::Rule::try_integrate`] takes such an integrand
     /// again scaled, and never returns this.
     #[error(
-        "the weighted sum of the integrand's finite values overflows f64: it came to {value} (its largest term |w f| is {largest}); expected values whose sums stay below f64::MAX: scale the integrand down, or integrate through a rule's `try_integrate`, which scales it"
+        "the weighted sum of the integrand's finite values (`{sum}`) overflows f64: it came to {value} (the rule's largest term |w f| is {largest}); expected values whose sums stay below f64::MAX: scale the integrand down, or integrate through a rule's `try_integrate`, which scales it"
     )]
     SumOutOfRange {
-        /// The sum as it came out (infinite or NaN in some channel), formatted.
+        /// Which sum left the range, named as the field of
+        /// [`crate::quadrature::nodes::ProductSum`] it would have filled:
+        /// `value`, or a companion's (`companion`, `companion4`,
+        /// `companion8`).
+        sum: &'static str,
+        /// That sum as it came out (infinite or NaN in some channel),
+        /// formatted.
         value: String,
-        /// The largest `|w f|`, formatted.
+        /// The largest `|w f|` of the rule's own sum, formatted.
         largest: String,
     },
     /// The integrand returned a non-finite value.

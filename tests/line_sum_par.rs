@@ -461,8 +461,9 @@ fn a_nan_in_a_late_span_is_reported_at_the_first_node_where_it_occurs() {
 /// rounding): 1e5 Gauss nodes summed to NaN and came back `Ok(NaN)`. Now
 /// the lanes' total finds it, serial and parallel, with the companions of a
 /// composite rule, and `sum |w f|` stays finite; where a sum does leave the
-/// range (the odometer's single running sum in two dimensions) it is an
-/// error naming it; and a rule's `try_integrate` finds the integral.
+/// range (the odometer's single running sum in two dimensions, a composite
+/// rule's `4h` companion, all in one lane) it is an error naming it; and a
+/// rule's `try_integrate` finds the integral.
 #[test]
 fn sums_of_values_near_f64_max_are_found_or_an_error_never_a_nan() {
     let near_max = |v: f64| (f64::MAX * (1.0 - 1e-12)..=f64::MAX).contains(&v);
@@ -495,10 +496,31 @@ fn sums_of_values_near_f64_max_are_found_or_an_error_never_a_nan() {
         in_pool(2, || line_sum_par(&composite, |_| Ok(f64::MAX))),
         "trapezoid",
     );
+    // The trapezoid rule's own sum on one axis is always found; its `4h`
+    // and `8h` companions put every term in one lane, whose running sum can
+    // pass `f64::MAX`: found, or an error that names that companion.
+    for m in [1001, 100_001, 1_000_001] {
+        let composite = trapezoid::unit_nodes(m).expect("nodes");
+        let serial = product_sum([&composite], |_: [f64; 1]| Ok(f64::MAX));
+        for (sum, what) in [
+            (serial, "serial"),
+            (line_sum_par(&composite, |_| Ok(f64::MAX)), "parallel"),
+        ] {
+            let what = format!("trapezoid, {m} nodes, {what}");
+            match sum {
+                Ok(s) => found(Ok(s), &what),
+                Err(QuadError::SumOutOfRange { sum, value, .. }) => {
+                    assert!(["companion4", "companion8"].contains(&sum), "{what}: {sum}");
+                    assert_eq!(value, "inf", "{what}");
+                }
+                Err(e) => panic!("{what}: {e}"),
+            }
+        }
+    }
     let few = unit_nodes(1000).expect("nodes");
     match product_sum([few.as_ref(), few.as_ref()], |_: [f64; 2]| Ok(f64::MAX)) {
-        Err(e @ QuadError::SumOutOfRange { .. }) => {
-            assert!(e.to_string().contains("overflows f64"), "{e}")
+        Err(e @ QuadError::SumOutOfRange { sum: "value", .. }) => {
+            assert!(e.to_string().contains("(`value`) overflows f64"), "{e}")
         }
         other => panic!("1000 x 1000 nodes: expected SumOutOfRange, got {other:?}"),
     }

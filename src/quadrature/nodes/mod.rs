@@ -85,9 +85,13 @@ pub struct ProductSum<V: Value> {
 /// A non-finite integrand value stops the sum with an error naming the point
 /// (on one axis, at the end of the block of 256 nodes it is in). Finite
 /// values within rounding of `f64::MAX`, whose sum passes it on the way,
-/// are summed on one axis (see [`crate::sum::Lanes::total`]); in two and
-/// more dimensions such a sum is [`QuadError::SumOutOfRange`], never a sum
-/// that is not finite.
+/// are summed on one axis (see [`crate::sum::Lanes::total`]), the rule's
+/// own sum always: its terms are spread over four lanes, each some quarter
+/// of the sum. A companion whose weights are zero at three nodes of four
+/// (a composite rule's `4h` and `8h` rules) puts all its terms in one lane,
+/// whose running sum can pass `f64::MAX` where the total would not; such
+/// a sum, and in two and more dimensions any, is
+/// [`QuadError::SumOutOfRange`] naming it, never a sum that is not finite.
 pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
     axes: [&UnitNodes; D],
     mut f: F,
@@ -196,21 +200,24 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
 /// `f64::MAX`: a scale of rounding, not a value.
 fn in_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError> {
     let sums = [
-        Some(sum.value),
-        sum.companion,
-        sum.companion4,
-        sum.companion8,
+        ("value", Some(sum.value)),
+        ("companion", sum.companion),
+        ("companion4", sum.companion4),
+        ("companion8", sum.companion8),
     ];
-    if sums.iter().flatten().all(Value::all_finite) {
-        Ok(ProductSum {
+    match sums
+        .into_iter()
+        .find_map(|(name, s)| s.filter(|s| !s.all_finite()).map(|s| (name, s)))
+    {
+        None => Ok(ProductSum {
             magnitude: sum.magnitude.map(|m| m.min(f64::MAX)),
             ..sum
-        })
-    } else {
-        Err(QuadError::SumOutOfRange {
-            value: format!("{:?}", sum.value),
+        }),
+        Some((name, out)) => Err(QuadError::SumOutOfRange {
+            sum: name,
+            value: format!("{out:?}"),
             largest: format!("{:?}", sum.largest),
-        })
+        }),
     }
 }
 
