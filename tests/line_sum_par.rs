@@ -8,7 +8,7 @@
 
 use lightquad::error::QuadError;
 use lightquad::quadrature::gauss_legendre::unit_nodes;
-use lightquad::quadrature::nodes::{PAR_SPAN, ProductSum, line_sum_par, product_sum};
+use lightquad::quadrature::nodes::{PAR_SPAN, ProductSum, line_sum_par, par_span, product_sum};
 use lightquad::quadrature::product::WithError;
 use lightquad::quadrature::{GaussLegendre, Rule, trapezoid};
 use lightquad::value::{Rgb, Value};
@@ -80,14 +80,19 @@ fn the_trapezoid_rule_and_its_companions_on_u_squared_match_euler_maclaurin() {
     assert!(close(sum.companion8.expect("8h"), 8.0 * h));
 }
 
+/// Spans of 4096 (74 of them) and of 8192 (`par_span`, 74 again), cut into
+/// runs of 1, 2, 3 and 7 workers, none of which divides 74.
 #[test]
 fn the_bits_do_not_depend_on_the_number_of_threads() {
-    let nodes = unit_nodes(300_001).expect("nodes");
-    let f = |u: f64| Ok((50.0 * u).cos() * (1.0 + u).ln());
-    let one = in_pool(1, || line_sum_par(&nodes, f)).expect("sum");
-    for threads in [2, 3, 7] {
-        let many = in_pool(threads, || line_sum_par(&nodes, f)).expect("sum");
-        assert_eq!(bits(&one), bits(&many), "{threads} threads");
+    for (n, span) in [(300_001, PAR_SPAN), (600_001, 2 * PAR_SPAN)] {
+        assert_eq!(par_span(n), span);
+        let nodes = unit_nodes(n).expect("nodes");
+        let f = |u: f64| Ok((50.0 * u).cos() * (1.0 + u).ln());
+        let one = in_pool(1, || line_sum_par(&nodes, f)).expect("sum");
+        for threads in [2, 3, 7] {
+            let many = in_pool(threads, || line_sum_par(&nodes, f)).expect("sum");
+            assert_eq!(bits(&one), bits(&many), "n = {n}, {threads} threads");
+        }
     }
 }
 

@@ -12,31 +12,61 @@ use crate::value::Value;
 
 use super::{ProductSum, UnitNodes, in_range, non_finite};
 
-/// Nodes per span of [`line_sum_par`]: a multiple of `BLOCK`, fixed, so
-/// the spans, and with them the result, do not depend on the number of
-/// threads. Some 36 µs of `cos(50 x)`, long against rayon's hand-over of
-/// a span (well under a microsecond), and short enough that threads share
-/// the spans evenly: 1e6 nodes make 245 spans, 1e5 make 25. Each span is a
-/// task of its own, so a thread left without work waits at most for the
-/// spans already under way, and a thread's share exceeds an even one by
-/// at most about one span: on two threads at n = 1e5, 6.5% with spans of
-/// 4096 (13 whole spans of 25 on one thread), where spans of 16384 could
-/// cost up to 33% (n = 49152, three spans, split 2 to 1). At n = 1e6 on
-/// two threads, spans of 8192 were some 0.3% faster than spans of 4096
-/// (`gl_race 201 --parallel`, medians 0.9991 and 1.0026 times gauss-quad's
-/// parallel sum in 10 processes each), spans of 2048 some 0.3% slower
-/// (1.0069 against 1.0038 in 5); at n = 1e5 spans of 8192 would make 13,
-/// 7 on one thread, 15% over even (benches/README.md, session 43).
+/// The fewest nodes in a span of [`line_sum_par`] ([`par_span`]): some
+/// 36 µs of `cos(50 x)`, long against the claim of a span (an atomic
+/// addition and an uncontended lock).
 pub const PAR_SPAN: usize = 1 << 12;
 
+/// Nodes per span of [`line_sum_par`] on an axis of `n` nodes: the power
+/// of two nearest `8 sqrt(n)` (between 5.7 and 11.3 times `sqrt(n)`),
+/// at least [`PAR_SPAN`]: 4096 below `n = 2^19`, 8192 from `2^19` (so at
+/// n = 1e6), 16384 from `2^21`, doubling at every fourfold `n`. It depends
+/// on `n` alone, so the spans, and with them the result, do not depend on
+/// the number of threads.
+///
+/// Why `sqrt(n)`: each span costs a fixed amount (its claim, its lanes
+/// set up, stored and merged: some 0.27 µs measured on one thread), and a
+/// thread that runs out of spans waits at most for the one its peer is in,
+/// on average about half a span. With `n / s` spans of `s` nodes on `P`
+/// threads the time lost is about `c n / (s P) + t s / 2`, least at `s`
+/// proportional to `sqrt(n)` whatever `P` is. Measured on two threads
+/// against gauss-quad's parallel sum (`cos(50 x)`, median of 5 processes
+/// each, benches/README.md, session 44): at n = 1e6 spans of 8192 gave
+/// 0.9969 where 4096 gave 1.0017; at n = 3e5, 4096 gave 1.0094 where 8192
+/// (37 spans, one thread doing 19) gave 1.0197.
+///
+/// ```
+/// use lightquad::quadrature::nodes::{PAR_SPAN, par_span};
+///
+/// assert_eq!(par_span(100_000), PAR_SPAN);
+/// assert_eq!(par_span(1_000_000), 8192);
+/// assert_eq!(par_span(10_000_000), 32768);
+/// ```
+pub fn par_span(n: usize) -> usize {
+    let log = n.checked_ilog2().unwrap_or(0);
+    PAR_SPAN.max(1 << ((log + 7) / 2))
+}
+
 /// [`product_sum`] on one axis, its nodes shared among rayon's threads:
-/// the axis is cut into spans of [`PAR_SPAN`] nodes, each summed as
+/// the axis is cut into spans of [`par_span`]`(n)` nodes, each summed as
 /// [`product_sum`] sums a whole axis (the same blocks, the same lanes, the
 /// same compensated sum), and the spans' sums are merged in node order
 /// ([`Lanes::merge`]). So the value is the same, bit for bit, whatever the
 /// number of threads, and the same as [`product_sum`]'s up to `n <=
 /// PAR_SPAN`; above, it differs from it in rounding only (the lanes restart
 /// at every span; both are compensated sums).
+///
+/// The spans are shared among one worker a thread of rayon's pool: the
+/// axis is cut into one run of consecutive spans a worker, and each worker
+/// claims the spans of its own run in order (an atomic addition each),
+/// then helps in the runs after it, so a thread reads the nodes in order,
+/// as the serial sum does, and waits at the end at most for the span its
+/// peer is in. Measured (benches/README.md, session 44) against what it
+/// replaced, rayon's tree of one task a span: on one thread 0.975 to
+/// 0.985 times gauss-quad's parallel sum where the tree gave 1.007 to
+/// 1.017. Spans claimed from one counter for all threads, so interleaved
+/// between them, were 3 to 7% slower on two threads: each thread's reads
+/// jumped at every span, and the caches' prefetching with them.
 ///
 /// `f` is called from several threads at once, at nodes in no particular
 /// order, each span through a shared reference. The reference reaches the
@@ -80,38 +110,64 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
 ) -> Result<ProductSum<V>, QuadError> {
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::{Mutex, PoisonError};
 
     // A value of no channels has nothing to store ([`LineSum::STORED`] is
     // 0): its nodes are evaluated, and their errors found, serially.
     if V::CHANNELS == 0 {
         return line_sum(a, f);
     }
+    // An atomic on a cache line of its own: a claim (a write) is not
+    // seen by the other threads' reads of what lay beside it.
+    #[repr(align(128))]
+    struct Padded(AtomicUsize);
     // The lowest span that has failed (or panicked) so far: later spans
     // need not run.
-    let failed = AtomicUsize::new(usize::MAX);
+    let failed = Padded(AtomicUsize::new(usize::MAX));
+    let nodes = par_span(a.len());
+    let count = a.len().div_ceil(nodes);
     // Each span's sums, the channels of `V` only ([`LineSum::store`]):
     // `LineSum` is sized for the most channels a value may have, and
     // moving it out of every span cost some 0.5 to 1% at n = 1e6.
-    let mut sums = vec![f64x4::ZERO; a.len().div_ceil(PAR_SPAN) * LineSum::<V>::STORED];
-    let spans: Vec<Option<SpanOutcome>> = sums
-        .par_chunks_mut(LineSum::<V>::STORED)
-        .enumerate()
-        .with_max_len(1)
-        .map(|(k, slot)| {
-            if k > failed.load(Ordering::Relaxed) {
-                return None;
+    let mut sums = vec![f64x4::ZERO; count * LineSum::<V>::STORED];
+    // Each span's slot and outcome, behind a lock that only the worker
+    // that claimed the span takes.
+    let slots: Vec<Mutex<(&mut [f64x4], Option<SpanOutcome>)>> = sums
+        .chunks_mut(LineSum::<V>::STORED)
+        .map(|slot| Mutex::new((slot, None)))
+        .collect();
+    // The runs: `first(w)..first(w + 1)`, and the next span of each to
+    // claim.
+    let workers = rayon::current_num_threads().clamp(1, count.max(1));
+    let first = |w: usize| w * count / workers;
+    let next: Vec<Padded> = (0..workers)
+        .map(|w| Padded(AtomicUsize::new(first(w))))
+        .collect();
+    (0..workers).into_par_iter().with_max_len(1).for_each(|w| {
+        for run in (w..workers).chain(0..w) {
+            loop {
+                let k = next[run].0.fetch_add(1, Ordering::Relaxed);
+                if k >= first(run + 1) || k > failed.0.load(Ordering::Relaxed) {
+                    break;
+                }
+                let range = k * nodes..((k + 1) * nodes).min(a.len());
+                let mut slot = slots[k].lock().unwrap_or_else(PoisonError::into_inner);
+                let (sums, outcome) = &mut *slot;
+                // `f` is only borrowed, and a span that panicked is never
+                // read: nothing broken by the panic is seen again.
+                let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    LineSum::of_span(a, range, &f, sums)
+                }));
+                if !matches!(span, Ok(Ok(()))) {
+                    failed.0.fetch_min(k, Ordering::Relaxed);
+                }
+                *outcome = Some(span);
             }
-            let range = k * PAR_SPAN..((k + 1) * PAR_SPAN).min(a.len());
-            // `f` is only borrowed, and a span that panicked is never
-            // read: nothing broken by the panic is seen again.
-            let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                LineSum::of_span(a, range, &f, slot)
-            }));
-            if !matches!(span, Ok(Ok(()))) {
-                failed.fetch_min(k, Ordering::Relaxed);
-            }
-            Some(span)
-        })
+        }
+    });
+    let spans: Vec<Option<SpanOutcome>> = slots
+        .into_iter()
+        .map(|slot| slot.into_inner().unwrap_or_else(PoisonError::into_inner).1)
         .collect();
     let mut total = LineSum::new();
     // In node order: the first failed span is reached before any skipped
@@ -174,8 +230,9 @@ const GROUP: usize = 16;
 
 const _: () = assert!(BLOCK.is_multiple_of(GROUP) && GROUP.is_multiple_of(crate::sum::LANES));
 
-// A span of `line_sum_par` is whole blocks, so its blocks are `product_sum`'s.
-const _: () = assert!(PAR_SPAN.is_multiple_of(BLOCK));
+// A span of `line_sum_par` (a power of two, at least `PAR_SPAN`) is whole
+// blocks, so its blocks are `product_sum`'s.
+const _: () = assert!(PAR_SPAN.is_power_of_two() && PAR_SPAN.is_multiple_of(BLOCK));
 
 /// [`product_sum`] on one axis: [`LineSum::add_span`] over all its nodes.
 ///

@@ -19,7 +19,7 @@ pub use composite::{CHECKED_POINTS, Composite, MAX_POINTS, coarse_weights};
 pub(crate) use estimate::ROUNDING_ULPS;
 pub use estimate::{DOMINANT_SHARE, dominated, richardson};
 use line::line_sum;
-pub use line::{PAR_SPAN, line_sum_par};
+pub use line::{PAR_SPAN, line_sum_par, par_span};
 
 /// A 1-D rule on `[0, 1]`: nodes `u_i` and weights `w_i` with `sum w_i = 1`
 /// (so the rule estimates `int_0^1 f(u) du` by `sum w_i f(u_i)`), and optional
