@@ -1,9 +1,10 @@
 //! Gauss–Legendre integration at n = 1e6 with cached nodes, lightquad
 //! against `bilby` and `gauss-quad`, timed in interleaved rounds.
 //!
-//! `cargo run --release --example gl_race -- [ROUNDS] [--serial | --parallel]`
-//! (in either order; ROUNDS default 41; `--serial` leaves out the two
-//! parallel contenders, `--parallel` times them alone)
+//! `cargo run --release --example gl_race -- [ROUNDS] [--serial | --parallel] [--n N]`
+//! (in any order; ROUNDS default 41; `--serial` leaves out the two
+//! parallel contenders, `--parallel` times them alone; N nodes, default
+//! 1e6, 1 to 1e7)
 //!
 //! The same integral as `cargo bench --bench quadrature -- gl_integrate`:
 //! `int_{-1}^{1} cos(50 x) dx`. On a shared machine whose speed drifts
@@ -36,7 +37,11 @@ use std::time::Instant;
 use lightquad::quadrature::gauss_legendre::unit_nodes;
 use lightquad::quadrature::nodes::{line_sum_par, product_sum};
 
+/// Nodes unless `--n` says otherwise.
 const N: usize = 1_000_000;
+
+/// Most nodes `--n` takes.
+const MAX_N: usize = 10_000_000;
 
 /// Most rounds (some 90 ms each).
 const MAX_ROUNDS: usize = 10_000;
@@ -84,16 +89,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // without the two that use every core, whose idle rayon threads spin a
     // while after each call and take a core from whatever is timed next on
     // a two-core machine; `--parallel`: those two alone.
-    let (mut rounds, mut only): (Option<usize>, Option<bool>) = (None, None);
-    for arg in std::env::args().skip(1) {
+    let (mut rounds, mut only, mut n): (Option<usize>, Option<bool>, Option<usize>) =
+        (None, None, None);
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
         match arg.as_str() {
             "--serial" | "--parallel" if only.is_none() => only = Some(arg == "--parallel"),
+            "--n" if n.is_none() => {
+                let value = args
+                    .next()
+                    .ok_or("--n: expected a number of nodes after it")?;
+                n = Some(value.parse().map_err(|e| format!("--n {value:?}: {e}"))?)
+            }
             _ if rounds.is_none() && !arg.starts_with('-') => {
                 rounds = Some(arg.parse().map_err(|e| format!("ROUNDS {arg:?}: {e}"))?)
             }
             _ => {
                 return Err(format!(
-                    "{arg:?}: expected [ROUNDS] [--serial | --parallel]: one number, one of the two flags"
+                    "{arg:?}: expected [ROUNDS] [--serial | --parallel] [--n N]: one number, one of the two flags, one --n"
                 )
                 .into());
             }
@@ -103,9 +116,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if !(1..=MAX_ROUNDS).contains(&rounds) {
         return Err(format!("ROUNDS {rounds}: expected 1 to {MAX_ROUNDS}").into());
     }
-    let nodes = unit_nodes(N)?;
-    let bil = bilby::GaussLegendre::new(N)?;
-    let gq = gauss_quad::GaussLegendre::new(NonZeroUsize::new(N).ok_or("n = 0")?);
+    let n = n.unwrap_or(N);
+    if !(1..=MAX_N).contains(&n) {
+        return Err(format!("--n {n}: expected 1 to {MAX_N} nodes").into());
+    }
+    let nodes = unit_nodes(n)?;
+    let bil = bilby::GaussLegendre::new(n)?;
+    let gq = gauss_quad::GaussLegendre::new(NonZeroUsize::new(n).ok_or("n = 0")?);
     let (a, b) = (-1.0f64, 1.0f64);
     let contenders: Vec<Contender> = vec![
         (
@@ -193,7 +210,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             times[i].push(start.elapsed().as_secs_f64() * 1e3);
         }
     }
-    println!("{N} nodes, {rounds} rounds");
+    println!("{n} nodes, {rounds} rounds");
     println!("| contender | median | least | error |");
     println!("|---|---:|---:|---:|");
     for (i, (name, _)) in contenders.iter().enumerate() {
