@@ -2,9 +2,10 @@
 # Runs examples/gl_race.rs in several processes and prints, for each paired
 # ratio, every process's median and the median over processes.
 #
-#   bash scripts/gl_race.sh [PROCESSES] [ROUNDS] [--serial | --parallel]
+#   bash scripts/gl_race.sh [PROCESSES] [ROUNDS] [--serial | --parallel] [--n N]
 #
-# (defaults 7 processes of 201 rounds, every contender). One process's
+# (defaults 7 processes of 201 rounds, every contender, 1e6 nodes; what
+# follows ROUNDS goes to gl_race as it is). One process's
 # median is sharp (its 95% interval is some +-0.2%), but the next process's
 # can differ by more than that: where the stack and the node tables fall,
 # and what the rest of the shared machine does that minute, move a ratio by
@@ -16,9 +17,9 @@ cd "$(dirname "$0")/.."
 
 processes=${1:-7}
 rounds=${2:-201}
-mode=${3:-}
+rest=("${@:3}")
 case "$processes$rounds" in
-  *[!0-9]* | '') echo "usage: $0 [PROCESSES] [ROUNDS] [--serial | --parallel]" >&2; exit 2 ;;
+  *[!0-9]* | '') echo "usage: $0 [PROCESSES] [ROUNDS] [--serial | --parallel] [--n N]" >&2; exit 2 ;;
 esac
 if [ "$processes" -lt 1 ]; then
   echo "PROCESSES $processes: expected at least 1" >&2
@@ -29,8 +30,7 @@ cargo build --release --example gl_race >&2
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 for p in $(seq 1 "$processes"); do
-  # shellcheck disable=SC2086 # an empty mode is no argument
-  ./target/release/examples/gl_race "$rounds" $mode > "$out/$p.txt"
+  ./target/release/examples/gl_race "$rounds" "${rest[@]}" > "$out/$p.txt"
   echo "process $p of $processes done" >&2
 done
 
