@@ -80,10 +80,14 @@ pub fn par_span(n: usize) -> usize {
 /// would have been cloned, or filled, once per span, or not accepted at
 /// all; benches/README.md, session 42.)
 ///
-/// An error (a non-finite value, a sum out of range, or the
-/// integrand's own) is the one [`product_sum`] would give: that of the
-/// first span, in node order, that fails, and in it of the first failing
-/// block. Spans after a failed span that have not started yet are skipped;
+/// An error (a non-finite value, or the integrand's own) is the one
+/// [`product_sum`] would give: that of the first span, in node order, that
+/// fails, and in it of the first failing block. A sum out of range
+/// ([`QuadError::SumOutOfRange`]) is the exception, as its rounding
+/// differs: a sum within rounding of `f64::MAX` can leave the range in one
+/// and not in the other (a trapezoid rule's `4h` companion on `f64::MAX`:
+/// at 100001 nodes serially, not here), or leave it in another of the
+/// companions. Spans after a failed span that have not started yet are skipped;
 /// spans before it all run, and spans already started run to their end. A
 /// panic of `f` is an outcome of its span like an error: it reaches the
 /// caller only where no span before it failed, as with [`product_sum`]
