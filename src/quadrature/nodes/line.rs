@@ -62,11 +62,15 @@ pub fn par_span(n: usize) -> usize {
 /// then helps in the runs after it, so a thread reads the nodes in order,
 /// as the serial sum does, and waits at the end at most for the span its
 /// peer is in. Measured (benches/README.md, session 44) against what it
-/// replaced, rayon's tree of one task a span: on one thread 0.975 to
-/// 0.985 times gauss-quad's parallel sum where the tree gave 1.007 to
-/// 1.017. Spans claimed from one counter for all threads, so interleaved
-/// between them, were 3 to 7% slower on two threads: each thread's reads
-/// jumped at every span, and the caches' prefetching with them.
+/// replaced, rayon's tree of one task a span: on two threads at n = 1e6,
+/// 0.9989 times gauss-quad's parallel sum (median of 10 processes) where
+/// the tree gave 1.0024; on one thread 0.981 to 0.993 times it where the
+/// tree gave 1.001 to 1.004, and 1.001 to 1.006 times the serial sum
+/// where the tree gave 1.022 to 1.028. Spans claimed from one counter for
+/// all threads, so interleaved between them, were 3% slower on two
+/// threads (8 to 12% before the counter had a cache line of its own):
+/// each thread's reads jumped at every span, and the caches' prefetching
+/// with them.
 ///
 /// `f` is called from several threads at once, at nodes in no particular
 /// order, each span through a shared reference. The reference reaches the
