@@ -30,10 +30,11 @@ pub const PAR_SPAN: usize = 1 << 12;
 /// on average about half a span. With `n / s` spans of `s` nodes on `P`
 /// threads the time lost is about `c n / (s P) + t s / 2`, least at `s`
 /// proportional to `sqrt(n)` whatever `P` is. Measured on two threads
-/// against gauss-quad's parallel sum (`cos(50 x)`, median of 5 processes
-/// each, benches/README.md, session 44): at n = 1e6 spans of 8192 gave
-/// 0.9969 where 4096 gave 1.0017; at n = 3e5, 4096 gave 1.0094 where 8192
-/// (37 spans, one thread doing 19) gave 1.0197.
+/// against gauss-quad's parallel sum (`cos(50 x)`, benches/README.md,
+/// session 44): at n = 1e6 spans of 8192 gave 1.0001 where 4096 gave
+/// 1.0026 (`gl_race`, medians of 10 processes); at n = 3e5, 4096 gave
+/// 1.0094 where 8192 (37 spans, one thread doing 19) gave 1.0197 (a
+/// scratch race, medians of 5).
 ///
 /// ```
 /// use lightquad::quadrature::nodes::{PAR_SPAN, par_span};
