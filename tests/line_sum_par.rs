@@ -81,7 +81,8 @@ fn the_trapezoid_rule_and_its_companions_on_u_squared_match_euler_maclaurin() {
 }
 
 /// Spans of 4096 (74 of them) and of 8192 (`par_span`, 74 again), cut into
-/// runs of 1, 2, 3 and 7 workers, none of which divides 74.
+/// runs of 1, 2, 3 and 7 workers (3 and 7 do not divide 74: runs of
+/// unequal length).
 #[test]
 fn the_bits_do_not_depend_on_the_number_of_threads() {
     for (n, span) in [(300_001, PAR_SPAN), (600_001, 2 * PAR_SPAN)] {

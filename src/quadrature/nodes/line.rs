@@ -12,29 +12,34 @@ use crate::value::Value;
 
 use super::{ProductSum, UnitNodes, in_range, non_finite};
 
-/// The fewest nodes in a span of [`line_sum_par`] ([`par_span`]): some
-/// 36 µs of `cos(50 x)`, long against the claim of a span (an atomic
-/// addition and an uncontended lock).
+/// The smallest span size of [`line_sum_par`] ([`par_span`]; the last
+/// span of an axis, and the one span of a shorter axis, can hold fewer
+/// nodes): some 36 µs of `cos(50 x)`, long against the claim of a span
+/// (an atomic addition and an uncontended lock).
 pub const PAR_SPAN: usize = 1 << 12;
 
 /// Nodes per span of [`line_sum_par`] on an axis of `n` nodes: the power
-/// of two nearest `8 sqrt(n)` (between 5.7 and 11.3 times `sqrt(n)`),
-/// at least [`PAR_SPAN`]: 4096 below `n = 2^19`, 8192 from `2^19` (so at
-/// n = 1e6), 16384 from `2^21`, doubling at every fourfold `n`. It depends
-/// on `n` alone, so the spans, and with them the result, do not depend on
-/// the number of threads.
+/// of two nearest `8 sqrt(n)` in ratio (between 5.7 and 11.3 times
+/// `sqrt(n)`), at least [`PAR_SPAN`]: 4096 below `n = 2^19`, 8192 from
+/// `2^19` (so at n = 1e6), 16384 from `2^21`, doubling at every fourfold
+/// `n`. It depends on `n` alone, so the spans, and with them the result,
+/// do not depend on the number of threads.
 ///
-/// Why `sqrt(n)`: each span costs a fixed amount (its claim, its lanes
-/// set up, stored and merged: some 0.27 µs measured on one thread), and a
-/// thread that runs out of spans waits at most for the one its peer is in,
-/// on average about half a span. With `n / s` spans of `s` nodes on `P`
-/// threads the time lost is about `c n / (s P) + t s / 2`, least at `s`
-/// proportional to `sqrt(n)` whatever `P` is. Measured on two threads
-/// against gauss-quad's parallel sum (`cos(50 x)`, benches/README.md,
-/// session 44): at n = 1e6 spans of 8192 gave 1.0001 where 4096 gave
-/// 1.0026 (`gl_race`, medians of 10 processes); at n = 3e5, 4096 gave
-/// 1.0094 where 8192 (37 spans, one thread doing 19) gave 1.0197 (a
-/// scratch race, medians of 5).
+/// Why `sqrt(n)`: each span costs a fixed amount (some 0.27 µs a span,
+/// measured on one thread when each span was a rayon task of its own),
+/// and a thread that runs out of spans waits at most for the one its peer
+/// is in, on average about half a span. With `n / s` spans of `s` nodes on
+/// `P` threads the time lost is about `c n / (s P) + t s / 2`, least at
+/// `s = sqrt(2 c n / (t P))`: proportional to `sqrt(n)` for every `P`, with
+/// a factor that falls as `1 / sqrt(P)`. The factor 8 is tuned on two
+/// threads (the formula gives some 5.7 there), and only the growth with
+/// `n` holds for every `P`. Measured on two threads against gauss-quad's
+/// parallel sum (`cos(50 x)`, benches/README.md, session 44): at n = 1e6
+/// spans of 8192 gave 1.0001 where 4096 gave 1.0026 (`gl_race`, medians of
+/// 10 processes); below, a scratch race (medians of 5) was mixed: at n =
+/// 3e5, 4096 gave 1.0094 where 8192 (37 spans, one thread doing 19) gave
+/// 1.0197, and at n = 1e5, 8192 gave 1.0135 where 4096 gave 1.0160. The
+/// cut at `2^19` is the rule's, not the data's.
 ///
 /// ```
 /// use lightquad::quadrature::nodes::{PAR_SPAN, par_span};
@@ -60,18 +65,20 @@ pub fn par_span(n: usize) -> usize {
 /// The spans are shared among one worker a thread of rayon's pool: the
 /// axis is cut into one run of consecutive spans a worker, and each worker
 /// claims the spans of its own run in order (an atomic addition each),
-/// then helps in the runs after it, so a thread reads the nodes in order,
-/// as the serial sum does, and waits at the end at most for the span its
-/// peer is in. Measured (benches/README.md, session 44) against what it
-/// replaced, rayon's tree of one task a span: on two threads at n = 1e6,
-/// 0.9989 times gauss-quad's parallel sum (median of 10 processes) where
-/// the tree gave 1.0024; on one thread 0.981 to 0.993 times it where the
-/// tree gave 1.001 to 1.004, and 1.001 to 1.006 times the serial sum
-/// where the tree gave 1.022 to 1.028. Spans claimed from one counter for
-/// all threads, so interleaved between them, were 3% slower on two
-/// threads (8 to 12% before the counter had a cache line of its own):
-/// each thread's reads jumped at every span, and the caches' prefetching
-/// with them.
+/// then helps in the other runs in turn (those after its own, then those
+/// before), so a thread reads the nodes in order, as the serial sum does,
+/// and waits at the end at most for the span its peer is in. Measured
+/// (benches/README.md, session 44) against what it replaced, rayon's tree
+/// of one task a span, alternating: on two threads at n = 1e6 0.9989 times
+/// gauss-quad's parallel sum (median of 10 processes) where the tree gave
+/// 1.0024, and 1.0010 (8) where it gave 1.0020: level with gauss-quad's,
+/// some 0.1 to 0.35% ahead of the tree; on one thread 0.981 to 0.993 times
+/// gauss-quad's where the tree gave 1.001 to 1.004, and 1.001 to 1.006
+/// times the serial sum where the tree gave 1.022 to 1.028. Spans claimed
+/// from one counter for all threads, so interleaved between them, were 3%
+/// slower on two threads in one process (8 to 12% before the counter had
+/// a cache line of its own); presumably each thread's reads, jumping at
+/// every span, lost the caches' prefetching (not measured).
 ///
 /// `f` is called from several threads at once, at nodes in no particular
 /// order, each span through a shared reference. The reference reaches the
@@ -152,6 +159,9 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     let next: Vec<Padded> = (0..workers)
         .map(|w| Padded(AtomicUsize::new(first(w))))
         .collect();
+    // Worker `w` claims the spans of run `w` until none is left, or until
+    // a span before the one it claimed has failed; then those of the other
+    // runs in turn.
     (0..workers).into_par_iter().with_max_len(1).for_each(|w| {
         for run in (w..workers).chain(0..w) {
             loop {
