@@ -140,8 +140,9 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     // The lowest span that has failed (or panicked) so far: later spans
     // need not run.
     let failed = Padded(AtomicUsize::new(usize::MAX));
-    let nodes = par_span(a.len());
-    let count = a.len().div_ceil(nodes);
+    // Nodes per span, and spans.
+    let per_span = par_span(a.len());
+    let count = a.len().div_ceil(per_span);
     // Each span's sums, the channels of `V` only ([`LineSum::store`]):
     // `LineSum` is sized for the most channels a value may have, and
     // moving it out of every span cost some 0.5 to 1% at n = 1e6.
@@ -169,7 +170,7 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
                 if k >= first(run + 1) || k > failed.0.load(Ordering::Relaxed) {
                     break;
                 }
-                let range = k * nodes..((k + 1) * nodes).min(a.len());
+                let range = k * per_span..((k + 1) * per_span).min(a.len());
                 let mut slot = slots[k].lock().unwrap_or_else(PoisonError::into_inner);
                 let (sums, outcome) = &mut *slot;
                 // `f` is only borrowed, and a span that panicked is never
