@@ -76,6 +76,7 @@ pub mod experiment;
 pub mod families;
 pub mod family;
 pub mod geometry;
+pub mod parallel;
 pub mod quadrature;
 pub mod rendering;
 pub mod sum;

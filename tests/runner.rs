@@ -2937,6 +2937,76 @@ fn a_report_that_cannot_be_written_is_named_and_leaves_no_partial_pages() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// The experiments' reports are written at once on the run's threads; one
+/// that fails removes every report file of the run, those the other
+/// threads wrote included, and the failure said is the first in the order
+/// of the experiments, whichever finished first.
+#[test]
+fn reports_written_in_parallel_are_removed_together_and_the_first_failure_is_said() {
+    let dir = scratch("parallel-reports");
+    let names = ["a", "b", "c", "d", "e", "f"];
+    let files: Vec<PathBuf> = names
+        .iter()
+        .map(|n| {
+            let file = dir.join(format!("{n}.json"));
+            fs::write(
+                &file,
+                VALID.replace(r#""name": "t""#, &format!(r#""name": "{n}""#)),
+            )
+            .expect("write");
+            file
+        })
+        .collect();
+    let out = dir.join("out");
+    let run = |args: &[&str]| {
+        bin()
+            .arg("run")
+            .args(args)
+            .args(["--threads", "2", "--out"])
+            .arg(&out)
+            .args(&files)
+            .output()
+            .expect("runs")
+    };
+    // A folder where the tables of d and f go (as a full disk there would),
+    // written after their pages and plots.
+    for n in ["d", "f"] {
+        fs::create_dir_all(out.join(n).join("results.csv").join("x")).expect("mkdir");
+    }
+    let o = run(&[]);
+    let msg = stderr(&o);
+    assert!(!o.status.success(), "{msg}");
+    let said: Vec<&str> = msg.lines().filter(|l| l.contains("results.csv")).collect();
+    assert!(
+        said.len() == 1 && said[0].contains(&out.join("d").display().to_string()),
+        "{msg}"
+    );
+    for n in names {
+        let mut left: Vec<String> = fs::read_dir(out.join(n))
+            .expect("experiment folder")
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|f| f != "results.csv")
+            .collect();
+        left.sort();
+        assert_eq!(left, ["experiment.json", "results.jsonl"], "{n}: {msg}");
+    }
+    assert!(!out.join("index.md").exists() && !out.join("index.html").exists());
+    // With the folders gone every report is written, whole.
+    for n in ["d", "f"] {
+        fs::remove_dir_all(out.join(n).join("results.csv")).expect("rm");
+    }
+    let o = run(&["--resume"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let index = fs::read_to_string(out.join("index.md")).expect("index");
+    for n in names {
+        assert!(out.join(n).join("report.md").is_file(), "{n}");
+        assert!(out.join(n).join("index.html").is_file(), "{n}");
+        assert!(index.contains(&format!("{n}/report.md")), "{n}: {index}");
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
 /// Shards that needed `--no-cost-limit` (ratio tracking through a blob of
 /// amplitude 1e307: its walks would collide about 1e307 times; a
 /// delta-tracking walk stops within a few thousand look-ups there, and the

@@ -309,10 +309,18 @@ fn write_reports(
     missing: Vec<String>,
 ) -> Result<PathBuf, RunError> {
     let report_files = run::ReportFiles::begin();
-    let mut entries = Vec::new();
-    let mut checks = Vec::new();
-    let mut problems = missing;
-    for (exp, results) in done {
+    // The experiments' pages at once on rayon's threads, as many as the
+    // memory holds (a report's converged reference and images take up to
+    // REPORT_RESERVE): one after another, a report's serial parts (its
+    // plots, and the end of each doubling of a converged reference) left
+    // the other threads idle. Each failure is said in entry order, whatever
+    // the order in which the reports finish.
+    let at_once = memory::available().map_or(usize::MAX, |a| {
+        (a / memory::REPORT_RESERVE).floor().max(1.0) as usize
+    });
+    let order: Vec<usize> = (0..done.len()).collect();
+    let pages = crate::parallel::dealt(&order, at_once, |k| {
+        let (exp, results) = &done[k];
         let dir = out.join(exp.name());
         // A converged reference is computed now, after the jobs: say so, or
         // a long one looks like a hang (a scene of radius 1e308 took minutes).
@@ -322,9 +330,15 @@ fn write_reports(
                 exp.name()
             );
         }
-        let written = exp
-            .write_report(&dir, results)
-            .map_err(|e| io(&dir, unfinished(e)))?;
+        report_files
+            .record(|| exp.write_report(&dir, results))
+            .map_err(|e| io(&dir, unfinished(e)))
+    });
+    let mut entries = Vec::new();
+    let mut checks = Vec::new();
+    let mut problems = missing;
+    for ((exp, _), written) in done.iter().zip(pages) {
+        let written = written?;
         entries.push((
             exp.name().to_string(),
             exp.description().to_string(),
@@ -354,7 +368,8 @@ fn write_reports(
         })
         .unwrap_or_default();
     earlier.sort();
-    report::write_index(out, &entries, &checks, &audits, &problems, &earlier)
+    report_files
+        .record(|| report::write_index(out, &entries, &checks, &audits, &problems, &earlier))
         .map_err(|e| io(out, unfinished(e)))?;
     report_files.finish();
     let index = out.join("index.md");

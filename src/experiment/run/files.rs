@@ -212,33 +212,55 @@ pub fn write_all_or_none<'a>(
     Ok(())
 }
 
+/// The paths of the report files written so far by one report.
+type Written = std::sync::Arc<std::sync::Mutex<Vec<PathBuf>>>;
+
 thread_local! {
-    /// The files written since [`ReportFiles::begin`] on this thread.
-    static WRITTEN: std::cell::RefCell<Option<Vec<PathBuf>>> =
+    /// The list of the report being written on this thread, inside
+    /// [`ReportFiles::record`].
+    static WRITTEN: std::cell::RefCell<Option<Written>> =
         const { std::cell::RefCell::new(None) };
 }
 
 /// A report written whole or not at all: the files [`write_report_file`]
-/// writes on this thread between [`begin`](Self::begin) and
-/// [`finish`](Self::finish) are removed again when the guard is dropped
-/// unfinished (a full disk at the index left the plots and pages written
-/// before it, with no index). Results files are not report files and stay.
-#[derive(Debug)]
+/// writes inside [`record`](Self::record), on whichever threads, are
+/// removed again when the guard is dropped without
+/// [`finish`](Self::finish) (a full disk at the index left the plots and
+/// pages written before it, with no index). Results files are not report
+/// files and stay.
+#[derive(Debug, Default)]
 pub struct ReportFiles {
+    written: Written,
     finished: bool,
 }
 
 impl ReportFiles {
-    /// Starts recording the report files written on this thread.
+    /// Starts a report with no files written.
     pub fn begin() -> Self {
-        WRITTEN.with(|w| *w.borrow_mut() = Some(Vec::new()));
-        ReportFiles { finished: false }
+        Self::default()
+    }
+
+    /// Runs `f`, recording the report files it writes on this thread. The
+    /// threads of a report written in parallel each record into the one
+    /// list; a thread that takes up another report's work while it waits
+    /// (rayon's work stealing) records that work into its own list, and
+    /// returns to this one after it.
+    pub fn record<R>(&self, f: impl FnOnce() -> R) -> R {
+        /// Puts the list that was there back, also when `f` panics.
+        struct Restore(Option<Written>);
+        impl Drop for Restore {
+            fn drop(&mut self) {
+                let before = self.0.take();
+                WRITTEN.with(|w| *w.borrow_mut() = before);
+            }
+        }
+        let _restore = Restore(WRITTEN.with(|w| w.replace(Some(self.written.clone()))));
+        f()
     }
 
     /// Keeps every file written: the report is complete.
     pub fn finish(mut self) {
         self.finished = true;
-        WRITTEN.with(|w| *w.borrow_mut() = None);
     }
 }
 
@@ -247,7 +269,11 @@ impl Drop for ReportFiles {
         if self.finished {
             return;
         }
-        for path in WRITTEN.with(|w| w.borrow_mut().take()).unwrap_or_default() {
+        let written = match self.written.lock() {
+            Ok(mut list) => std::mem::take(&mut *list),
+            Err(poisoned) => std::mem::take(&mut *poisoned.into_inner()),
+        };
+        for path in written {
             let _ = fs::remove_file(path);
         }
     }
@@ -258,8 +284,11 @@ impl Drop for ReportFiles {
 /// for [`ReportFiles`].
 pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
     WRITTEN.with(|w| {
-        if let Some(list) = w.borrow_mut().as_mut() {
-            list.push(path.to_path_buf());
+        if let Some(list) = w.borrow().as_ref() {
+            match list.lock() {
+                Ok(mut list) => list.push(path.to_path_buf()),
+                Err(poisoned) => poisoned.into_inner().push(path.to_path_buf()),
+            }
         }
     });
     write_atomic(path, bytes).map_err(|e| {
