@@ -8,7 +8,7 @@
 //! longest-processing-time-first schedule), and at most a given number run
 //! at once.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
@@ -44,4 +44,30 @@ pub fn costliest_first<R: Send>(costs: &[u64], work: impl Fn(usize) -> R + Sync)
     let mut order: Vec<usize> = (0..costs.len()).collect();
     order.sort_by_key(|&k| (std::cmp::Reverse(costs[k]), k));
     dealt(&order, usize::MAX, work)
+}
+
+/// [`dealt`] for work that can fail: once an item has failed no new item
+/// is started (the items under way finish), and the error returned is the
+/// first in ascending `k`, the same as if every item had run: an item not
+/// started comes after every item started in `order`, so, with `order`
+/// ascending, after the one that failed.
+pub fn try_dealt<T: Send, E: Send>(
+    order: &[usize],
+    workers: usize,
+    work: impl Fn(usize) -> Result<T, E> + Sync,
+) -> Result<Vec<T>, E> {
+    let failed = AtomicBool::new(false);
+    dealt(order, workers, |k| {
+        if failed.load(Ordering::Relaxed) {
+            return None;
+        }
+        let out = work(k);
+        if out.is_err() {
+            failed.store(true, Ordering::Relaxed);
+        }
+        Some(out)
+    })
+    .into_iter()
+    .flatten()
+    .collect()
 }

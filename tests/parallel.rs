@@ -82,3 +82,36 @@ fn nested_deals_finish() {
     let want: Vec<usize> = (0..6).map(|k| 15 + 6 * k).collect();
     assert_eq!(out, want);
 }
+
+#[test]
+fn after_a_failure_no_item_is_started_and_the_first_failure_in_order_is_returned() {
+    let order: Vec<usize> = (0..40).collect();
+    for threads in [1, 2, 4] {
+        let started = AtomicUsize::new(0);
+        let out: Result<Vec<usize>, usize> = pool(threads).install(|| {
+            lightquad::parallel::try_dealt(&order, usize::MAX, |k| {
+                started.fetch_add(1, Ordering::SeqCst);
+                // The items after the failure take long: the threads start
+                // few of them before it is known.
+                if k > 7 {
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+                if k == 7 || k == 9 || k == 30 {
+                    Err(k)
+                } else {
+                    Ok(k)
+                }
+            })
+        });
+        assert_eq!(out, Err(7), "{threads} threads");
+        let started = started.into_inner();
+        if threads == 1 {
+            assert_eq!(started, 8);
+        } else {
+            assert!(started < 40, "{threads} threads: every item started");
+        }
+        let all: Result<Vec<usize>, usize> =
+            pool(threads).install(|| lightquad::parallel::try_dealt(&order, 2, Ok));
+        assert_eq!(all, Ok(order.clone()));
+    }
+}

@@ -313,13 +313,14 @@ fn write_reports(
     // memory holds (a report's converged reference and images take up to
     // REPORT_RESERVE): one after another, a report's serial parts (its
     // plots, and the end of each doubling of a converged reference) left
-    // the other threads idle. Each failure is said in entry order, whatever
-    // the order in which the reports finish.
+    // the other threads idle. After a failure no report is started (an
+    // error waited on every converged reference), and the failure said is
+    // the first in entry order, whatever the order the reports finish in.
     let at_once = memory::available().map_or(usize::MAX, |a| {
         (a / memory::REPORT_RESERVE).floor().max(1.0) as usize
     });
     let order: Vec<usize> = (0..done.len()).collect();
-    let pages = crate::parallel::dealt(&order, at_once, |k| {
+    let pages = crate::parallel::try_dealt(&order, at_once, |k| {
         let (exp, results) = &done[k];
         let dir = out.join(exp.name());
         // A converged reference is computed now, after the jobs: say so, or
@@ -337,8 +338,7 @@ fn write_reports(
     let mut entries = Vec::new();
     let mut checks = Vec::new();
     let mut problems = missing;
-    for ((exp, _), written) in done.iter().zip(pages) {
-        let written = written?;
+    for ((exp, _), written) in done.iter().zip(pages?) {
         entries.push((
             exp.name().to_string(),
             exp.description().to_string(),

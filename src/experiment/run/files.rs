@@ -223,11 +223,13 @@ thread_local! {
 }
 
 /// A report written whole or not at all: the files [`write_report_file`]
-/// writes inside [`record`](Self::record), on whichever threads, are
-/// removed again when the guard is dropped without
-/// [`finish`](Self::finish) (a full disk at the index left the plots and
-/// pages written before it, with no index). Results files are not report
-/// files and stay.
+/// writes inside [`record`](Self::record) are removed again when the guard
+/// is dropped without [`finish`](Self::finish) (a full disk at the index
+/// left the plots and pages written before it, with no index). Results
+/// files are not report files and stay. Several threads may each call
+/// `record` on one guard; but a file is recorded only on a thread inside
+/// `record`, so work that the closure hands to other threads (a `par_iter`
+/// in it) must not write report files, or must call `record` itself.
 #[derive(Debug, Default)]
 pub struct ReportFiles {
     written: Written,
@@ -240,11 +242,12 @@ impl ReportFiles {
         Self::default()
     }
 
-    /// Runs `f`, recording the report files it writes on this thread. The
-    /// threads of a report written in parallel each record into the one
-    /// list; a thread that takes up another report's work while it waits
-    /// (rayon's work stealing) records that work into its own list, and
-    /// returns to this one after it.
+    /// Runs `f`, recording the report files it writes on this thread (not
+    /// those written by work it hands to other threads). The threads of
+    /// reports written in parallel each record into the one list; a thread
+    /// that takes up another report's work while it waits (rayon's work
+    /// stealing) records that work into that report's list, and returns to
+    /// this one after it.
     pub fn record<R>(&self, f: impl FnOnce() -> R) -> R {
         /// Puts the list that was there back, also when `f` panics.
         struct Restore(Option<Written>);
