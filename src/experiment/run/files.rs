@@ -272,10 +272,14 @@ impl Drop for ReportFiles {
         if self.finished {
             return;
         }
-        let written = match self.written.lock() {
-            Ok(mut list) => std::mem::take(&mut *list),
-            Err(poisoned) => std::mem::take(&mut *poisoned.into_inner()),
-        };
+        // A thread that panicked while holding the list left it whole (a
+        // push), so a poisoned lock still gives every path.
+        let written = std::mem::take(
+            &mut *self
+                .written
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner),
+        );
         for path in written {
             let _ = fs::remove_file(path);
         }
@@ -288,10 +292,9 @@ impl Drop for ReportFiles {
 pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
     WRITTEN.with(|w| {
         if let Some(list) = w.borrow().as_ref() {
-            match list.lock() {
-                Ok(mut list) => list.push(path.to_path_buf()),
-                Err(poisoned) => poisoned.into_inner().push(path.to_path_buf()),
-            }
+            list.lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .push(path.to_path_buf());
         }
     });
     write_atomic(path, bytes).map_err(|e| {
