@@ -40,22 +40,30 @@ fn main() {
     let stamp = if dirty {
         format!("{commit}-dirty")
     } else {
-        commit
+        commit.clone()
     };
     println!("cargo:rustc-env=LIGHTQUAD_GIT_COMMIT={stamp}");
-    // The commit moves when HEAD names another branch, when the branch's
-    // ref file is rewritten, or when refs are packed; the stamp's "-dirty"
-    // when a source changes (staging alone changes neither; `status` takes
-    // no optional lock, so it never rewrites the index under another git).
-    println!("cargo:rerun-if-changed=.git/HEAD");
-    println!("cargo:rerun-if-changed=.git/packed-refs");
+    // The stamp changes with the sources (their "-dirty") and with the
+    // commit: HEAD naming another branch, or a ref moving, loose or packed.
+    // Only paths that exist are watched: cargo takes a watched path that is
+    // missing for a change and would run this script, and rebuild the crate,
+    // on every build. The refs are watched as folders, so a ref file that
+    // appears (a commit after `git pack-refs`) is seen too. Without git or a
+    // checkout (a source tarball) the stamp is empty ("unknown" in reports).
     for source in SOURCES {
-        println!("cargo:rerun-if-changed={source}");
+        watch_if_present(Path::new(source));
     }
-    if let Ok(head) = std::fs::read_to_string(".git/HEAD")
-        && let Some(branch) = head.trim().strip_prefix("ref: ")
-    {
-        println!("cargo:rerun-if-changed=.git/{branch}");
+    if !commit.is_empty() {
+        for (flag, files) in [
+            ("--git-dir", &["HEAD"][..]),
+            ("--git-common-dir", &["packed-refs", "refs/heads"][..]),
+        ] {
+            if let Some(dir) = git(&["rev-parse", flag]) {
+                for file in files {
+                    watch_if_present(&Path::new(dir.trim()).join(file));
+                }
+            }
+        }
     }
 
     let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
@@ -64,7 +72,6 @@ fn main() {
         ("EXPERIMENTS", root.join("experiments")),
         ("VALUES", root.join("reference/values")),
     ] {
-        println!("cargo:rerun-if-changed={}", dir.display());
         code.push_str(&format!("pub static {name}: &[(&str, &str)] = &[\n"));
         for file in json_files(&dir) {
             let file_name = file
@@ -80,6 +87,13 @@ fn main() {
     }
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo")).join("bundled.rs");
     std::fs::write(&out, code).expect("OUT_DIR is writable");
+}
+
+/// Asks cargo to run this script again when `path` changes, if it exists.
+fn watch_if_present(path: &Path) {
+    if path.exists() {
+        println!("cargo:rerun-if-changed={}", path.display());
+    }
 }
 
 /// The `.json` files of `dir` with UTF-8 names, sorted (none when `dir` is
