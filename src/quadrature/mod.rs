@@ -357,7 +357,14 @@ macro_rules! registry {
                 rng: &mut R,
                 f: F,
             ) -> Result<Estimate<V>, QuadError> {
-                match self { $(BaseRule::$rule(r) => r.integrate_unguarded(n, rng, f),)+ }
+                // The integrand as a trait object: a rule chosen at run time
+                // is compiled once per dimension and value type, where a
+                // generic `F` compiled every rule of the registry again for
+                // each integrand. A rule named by its own type keeps its
+                // integrand inlined.
+                let mut f = f;
+                let f: &mut dyn FnMut([f64; D]) -> Result<V, QuadError> = &mut f;
+                match self { $(BaseRule::$rule(r) => r.integrate_unguarded(n, rng, &mut *f),)+ }
             }
         }
     };
