@@ -1,12 +1,12 @@
 //! The memory estimate of a volume job (`Family::memory`) counts the
 //! cumulative optical depth's checkpoint table, one entry per outer node of
-//! V-E and V-L (the hostile review of issue 10: the estimate held the rule's
-//! node table only). Measured here by a counting allocator around the real
-//! evaluation: the peak bytes allocated by a job of I_E above those of a job
+//! V-E and V-L, beside the rule's node table. Measured here by a counting
+//! allocator around the real evaluation: the peak bytes allocated by a job of I_E above those of a job
 //! of tau alone (the same rule, budget and scene: tau's integral holds the
 //! node table, I_E's the table and the checkpoints) against the estimate's
-//! difference. One test in this binary, so that nothing else allocates
-//! while it measures.
+//! difference. A binary of its own with this one test: the counting
+//! allocator counts the whole process, so nothing else may allocate while it
+//! measures.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -51,7 +51,7 @@ fn peak_of(f: impl FnOnce()) -> f64 {
 
 #[test]
 fn the_memory_estimate_counts_the_depth_checkpoints() {
-    // The constant sphere of VALID in tests/runner.rs, emitting, cumulative
+    // The constant sphere of VALID in tests/it/runner.rs, emitting, cumulative
     // depth (the default).
     let spec: SceneSpec = serde_json::from_value(serde_json::json!({
         "ray": {"origin": [-3.0, 0.3, 0.0], "direction": [1.0, 0.0, 0.0]},

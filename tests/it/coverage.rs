@@ -10,7 +10,7 @@
 //! 10^4 independent runs (the seeds are fixed, so every run is the same).
 //! With `R = 400` the accepted counts are about 363..=396 (90.8%..99%).
 
-mod common;
+use crate::common;
 use common::*;
 use lightquad::domain::Vec3;
 use lightquad::exact::volume as exact;
@@ -432,7 +432,7 @@ fn rule_runs(rule: &AnyRule, n: usize, f: Integrand, exact: f64) -> (u64, u64, u
     let (mut covered, mut flagged, mut missed) = (0, 0, 0);
     for seed in 0..R {
         let e = rule
-            .integrate::<1, f64, _, _>(n, &mut rng(70_000 + seed), |u| f(u[0]))
+            .integrate::<1, f64, _, _>(n, &mut rng(70_000 + seed), |u: [f64; 1]| f(u[0]))
             .expect("finite");
         let c = (e.value - exact).abs() <= 1.96 * e.error;
         covered += c as u64;

@@ -24,7 +24,7 @@
 //! (a trapezoid at `n = 2^k - 1`) compare coarser rules with a finer tail,
 //! so every point count has the differences that show a chance agreement.
 
-mod common;
+use crate::common;
 use common::rng;
 use lightquad::quadrature::gauss_kronrod::XGK;
 use lightquad::quadrature::{GaussKronrod, GaussLegendre, Rule, Simpson, Trapezoid};

@@ -5,7 +5,7 @@
 //! the bounces a truncation needs against `ln tol / ln rho`, and bad scenes
 //! named at their JSON paths.
 
-mod common;
+use crate::common;
 use std::fs;
 
 use common::{bin, rel, rng, scratch, stderr};

@@ -9,7 +9,7 @@
 //! double-double angle) within 1 eps absolute for nodes and 2 eps relative for
 //! `1 - |x|` and the weights (measured worst: 0.5 and 1.2).
 
-mod common;
+use crate::common;
 use common::*;
 use lightquad::QuadError;
 use lightquad::quadrature::gauss_legendre::{

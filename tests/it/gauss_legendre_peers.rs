@@ -3,7 +3,7 @@
 //! and all three against the 40-digit values, so "at the same accuracy" is a
 //! measured statement. Run with `--nocapture` to see the figures.
 
-mod common;
+use crate::common;
 use common::*;
 use lightquad::quadrature::gauss_legendre::table;
 

@@ -3,7 +3,7 @@
 //! irradiance at a rectangle's corner at heights down to 1e-6 of its size
 //! (Howell's B-3), and honest or doubted estimates across a jump and a kink.
 
-mod common;
+use crate::common;
 use common::rng;
 use lightquad::exact::rendering::rectangle_corner;
 use lightquad::quadrature::genz_malik::points_per_box;

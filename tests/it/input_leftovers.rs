@@ -5,7 +5,7 @@
 use serde_json::{Value, json};
 use std::fs;
 
-mod common;
+use crate::common;
 use common::{bin, root, scratch, stderr};
 
 /// A bundled experiment with `edit` applied, checked by the binary.

@@ -1,12 +1,10 @@
-//! The memory a job holds, estimated before it runs (`Rule::memory`, issue
-//! 10 item 4: Gauss–Legendre at 1e8 nodes took 5 GB per job), against the
-//! peak resident memory the operating system measured for the real binary
-//! running that job, and the refusal of a budget past the limit.
+//! The refusal of a job whose memory, estimated before it runs
+//! (`Rule::memory`), is past the limit: the cost guard of `check` and `run`,
+//! and a process's address-space limit. The estimate itself is measured
+//! against the operating system's peak in `tests/memory_peak.rs`.
 
 use std::path::PathBuf;
 use std::process::Command;
-
-use lightquad::quadrature::{GaussLegendre, Rule, Trapezoid};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_lightquad"))
@@ -28,75 +26,6 @@ fn scratch(tag: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("scratch");
     dir
-}
-
-/// Runs the job in a child process and returns that child's own peak
-/// resident memory in bytes (`wait4` on its pid: `getrusage(RUSAGE_CHILDREN)`
-/// would report the largest child of the whole test binary, whose other
-/// tests run children of their own at the same time).
-#[cfg(target_os = "linux")]
-fn run_and_measure(rule: &str, n: usize) -> f64 {
-    use std::io::Read;
-    use std::process::Stdio;
-    let dir = scratch(&format!("{rule}-{n}"));
-    let file = dir.join("e.json");
-    std::fs::write(&file, experiment(rule, n)).expect("write");
-    #[expect(clippy::zombie_processes, reason = "reaped by wait4 below")]
-    let mut child = bin()
-        .arg("run")
-        .arg(&file)
-        .arg("--out")
-        .arg(dir.join("out"))
-        .args(["--threads", "1"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("runs");
-    // Drained to the end whatever its bytes, so the child never blocks on a
-    // full pipe.
-    let mut bytes = Vec::new();
-    if let Some(mut e) = child.stderr.take() {
-        let _ = e.read_to_end(&mut bytes);
-    }
-    let stderr = String::from_utf8_lossy(&bytes);
-    let pid = libc::pid_t::try_from(child.id()).expect("pid fits pid_t");
-    let mut status = 0;
-    // SAFETY: wait4 writes one int and one rusage struct, both on our stack;
-    // the child is reaped here and never waited for through `child`.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    let rc = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    assert_eq!(rc, pid, "wait4 failed");
-    assert!(
-        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        "status {status}: {stderr}"
-    );
-    let _ = std::fs::remove_dir_all(&dir);
-    usage.ru_maxrss as f64 * 1024.0
-}
-
-/// The estimates of the two rules whose tables grow with n are within a
-/// factor 1.5 of the peak memory measured (above the binary's own baseline,
-/// measured on a job of 16 nodes).
-#[cfg(target_os = "linux")]
-#[test]
-fn memory_estimates_match_the_measured_peak() {
-    let baseline = run_and_measure("trapezoid", 16);
-    let n = 4_000_000;
-    for (rule, estimate) in [
-        ("trapezoid", Trapezoid.memory(n, 1)),
-        ("gauss-legendre", GaussLegendre::default().memory(n, 1)),
-    ] {
-        let measured = run_and_measure(rule, n) - baseline;
-        let ratio = estimate / measured;
-        eprintln!(
-            "{rule} n = {n}: estimate {estimate:.3e} B, measured {measured:.3e} B, ratio {ratio:.2}"
-        );
-        assert!(
-            (1.0 / 1.5..=1.5).contains(&ratio),
-            "{rule} at n = {n}: estimate {estimate:.3e} B, measured {measured:.3e} B above a \
-             baseline of {baseline:.3e} B (ratio {ratio:.2})"
-        );
-    }
 }
 
 /// Gauss–Legendre at 1e8 nodes is refused at `check` with its memory
@@ -160,8 +89,8 @@ fn a_job_past_a_process_memory_limit_is_refused_with_the_limit() {
             assert!(msg.contains(want), "no `{want}` in {msg}");
         }
     };
-    // Gauss–Legendre at 1e7 nodes holds about 0.56 GB (the estimate tested
-    // above against the measured peak).
+    // Gauss–Legendre at 1e7 nodes holds about 0.56 GB (the estimate measured
+    // against the operating system's peak in tests/memory_peak.rs).
     refused(run(400_000, false));
     assert!(!dir.join("out").exists(), "output left behind");
     let o = run(4_000_000, false);

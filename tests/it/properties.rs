@@ -6,7 +6,7 @@
 //! - invariance under an affine change of variables;
 //! - reproducibility from a seed.
 
-mod common;
+use crate::common;
 use common::*;
 use lightquad::domain::{Segment, integrate_over};
 use lightquad::quadrature::{AnyRule, BaseRule, Rule};
@@ -105,7 +105,7 @@ proptest! {
         let right = Segment::new((a - shift) / s, (b - shift) / s).expect("valid");
         for rule in rules() {
             let ql = integrate_over(&rule, &left, n, &mut rng(seed), f).expect("finite");
-            let qr = integrate_over(&rule, &right, n, &mut rng(seed), |tau| s * f(s * tau + shift))
+            let qr = integrate_over(&rule, &right, n, &mut rng(seed), |tau: f64| s * f(s * tau + shift))
                 .expect("finite");
             let scale = len * (1.0 + 0.1 * a.abs().max(b.abs()));
             prop_assert!(

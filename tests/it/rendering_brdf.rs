@@ -7,7 +7,7 @@
 //! pbrt-v4 style); the inverse of each sampling map by a round trip;
 //! reciprocity (R-rec) and energy conservation by proptest.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

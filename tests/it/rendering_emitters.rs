@@ -17,7 +17,7 @@
 //!   hit it;
 //! - round trips `invert(map(u)) = u` of the cap and BRDF-sampled maps.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

@@ -17,7 +17,7 @@
 use std::f64::consts::PI;
 use std::fs;
 
-mod common;
+use crate::common;
 use common::{bin, bundled, root, scratch, stderr};
 
 use lightquad::domain::Vec3;

@@ -5,7 +5,7 @@
 //! (`exact::rendering::furnace`). The closed form rests on the sphere's
 //! constant kernel, checked here by an independent area integral.
 
-mod common;
+use crate::common;
 use common::rng;
 use lightquad::domain::{SphericalCap, Vec3, integrate_over};
 use lightquad::exact::rendering::{furnace, furnace_truncated};

@@ -6,7 +6,7 @@
 //! Randomised rules are averaged over seeds (root-mean-square error), every
 //! seed fixed, so the fitted orders are reproducible.
 
-mod common;
+use crate::common;
 use common::*;
 use lightquad::QuadError;
 use lightquad::Rgb;
@@ -562,14 +562,14 @@ fn integrands_near_the_top_of_the_f64_range_give_finite_estimates() {
             let (constant, jump) = if d == 1 {
                 (
                     rule.integrate::<1, f64, _, _>(64, &mut rng, |_| 1e308),
-                    rule.integrate::<1, f64, _, _>(64, &mut rng, |u| {
+                    rule.integrate::<1, f64, _, _>(64, &mut rng, |u: [f64; 1]| {
                         if u[0] < 0.5 { -1e308 } else { 1e308 }
                     }),
                 )
             } else {
                 (
                     rule.integrate::<2, f64, _, _>(64, &mut rng, |_| 1e308),
-                    rule.integrate::<2, f64, _, _>(64, &mut rng, |u| {
+                    rule.integrate::<2, f64, _, _>(64, &mut rng, |u: [f64; 2]| {
                         if u[0] < 0.5 { -1e308 } else { 1e308 }
                     }),
                 )
@@ -636,7 +636,7 @@ fn every_channel_keeps_its_own_scale_from_1e_minus_300_to_1e308() {
     let mut rng = rng(9);
     for rule in every_rule() {
         let name = rule.label();
-        let Ok(e) = rule.integrate::<1, lightquad::Rgb, _, _>(64, &mut rng, |u| {
+        let Ok(e) = rule.integrate::<1, lightquad::Rgb, _, _>(64, &mut rng, |u: [f64; 1]| {
             lightquad::Rgb::new(1.7e308 * u[0], f64::MIN_POSITIVE, 1e-300 * u[0])
         }) else {
             assert!(!rule.dimensions().contains(1), "{name} refused");
@@ -698,7 +698,7 @@ fn a_rescaled_second_pass_stays_within_the_budget() {
         for (case, f, exact) in cases {
             for n in [15usize, 45, 47, 95, 255, 1000] {
                 let calls = Cell::new(0u64);
-                let Ok(e) = rule.integrate::<1, f64, _, _>(n, &mut rng(n as u64), |u| {
+                let Ok(e) = rule.integrate::<1, f64, _, _>(n, &mut rng(n as u64), |u: [f64; 1]| {
                     calls.set(calls.get() + 1);
                     f(u[0])
                 }) else {
@@ -753,7 +753,7 @@ fn large_values_past_the_replay_log_and_infinite_values() {
         .filter(|r| r.dimensions().contains(1))
     {
         let calls = std::cell::Cell::new(0u64);
-        let r = rule.integrate::<1, f64, _, _>(64, &mut rng(1), |u| {
+        let r = rule.integrate::<1, f64, _, _>(64, &mut rng(1), |u: [f64; 1]| {
             calls.set(calls.get() + 1);
             if u[0] > 0.5 { f64::INFINITY } else { 1.0 }
         });

@@ -2,7 +2,7 @@
 //! high-order quadrature and each other; stiff and extreme cases; the audit of
 //! the printed formulas; what a scene without a part costs.
 
-mod common;
+use crate::common;
 use common::*;
 use lightquad::domain::Vec3;
 use lightquad::exact::volume as exact;

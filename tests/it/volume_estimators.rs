@@ -3,7 +3,7 @@
 //! and the coverage of their standard errors (a binomial test, statrs, with
 //! the significance stated), and property tests of the transmittance laws.
 
-mod common;
+use crate::common;
 use common::*;
 use lightquad::domain::Vec3;
 use lightquad::geometry::Ray;

@@ -11,7 +11,7 @@
 
 use std::fs;
 
-mod common;
+use crate::common;
 use common::{bin, bundled, fitted_order, root, scratch, stderr};
 
 use lightquad::experiment::validate::{Experiment, deserialize, validate};

@@ -7,7 +7,7 @@ use std::fs;
 use std::io::{BufRead, BufReader};
 use std::process::Stdio;
 
-mod common;
+use crate::common;
 use common::{bin, root, scratch, stderr};
 
 /// `render` refuses to write its PNG or PFM over the experiment file it

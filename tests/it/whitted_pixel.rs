@@ -15,7 +15,7 @@
 //! grid and jittered sampling go as `N^-1`, scrambled Sobol' as `N^-3/2`.
 //! Each test prints its fitted orders.
 
-mod common;
+use crate::common;
 use common::fitted_order;
 
 use lightquad::domain::{Pixel, Vec3};

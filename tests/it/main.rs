@@ -1,0 +1,51 @@
+//! The integration tests: one test binary, one module per area, each
+//! asserting against an independent reference (a closed form, a cited
+//! high-precision table in `tests/data/`, another method).
+//!
+//! One binary links the crate once: `cargo test --release` compiles this
+//! crate and `tests/memory_checkpoints.rs`, which owns its process because
+//! it installs a counting global allocator. Tests here share one process,
+//! so none may change process-wide state (the working folder, environment
+//! variables, rayon's global pool); scratch folders come from
+//! [`common::scratch`], unique per call.
+
+mod common;
+
+mod anywhere;
+mod coverage;
+mod domains;
+mod estimate_honesty;
+mod family_plugin;
+mod furnace_family;
+mod gauss_legendre;
+mod gauss_legendre_peers;
+mod genz_malik;
+mod html_report;
+mod input_leftovers;
+mod line_sum_par;
+mod memory_estimate;
+mod mitsuba;
+mod parallel;
+mod properties;
+mod rendering_brdf;
+mod rendering_contour;
+mod rendering_convergence;
+mod rendering_emitters;
+mod rendering_exact;
+mod rendering_family;
+mod rendering_forms;
+mod rendering_furnace;
+mod rendering_mis;
+mod rules;
+mod runner;
+mod spec_fuzz;
+mod sum_lanes;
+mod tracking_cost;
+mod volume;
+mod volume_emission;
+mod volume_estimators;
+mod volume_media;
+mod whitted_family;
+mod whitted_outputs;
+mod whitted_pixel;
+mod whitted_shading;
