@@ -4,16 +4,20 @@
 //! and what does it cost? lightquad answers with pluggable quadrature rules,
 //! domains that map the unit cube onto the geometry of rendering, and the
 //! equations of volume rendering with a directional light ([`volume`],
-//! docs/EQUATIONS.md V-*) with closed forms ([`exact`]) where they exist, the
-//! rendering equation ([`rendering`], R-*) and Whitted ray tracing
-//! ([`whitted`], W-*: W-6.1 with Phong, recursive rays, the pixel as an
-//! integral over its square).
+//! docs/EQUATIONS.md `V-*`) with closed forms ([`exact`]) where they exist, the
+//! rendering equation ([`rendering`], `R-*`, and its closed scene, the
+//! furnace, in [`rendering::closed`]) and Whitted ray tracing ([`whitted`],
+//! `W-*`: W-6.1 with Phong, recursive rays, the pixel as an integral over its
+//! square).
 //!
-//! Runnable programs in `examples/`: `cargo run --release --example
-//! quadrature_over_a_domain` (a rule over a disk and a hemisphere),
+//! Runnable programs in `examples/` (`cargo run --release --example NAME`):
+//! `quadrature_over_a_domain` (a rule over a disk and a hemisphere),
 //! `volume_term` (transmittance and emission along a ray through a constant
-//! sphere), `experiment_from_code` (an experiment file run from code into a
-//! report); each checks its result against a closed form it computes.
+//! sphere) and `experiment_from_code` (an experiment file run from code into
+//! a report) each check their result against a closed form they compute;
+//! `gl_race` times Gauss–Legendre integration against the crates `bilby` and
+//! `gauss-quad`, and `tracking_race` times the tracking estimators for
+//! `scripts/tracking_race.py`, which races them against Mitsuba 3.
 //!
 //! Three independent axes meet only where an integral is evaluated:
 //!
@@ -37,10 +41,10 @@
 //! ```
 //! use lightquad::domain::{Domain, Hemisphere, integrate_over};
 //! use lightquad::quadrature::GaussLegendre;
-//! use rand::SeedableRng;
+//! use lightquad::rand::SeedableRng;
 //!
 //! // int_{H^2} cos(theta) d omega = pi
-//! let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+//! let mut rng = lightquad::rand_pcg::Pcg64::seed_from_u64(1);
 //! let hemisphere = Hemisphere::uniform();
 //! let est = integrate_over(&GaussLegendre::default(), &hemisphere, 64, &mut rng, |w| w.z)?;
 //! assert!((est.value - std::f64::consts::PI).abs() < 1e-12);
@@ -86,4 +90,17 @@ pub mod whitted;
 
 pub use error::QuadError;
 pub use estimate::{ErrorKind, Estimate};
+/// The random-number crate of the public API (every rule takes a
+/// [`rand::Rng`]), at the version lightquad uses: code using lightquad needs
+/// no dependency on it of its own.
+pub use rand;
+/// The generator the examples and tests seed ([`rand_pcg::Pcg64`]), at the
+/// version lightquad uses.
+pub use rand_pcg;
+
+/// The README's Rust example, compiled and run with the doctests so that it
+/// cannot go stale.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeExample;
 pub use value::{Rgb, Value};

@@ -39,6 +39,11 @@ use crate::family::{Family, Method};
 #[serde(deny_unknown_fields, bound = "")]
 #[schemars(bound = "", rename = "Experiment")]
 pub struct ExperimentSpec<F: Family> {
+    /// The JSON Schema the file follows, for an editor to validate and
+    /// complete it against (`lightquad schema > lightquad.schema.json`);
+    /// any string, not read.
+    #[serde(rename = "$schema", default, skip_serializing_if = "Option::is_none")]
+    pub schema: Option<String>,
     /// Short name (file-name safe: letters, digits, `-`, `_`).
     pub name: String,
     /// The equation family (`volume`, ...): it decides what `scene`,
