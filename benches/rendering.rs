@@ -1,5 +1,5 @@
 //! Time to 1e-6 and to 1e-12 relative error in the irradiance of a
-//! rectangle light (issue 11), per form and rule of the rendering family.
+//! rectangle light, per form and rule of the rendering family.
 //!
 //! The scene is the bundled `r-h-vs-a-tilted-rectangle` (a tilted
 //! parallelogram light over a tilted receiver), whose irradiance has a

@@ -7,7 +7,7 @@
 #                                 committed values file is stale, and regenerates
 #                                 one transmittance and one single-scattering value
 #                                 with few samples into a scratch folder, which the
-#                                 Rust test tests/mitsuba.rs then checks against
+#                                 Rust test tests/it/mitsuba.rs then checks against
 #                                 lightquad (so the harness cannot rot).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,7 +37,7 @@ if [ "${1:-}" = "--ci" ]; then
     ../experiments/mitsuba-tau-constant-sphere.json ../experiments/v-l-single-scattering.json \
     ../experiments/r-h-vs-a-tilted-rectangle.json ../experiments/mitsuba-r-furnace-bounces.json \
     ../experiments/w-ss-edge-coverage.json)
-  LIGHTQUAD_REFERENCE_VALUES="$scratch" cargo test --release --test mitsuba
+  LIGHTQUAD_REFERENCE_VALUES="$scratch" cargo test --release --test it mitsuba::
 else
   # Every experiment that has a committed values file (Mitsuba cannot express
   # every scene: Gaussian blobs, linear gradients and volumetric emission have

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Races lightquad's stochastic volume estimators against Mitsuba 3's on one
 32^3 voxel grid and one ray: the wall time each needs to reach a relative
-standard error of 1e-3 (issue 13, target 3).
+standard error of 1e-3 (the tracking-race target in benches/README.md).
 
     scripts/tracking_race.py [--target 1e-3] [--threads 2] [--repeats 5] [--quick]
                              [--only ratio|delta|light] ... [--json FILE]

@@ -1,6 +1,6 @@
 //! The contract of an equation family: what the experiment layer needs of the
-//! volume-rendering equations (V-*), the rendering equation (R-*) or
-//! Whitted's model (W-*), and nothing more.
+//! volume-rendering equations (`V-*`), the rendering equation (`R-*`) or
+//! Whitted's model (`W-*`), and nothing more.
 //!
 //! A family owns its scene format (serde + JSON Schema), its quantities, the
 //! estimators it has beside the quadrature rules (tracking, path tracing,

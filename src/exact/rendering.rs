@@ -1,5 +1,5 @@
 //! Closed forms of the rendering equation's integrals (docs/EQUATIONS.md,
-//! R-*): form factors and irradiance from Lambertian emitters, cosine-power
+//! `R-*`): form factors and irradiance from Lambertian emitters, cosine-power
 //! lobe integrals and the white furnace.
 //!
 //! A Lambertian emitter of radiance `L` seen from a point with normal `n`

@@ -1,4 +1,4 @@
-//! Closed forms of the volume-rendering terms (docs/EQUATIONS.md, V-*): V-tau for
+//! Closed forms of the volume-rendering terms (docs/EQUATIONS.md, `V-*`): V-tau for
 //! the constant-density sphere and for Gaussian blobs; V-E and V-L for the
 //! constant sphere, `sigma = lambda kappa` on a chord of length `L`.
 //!

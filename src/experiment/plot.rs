@@ -229,8 +229,8 @@ mod tests {
 
     /// Errors across the whole f64 range (a reference of 1.5e-305 beside an
     /// error of 1e305, 5e-324, an infinite error) are plotted, and promptly:
-    /// plotters' log axis looped without end over 320 decades (the hostile
-    /// probe of issue 10). A thread and a deadline make a hang a failure.
+    /// plotters' log axis looped without end over 320 decades. A thread and
+    /// a deadline make a hang a failure.
     #[test]
     fn a_plot_over_every_decade_of_f64_finishes_with_its_decades_labelled()
     -> Result<(), Box<dyn std::error::Error>> {

@@ -30,7 +30,7 @@
 //! the horizon's, the lobe clamp's and the earlier blockers' outlines cross
 //! it ([`crate::rendering::arcs`]), so no piece holds a jump and no
 //! visibility test is made. Checked against an independent contour
-//! integral (Stokes on the sphere of directions, tests/rendering_contour.rs)
+//! integral (Stokes on the sphere of directions, tests/it/rendering_contour.rs)
 //! to 3e-13: a sphere light hiding part of a rectangle light, where the
 //! evaluation over the blocker's cone with a visibility test was 7.3e-5
 //! off while its change between budgets said 5.6e-8.

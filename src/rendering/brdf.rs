@@ -314,7 +314,7 @@ impl Lobe {
 ///
 /// Directional albedo at normal incidence `a(n) = k_s 2 pi / (n + 2)`
 /// ([`crate::exact::rendering::phong_albedo_normal`]). Off normal incidence
-/// it is smaller (measured by quadrature, see tests/rendering_brdf.rs), so
+/// it is smaller (measured by quadrature, see tests/it/rendering_brdf.rs), so
 /// the lobe conserves energy exactly when `k_s 2 pi / (n + 2) <= 1`: for
 /// every `k_s <= 1` once `n >= 2 pi - 2 = 4.28`, but not at `n = 0`, `k_s >
 /// 1/pi` (albedo `pi k_s`).

@@ -1,7 +1,7 @@
 //! A cone of directions about an axis, cut by the receiver's horizon, as
 //! pieces on which an integrand that vanishes below the horizon is smooth:
-//! the split of a Phong lobe at the horizon (issue 11, point 4: splitting
-//! at the kinks the scene can compute).
+//! the split of a Phong lobe at the horizon (splitting at the kinks the
+//! scene can compute).
 //!
 //! About the axis `r` (the lobe's mirror direction) with the unit `t`
 //! toward the normal `n` in the plane of `r` and `n`, a direction at angle

@@ -1,4 +1,4 @@
-//! The rendering-equation family (R-* in docs/EQUATIONS.md): BRDFs,
+//! The rendering-equation family (`R-*` in docs/EQUATIONS.md): BRDFs,
 //! emitters and occluders, and the hemispherical (R-H) and area (R-A)
 //! forms of reflected radiance and irradiance at a point.
 //!

@@ -42,7 +42,7 @@ impl ConstantSphere {
     /// A constant-density sphere; `kappa` finite and >= 0, and 0 or a normal
     /// f64: a subnormal density (1e-320) keeps a few bits, and the closed
     /// form `c (1 - e^(-kappa L)) / kappa` built from it was off by 1.2e-4
-    /// while every rule had `c L` exactly (the hostile probe of issue 10).
+    /// while every rule had `c L` exactly.
     pub fn new(centre: Vec3, radius: f64, kappa: f64) -> Result<Self, QuadError> {
         if !(kappa.is_finite() && (kappa == 0.0 || kappa >= f64::MIN_POSITIVE)) {
             return Err(QuadError::invalid(

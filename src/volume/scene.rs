@@ -1,5 +1,5 @@
 //! A volume-rendering scene along one eye ray: only the parts it has.
-//! (docs/EQUATIONS.md, V-*: a medium, an emission map, a background, a directional
+//! (docs/EQUATIONS.md, `V-*`: a medium, an emission map, a background, a directional
 //! light, optionally with single scattering.)
 //!
 //! ```

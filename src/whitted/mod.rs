@@ -1,4 +1,4 @@
-//! Whitted ray tracing (W-* in docs/EQUATIONS.md): the illumination model
+//! Whitted ray tracing (`W-*` in docs/EQUATIONS.md): the illumination model
 //! W-6.1 with the Phong term (W-Phong), recursive reflection and refraction,
 //! and the pixel as an integral over its square, estimated by supersampling
 //! (W-SS), by Whitted's shared corner rays (W-Corner) and by any rule of the

@@ -751,7 +751,7 @@ fn projected_hemisphere_lets_every_rule_integrate_cosine_weighted_integrands() {
 /// A domain whose measure overflows f64 is refused by its constructor, with
 /// the reason: a disk of radius 1e200 and the segment [-f64::MAX, f64::MAX]
 /// were built, and every integral over them then blamed an integrand that
-/// returned 1.0 (the hostile probe of issue 10); a rectangle of edges 1e200
+/// returned 1.0; a rectangle of edges 1e200
 /// was called "not of finite length", a triangle with a vertex at f64::MAX
 /// "not distinct from a".
 #[test]

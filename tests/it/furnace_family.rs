@@ -1,4 +1,4 @@
-//! The furnace family (issue 11, item 5): the full rendering equation in an
+//! The furnace family: the full rendering equation in an
 //! integrating sphere through the experiment layer. Values against the
 //! closed forms summed here term by term (`L_e sum rho^k` for the white
 //! furnace, the cap's share `L_e (1 - cos alpha)/2` per bounce otherwise),

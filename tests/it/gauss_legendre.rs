@@ -334,8 +334,8 @@ fn the_error_estimate_tracks_the_truth_for_algebraic_and_geometric_convergence()
 }
 
 /// `half_node` refuses what has no node (it returned NaN for n = 0 and a
-/// node outside [-1, 1] for k past the middle; the hostile review of issue
-/// 10), and its last valid k is the middle node, 0 for odd n.
+/// node outside [-1, 1] for k past the middle), and its last valid k is the
+/// middle node, 0 for odd n.
 #[test]
 fn half_node_refuses_orders_and_indices_that_have_no_node() {
     for (n, k, field) in [(0, 0, "n"), (5, 0, "k"), (5, 4, "k"), (4, 3, "k")] {
@@ -346,8 +346,8 @@ fn half_node_refuses_orders_and_indices_that_have_no_node() {
     assert_eq!(middle.one_minus_x, 1.0);
 }
 
-/// The public building blocks refuse what is out of range (hostile probe,
-/// issue 10): `bogaert::node(0, 0)` gave x = -3.4e62 and a weight of
+/// The public building blocks refuse what is out of range:
+/// `bogaert::node(0, 0)` gave x = -3.4e62 and a weight of
 /// -3.7e17, and the unguarded entry point of a rule at `usize::MAX` in three
 /// dimensions ran on (1.8e19 evaluations).
 #[test]

@@ -1,6 +1,6 @@
-//! The leftovers of issue 10's input checks and issue 12's `render` flags,
-//! on the real binary: every refusal names the JSON path (or the flag), the
-//! value in a short form and what is accepted.
+//! The input checks and the `render` flags, on the real binary: every
+//! refusal names the JSON path (or the flag), the value in a short form and
+//! what is accepted.
 
 use serde_json::{Value, json};
 use std::fs;
@@ -215,7 +215,7 @@ fn a_number_beyond_f64_as_the_description_asks_for_a_string() {
     refused(&o, "description", &["1e400", "line 4", "expected a string"]);
 }
 
-/// `lightquad render`'s own faults (the hostile probe of issue 12).
+/// `lightquad render`'s own faults.
 #[test]
 fn render_flags_and_files_are_checked_and_named() {
     let dir = scratch("render-flags");
@@ -312,8 +312,8 @@ fn the_fov_minimum_is_stated_and_phong_zero_is_accepted() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
-/// The cost guard counts the work of one evaluation (issue 10, the hostile
-/// probe of session 21): a lookup in 2000 Gaussian blobs, a sample's shadow
+/// The cost guard counts the work of one evaluation (the hostile probe of
+/// session 21): a lookup in 2000 Gaussian blobs, a sample's shadow
 /// ray against 2000 occluders, a ray against 500 objects each passed as one
 /// evaluation, and jobs of days were accepted. Each is refused now, at
 /// `budgets`, with its estimate; without the factor each stays under 1e11.
@@ -590,8 +590,8 @@ fn render_refuses_an_image_that_would_not_fit_in_memory() {
 }
 
 /// An empty file, a file cut short and a key that is not a string: each is
-/// named where it is (the hostile probe of issue 10 saw `.` for an empty file
-/// and `scene.?` for a key it could not read).
+/// named where it is (they were named `.` for an empty file and `scene.?`
+/// for a key that could not be read).
 #[test]
 fn empty_cut_short_and_unreadable_keys_are_named_where_they_are() {
     refused(&check_text(""), ".", &["the file is empty"]);
@@ -610,7 +610,7 @@ fn empty_cut_short_and_unreadable_keys_are_named_where_they_are() {
         &["key must be a string"],
     );
     // A byte-order mark was "expected value at line 1 column 1", and more
-    // after the object "trailing characters" (hostile probe, issue 10).
+    // after the object "trailing characters".
     refused(
         &check_text(&format!("\u{feff}{text}")),
         ".",
@@ -644,7 +644,7 @@ fn empty_cut_short_and_unreadable_keys_are_named_where_they_are() {
 /// the primary-ray count and would have run for hours. And it checks its
 /// flags and output folders before rendering: `--width 0` was named as the
 /// file's `scene.camera.width`, and an unwritable `--pfm` was found after
-/// the render, leaving the PNG behind (the hostile probe of issue 10).
+/// the render, leaving the PNG behind.
 #[test]
 fn render_counts_the_ray_tree_and_checks_its_outputs_first() {
     let dir = scratch("render-tree");
@@ -706,7 +706,7 @@ fn render_counts_the_ray_tree_and_checks_its_outputs_first() {
 }
 
 /// An equation ID in a family that has none said so with an empty list
-/// ("expected one of" and nothing; the hostile probe of issue 10).
+/// ("expected one of" and nothing).
 #[test]
 fn an_equation_id_in_a_family_without_equations_says_there_are_none() {
     let o = check_edited("calibration-exp.json", |v| {
@@ -716,7 +716,7 @@ fn an_equation_id_in_a_family_without_equations_says_there_are_none() {
 }
 
 /// `lightquad schema | head -1` ended with "error: Broken pipe": a reader
-/// that stops early is no failure (hostile probe, issue 10).
+/// that stops early is no failure.
 #[test]
 fn a_reader_that_stops_early_is_no_error() {
     use std::io::Read;
@@ -745,8 +745,7 @@ fn a_reader_that_stops_early_is_no_error() {
 
 /// A run whose stderr is closed (`run 2>&1 | head -2`) finishes its jobs and
 /// its report: the first progress line to the closed pipe panicked, and the
-/// run stopped after three experiments without a report (hostile probe,
-/// issue 10). `merge` likewise.
+/// run stopped after three experiments without a report. `merge` likewise.
 #[test]
 fn a_run_whose_stderr_is_closed_finishes_its_report() {
     let dir = common::scratch("closed-stderr");
@@ -791,7 +790,7 @@ fn a_run_whose_stderr_is_closed_finishes_its_report() {
 }
 
 /// A voxel count names a range a person can read: `1..=18446744073709551615`
-/// was printed for `resolution[0]: []` (hostile probe, issue 10).
+/// was printed for `resolution[0]: []`.
 #[test]
 fn a_voxel_count_names_a_readable_range() {
     let mut spec: serde_json::Value = serde_json::from_str(

@@ -123,8 +123,8 @@ fn a_job_past_a_process_memory_limit_is_refused_with_the_limit() {
 /// written, whatever its size: under `ulimit -v` of 60 to 240 MB the run
 /// aborted part-way ("memory allocation of 280 bytes failed", results of
 /// some experiments and no report) where the room measured at the start
-/// missed the workers' allocator arenas and the reports (hostile probe,
-/// issue 10); and threads the limits cannot start are named as --threads.
+/// missed the workers' allocator arenas and the reports; and threads the
+/// limits cannot start are named as --threads.
 #[test]
 fn a_run_under_a_tight_cap_is_refused_whole_or_runs_whole() {
     let dir = scratch("tight");

@@ -6,8 +6,8 @@
 //! at the light's outline), and the stiff cases where a plain
 //! parameterisation fails (a receiver 1e-3 and 1e-6 of the light's size
 //! below a disk or a rectangle; a cap or sphere crossing the horizon),
-//! which issue 11 item 4 (adaptive cubature, peak-resolving maps, splitting
-//! at kinks) is to fix.
+//! which adaptive cubature, peak-resolving maps and splitting at kinks are
+//! there to fix.
 
 use std::f64::consts::PI;
 
@@ -186,7 +186,7 @@ fn smooth_cases_converge_spectrally_hemisphere_algebraically() -> Result<(), Qua
     Ok(())
 }
 
-/// The stiff cases of issue 11 item 4 with the plain maps: a receiver very
+/// The stiff cases with the plain maps: a receiver very
 /// close to a disk (on its axis) and to a rectangle (below its centre), a sphere
 /// nearly touching the receiver's point of view, a cap and a sphere light
 /// across the horizon (Snyder's closed form).

@@ -1,4 +1,4 @@
-//! The full rendering equation in an integrating sphere (issue 11, item 5):
+//! The full rendering equation in an integrating sphere:
 //! the Neumann series bounce by bounce and path tracing with Russian
 //! roulette, against the closed form `L = L_e [cap] + rho L_e (1 - cos
 //! alpha) / (2 (1 - rho))` and the white furnace `L_e / (1 - rho)`

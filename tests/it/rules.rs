@@ -376,7 +376,7 @@ fn bad_input_is_a_clear_error_never_a_panic() {
         assert!(e.to_string().contains("NaN"), "{e}");
     }
     // A product rule names the point in the square (it named the inner
-    // rule's 1-D point, the hostile probe of issue 10); stratified sampling
+    // rule's 1-D point); stratified sampling
     // of a 0-dimensional integral says it needs a dimension.
     let e = AnyRule::by_name("product(gauss-legendre,trapezoid)")
         .expect("a rule")
@@ -598,7 +598,7 @@ fn integrands_near_the_top_of_the_f64_range_give_finite_estimates() {
 
 /// Values of `+-f64::MAX` at three Monte Carlo samples: the standard error,
 /// about 2.2 f64::MAX, lies beyond the f64 range, and came back infinite and
-/// trusted (the hostile review of issue 10). An infinite error is no bound a
+/// trusted. An infinite error is no bound a
 /// report can show: the estimate is doubted, whichever rule took it.
 #[test]
 fn an_error_beyond_the_f64_range_is_doubted() {
@@ -629,7 +629,7 @@ fn an_error_beyond_the_f64_range_is_doubted() {
 /// 2.2e-308 was scaled by the large one's 2^-e to 0 and came back as 0 with
 /// an error of 0 (Monte Carlo, stratified, Sobol', Gauss–Kronrod); and an
 /// integrand near 1e-300 had its squared deviations underflow, a standard
-/// error of 0 (the hostile review of issue 10). Integrals: `int_0^1 1.7e308 x
+/// error of 0. Integrals: `int_0^1 1.7e308 x
 /// = 8.5e307`, `int 2.2e-308 = 2.2e-308`, `int 1e-300 x = 5e-301`.
 #[test]
 fn every_channel_keeps_its_own_scale_from_1e_minus_300_to_1e308() {
@@ -666,7 +666,7 @@ fn every_channel_keeps_its_own_scale_from_1e_minus_300_to_1e308() {
 /// The rescaled second pass keeps the budget: integrands whose values lie
 /// below 2^-500 (squares underflow) or above 2^500 (sums overflow) are taken
 /// again scaled, and that pass replays the first's draws and values instead
-/// of evaluating again (the hostile probe of issue 9: stratified sampling
+/// of evaluating again (stratified sampling
 /// made 510 evaluations at a budget of 255 on a Gaussian peak of width 1e-4
 /// that no sample reached, G7-K15 90 at 45, Sobol' 64 at 47). Counted
 /// calls: at most the rule's own promise (`Rule::evaluations`, the budget

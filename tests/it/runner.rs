@@ -562,8 +562,8 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
         ["calibration", "volume", "rendering", "whitted", "furnace"]
     );
     // Every object the schema describes is closed, as `check` refuses
-    // unknown fields: `{"rule": "trapezoid", "foo": 1}` passed the schema
-    // (the hostile probe of issue 10); and `name` says what `check` accepts.
+    // unknown fields: `{"rule": "trapezoid", "foo": 1}` passed the schema;
+    // and `name` says what `check` accepts.
     fn open_objects(v: &serde_json::Value, path: &str, out: &mut Vec<String>) {
         match v {
             serde_json::Value::Object(m) => {
@@ -860,9 +860,8 @@ fn faults_inside_rules_and_references_are_named_where_they_are() {
 }
 
 /// A medium whose extinction or optical depth overflows f64 is refused at
-/// `check` naming the medium (found by the hostile review of issue 9: the
-/// terms of a linear gradient of radius 1e300 came out 0, silently; blobs of
-/// amplitude 1e308 failed every job).
+/// `check` naming the medium (the terms of a linear gradient of radius 1e300
+/// came out 0, silently; blobs of amplitude 1e308 failed every job).
 #[test]
 fn media_whose_optical_depth_overflows_are_refused_at_check() {
     let blobs = VALID.replace(
@@ -901,13 +900,12 @@ fn media_whose_optical_depth_overflows_are_refused_at_check() {
 }
 
 /// A constant sphere whose optical depth overflows is refused at the field
-/// that does it, with the value and the largest it may take (the hostile
-/// review of issue 10: kappa = 1e308 and radius = 1e308 were refused at
-/// `scene.medium` only). VALID's ray, y = 0.3 from the centre, has the
-/// chord 2 sqrt(1 - 0.3^2) = 1.908 in the unit sphere, so kappa may reach
-/// f64::MAX / 1.908 = 9.42e307; a sphere of radius 1e308 holds the ray's
-/// origin, so its chord from t = 0 is r + 3 (about r), and with kappa = 2
-/// the radius may reach f64::MAX / 2 = 8.99e307.
+/// that does it, with the value and the largest it may take (kappa = 1e308 and
+/// radius = 1e308 were refused at `scene.medium` only). VALID's ray, y = 0.3
+/// from the centre, has the chord 2 sqrt(1 - 0.3^2) = 1.908 in the unit
+/// sphere, so kappa may reach f64::MAX / 1.908 = 9.42e307; a sphere of radius
+/// 1e308 holds the ray's origin, so its chord from t = 0 is r + 3 (about r),
+/// and with kappa = 2 the radius may reach f64::MAX / 2 = 8.99e307.
 #[test]
 fn a_sphere_whose_depth_overflows_is_refused_at_kappa_or_radius_with_the_range() {
     let chord = 2.0 * (1.0f64 - 0.09).sqrt();
@@ -1114,8 +1112,8 @@ fn infinite_error_estimates_survive_the_results_file() {
     same(&results(&merged, "t"), &results(&out, "t"));
     let _ = fs::remove_dir_all(&dir);
 
-    // Where tau underflows to 0 its error was 0 * inf, written as NaN
-    // (hostile probe, issue 10): no estimate is inf there too.
+    // Where tau underflows to 0 its error was 0 * inf, written as NaN: no
+    // estimate is inf there too.
     let stiff = fs::read_to_string(root().join("experiments/v-tau-stiff-sphere.json"))
         .expect("bundled")
         .replace(
@@ -1170,7 +1168,7 @@ fn emission_near_the_top_of_the_f64_range_is_integrated_not_failed() {
 }
 
 /// A key given twice is refused, not silently the last one, at the key's
-/// own path (a top-level key was placed at `.`, the hostile probe of issue 10).
+/// own path (a top-level key was placed at `.`).
 #[test]
 fn duplicate_keys_are_refused() {
     rejected(
@@ -1223,7 +1221,7 @@ fn an_incomplete_merge_says_so_in_the_index() {
     let _ = fs::remove_dir_all(&dir);
 }
 
-/// Regression (issue 9, item 9): a converged reference is converged per
+/// Regression: a converged reference is converged per
 /// quantity, well below the tightest target. The bundled voxel grid's
 /// reference was Gauss–Legendre at n = 16 against 32, which changed I_L by
 /// 2.2e-6; that one figure was every quantity's accuracy, so every rule was
@@ -1257,7 +1255,7 @@ fn a_converged_reference_is_converged_per_quantity() {
     let _ = fs::remove_dir_all(&dir);
 }
 
-/// Regressions from the issue 9 hostile review: a negative emission is
+/// Regressions: a negative emission is
 /// refused like a negative background; a reference value for a quantity the
 /// experiment does not ask for is refused, not ignored.
 #[test]
@@ -1277,7 +1275,7 @@ fn negative_emission_and_stray_reference_values_are_refused() {
     );
 }
 
-/// Regression from the issue 9 hostile review: with kappa 0 no collision is
+/// Regression: with kappa 0 no collision is
 /// possible, so delta tracking's tau = 1 and I_E = 0 are exact (closed forms
 /// 1 and 0): no Wilson bound, no "all walks alike" flag.
 #[test]
@@ -1457,8 +1455,8 @@ fn delta_tracking_with_an_emission_field_is_refused_at_check() {
 
 /// The slope against n is fitted against the resolution the rule really
 /// uses: Simpson takes the largest 4k + 1 <= n points, so against the budget
-/// its slope read -4.39 on calibration-exp (the independent check of issue
-/// 9); against its intervals (error `h^4 (f'(1) - f'(0)) / 180`) it is -4.
+/// its slope read -4.39 on calibration-exp; against its intervals (error
+/// `h^4 (f'(1) - f'(0)) / 180`) it is -4.
 #[test]
 fn simpson_and_the_trapezoid_show_their_orders_against_the_points_they_use() {
     let (dir, out, o) = run_text(
@@ -1543,7 +1541,7 @@ fn a_second_run_into_a_busy_folder_stops_and_touches_nothing() {
     let _ = fs::remove_dir_all(&dir);
 }
 
-/// Inputs that passed `check` or hung (issue 10, item 5): a 300-character
+/// Inputs that passed `check` or hung: a 300-character
 /// name (the run then failed, "File name too long", with a folder left); a
 /// Mitsuba values file or an experiment file that is a FIFO or /dev/zero
 /// (read forever).
@@ -1580,7 +1578,7 @@ fn long_names_and_files_that_are_not_regular_are_refused() {
 
 /// The nested depth scheme at a budget of 1e6 was accepted and would have run
 /// for about 22 hours: a job's cost is estimated before anything runs
-/// (issue 10, item 4), refused with the estimate and the flag that lifts it.
+/// and refused with the estimate and the flag that lifts it.
 #[test]
 fn jobs_that_would_take_hours_are_refused_with_their_estimate() {
     let nested = VALID
@@ -1630,7 +1628,7 @@ fn jobs_that_would_take_hours_are_refused_with_their_estimate() {
 
 /// A ray that misses the sphere: every density-driven term is 0 (tau = 1,
 /// I_B = I_b), which the closed-form reference used to refuse ("no closed
-/// form for this scene"; issue 10, item 5).
+/// form for this scene").
 #[test]
 fn a_ray_that_misses_the_medium_has_closed_forms() {
     let text = VALID
@@ -1665,8 +1663,8 @@ fn a_ray_that_misses_the_medium_has_closed_forms() {
 }
 
 /// Shards share a folder, but a whole run or a merge may not join them, and
-/// a merge does not read a folder shards are still writing (the hostile
-/// review of issue 10 ran `run --shard` and `run` into one folder at once).
+/// a merge does not read a folder shards are still writing (`run --shard`
+/// and `run` were run into one folder at once).
 #[test]
 fn shards_exclude_whole_runs_and_merges_of_their_folder() {
     let (dir, out, o) = run_text("shardlock", VALID);
@@ -1718,7 +1716,7 @@ fn shards_exclude_whole_runs_and_merges_of_their_folder() {
     let _ = fs::remove_dir_all(&dir);
 }
 
-/// Values near 1.8e308 (the hostile review of issue 10): the report's mean
+/// Values near 1.8e308: the report's mean
 /// over repeats overflowed to an unflagged `inf`, and a Monte Carlo standard
 /// error of values near 1e308 was stored as `inf`.
 #[test]
@@ -1755,8 +1753,7 @@ fn means_and_standard_errors_near_the_top_of_the_f64_range_stay_finite() {
 
 /// `--resume` reads every line on its own and says which it does not reuse:
 /// one line that is not UTF-8 in the middle of results.jsonl ended the
-/// reading, and every later line was dropped and re-run in silence (the
-/// hostile review of issue 10).
+/// reading, and every later line was dropped and re-run in silence.
 #[test]
 fn resume_reads_past_a_bad_line_and_says_what_it_does_not_reuse() {
     let (dir, out, o) = run_text("badline", VALID);
@@ -1800,7 +1797,7 @@ fn resume_reads_past_a_bad_line_and_says_what_it_does_not_reuse() {
 
 /// A value near the top of the range against a reference of the other sign:
 /// their difference overflowed, and the report showed a true error of `inf`
-/// where it is |I_E - r| / |r| = 1.38 (the hostile review of issue 10, M4).
+/// where it is |I_E - r| / |r| = 1.38.
 /// I_E = c (1 - e^{-sigma L}) / sigma with c = 1.7e308, sigma = 2, L = 2
 /// sqrt(1 - 0.3^2), against the reference -1.7e308. A radiance is never
 /// negative, so `check` now refuses that literal reference (see
@@ -1840,7 +1837,7 @@ fn true_errors_near_the_top_of_the_range_do_not_overflow() {
 }
 
 /// A value of the wrong JSON kind where a name or an object is needed lists
-/// what is accepted (the hostile review of issue 10, M5): enum fields said
+/// what is accepted: enum fields said
 /// only "expected string or map", and `"scene": [1, 2]` was reported at
 /// `scene[0]`.
 #[test]
@@ -1911,10 +1908,10 @@ fn a_value_of_the_wrong_kind_lists_what_is_accepted() {
     );
 }
 
-/// Every number error states the range the field accepts (the hostile
-/// review of issue 10, M6): `"replicates": -1` said `>= 0` (it accepts
-/// 2..=1000000), `budgets: [18446744073709551615]` named no range, and a
-/// number past the f64 range said only "number out of range".
+/// Every number error states the range the field accepts: `"replicates": -1`
+/// said `>= 0` (it accepts 2..=1000000), `budgets: [18446744073709551615]`
+/// named no range, and a number past the f64 range said only "number out of
+/// range".
 #[test]
 fn every_number_error_states_the_range_the_field_accepts() {
     rejected(
@@ -1969,14 +1966,13 @@ fn every_number_error_states_the_range_the_field_accepts() {
     );
 }
 
-/// A whole number beyond the f64 range (1e400), or beyond what the field
-/// holds (1000000000000000000000, which JSON readers give as the float
-/// 1e21), is refused naming the range the field accepts (the hostile review
-/// of issue 10: 1e400 said only "expected a finite number", 1e21 "invalid
-/// type: floating point"); a whole number written with an exponent (1e3)
-/// is the whole number JSON Schema's `integer` says it is. The ranges are
-/// the schema's (`lightquad schema`: repeats 1..=1000, budgets
-/// 1..=100000000, reference.n 2..=100000, seed a u64).
+/// A whole number beyond the f64 range (1e400), or beyond what the field holds
+/// (1000000000000000000000, which JSON readers give as the float 1e21), is
+/// refused naming the range the field accepts (1e400 said only "expected a
+/// finite number", 1e21 "invalid type: floating point"); a whole number
+/// written with an exponent (1e3) is the whole number JSON Schema's `integer`
+/// says it is. The ranges are the schema's (`lightquad schema`: repeats
+/// 1..=1000, budgets 1..=100000000, reference.n 2..=100000, seed a u64).
 #[test]
 fn whole_numbers_beyond_the_range_name_the_range() {
     let schema = bin().arg("schema").output().expect("runs");
@@ -2049,9 +2045,9 @@ fn whole_numbers_beyond_the_range_name_the_range() {
     let _ = fs::remove_dir_all(&dir);
 }
 
-/// A missing field is named at its own path, not at the object that lacks
-/// it (the hostile review of issue 10, M7): `scene.ray.origin`, not
-/// `scene.ray`. Every required field of a valid file, dropped in turn.
+/// A missing field is named at its own path, not at the object that lacks it:
+/// `scene.ray.origin`, not `scene.ray`. Every required field of a valid file,
+/// dropped in turn.
 #[test]
 fn a_missing_field_is_named_at_its_own_path() {
     // What each accepts, as the schema (`lightquad schema`) and the README
@@ -2144,9 +2140,9 @@ fn a_missing_field_is_named_at_its_own_path() {
 }
 
 /// A radiance, intensity or transmittance given as a literal reference is
-/// refused outside what the quantity can take (the hostile review of issue
-/// 10, M4): `I_E: -1` was accepted and every error measured against it.
-/// `ln_tau` may be negative (it is at most 0).
+/// refused outside what the quantity can take: `I_E: -1` was accepted and
+/// every error measured against it. `ln_tau` may be negative (it is at
+/// most 0).
 #[test]
 fn a_reference_value_outside_what_the_quantity_can_take_is_refused() {
     let with = |values: &str| {
@@ -2181,7 +2177,7 @@ fn a_reference_value_outside_what_the_quantity_can_take_is_refused() {
     let _ = fs::remove_dir_all(&dir);
 }
 
-/// What the independent check of the reports found (issue 9): on the stiff
+/// What an independent check of the reports found: on the stiff
 /// sphere (optical depth 1e5) `I_B = e^-100000` reads 0 against a
 /// reference of 0 and was shown unflagged, ranked by time and "at the error
 /// floor from its first budget: easy"; it is flagged as underflowing like
@@ -2255,10 +2251,10 @@ fn underflow_constant_integrands_and_missing_estimates_are_labelled() {
     }
 }
 
-/// File system faults name the path and the reason in words (the hostile
-/// review of issue 10, low): not found, a directory, a FIFO, a device, an
-/// --out that is a file; a Mitsuba reference that is some other JSON file
-/// says it is not a values file and what it lacks (it was called "stale").
+/// File system faults name the path and the reason in words: not found, a
+/// directory, a FIFO, a device, an --out that is a file; a Mitsuba reference
+/// that is some other JSON file says it is not a values file and what it lacks
+/// (it was called "stale").
 #[test]
 fn file_system_faults_name_the_path_and_the_reason() {
     let dir = scratch("fs");
@@ -2323,7 +2319,7 @@ fn file_system_faults_name_the_path_and_the_reason() {
     );
     // Named like a bundled experiment whose (bundled) values were made from
     // another file: the named file is still the fault, not those values'
-    // staleness (the hostile review of issue 10).
+    // staleness.
     let bundled = VALID
         .replace("\"name\": \"t\"", "\"name\": \"v-tau-stiff-sphere\"")
         .replace(
@@ -2351,9 +2347,9 @@ fn file_system_faults_name_the_path_and_the_reason() {
 }
 
 /// A sphere of subnormal radius is refused at check with the accepted range
-/// (the hostile review of issue 10, M1: radius 1e-310 gave a closed-form
-/// ln tau of -inf); tiny normal radii seen from far away are measured right
-/// (M2: radius 1e-200 from a distance of 3, ln tau = -kappa 2r = -4e-200).
+/// (radius 1e-310 gave a closed-form ln tau of -inf); tiny normal radii seen
+/// from far away are measured right (radius 1e-200 from a distance of 3,
+/// ln tau = -kappa 2r = -4e-200).
 #[test]
 fn sphere_radii_are_normal_numbers_and_tiny_ones_are_measured_right() {
     let with = |r: &str| {
@@ -2384,7 +2380,7 @@ fn sphere_radii_are_normal_numbers_and_tiny_ones_are_measured_right() {
     }
 }
 
-/// The hostile review of issue 10, H7: a constant sphere of radius 1e308
+/// A constant sphere of radius 1e308
 /// (optical depth 8e307, 1024 graded pieces) with a light and a converged
 /// reference ran for minutes (n = 1000: 292 s; n = 1e5 for hours): the
 /// adaptive rule spent its whole budget on every piece past the depth where
@@ -2443,8 +2439,8 @@ fn a_sphere_of_radius_1e308_with_a_converged_reference_runs_in_seconds() {
 }
 
 /// A table whose rows count more evaluations than their budget says why,
-/// in the Markdown and the HTML page (the hostile review of issue 10: V-E
-/// with Gauss–Legendre showed about 50 n evaluations unexplained). The
+/// in the Markdown and the HTML page (V-E with Gauss–Legendre showed about
+/// 50 n evaluations unexplained). The
 /// independent facts: V-E's outer nodes walk the cumulative depth (about
 /// 12 lookups each), and Gauss–Legendre's estimate evaluates 3.5 n; the
 /// trapezoid on tau alone evaluates exactly its n nodes on the one smooth
@@ -2722,7 +2718,7 @@ fn failed_writes_and_killed_runs_leave_no_temporary_files() {
 
 /// Shards of an experiment whose Mitsuba values file is named by a path
 /// relative to the experiment file: `run` found it, `merge` of the shards'
-/// folders did not (the hostile probe of issue 10). A run keeps a copy
+/// folders did not. A run keeps a copy
 /// beside `experiment.json`, and the merged report compares with it.
 #[test]
 fn shards_with_a_relative_mitsuba_values_file_merge() {
@@ -2776,7 +2772,7 @@ fn shards_with_a_relative_mitsuba_values_file_merge() {
 /// as this version writes them: a line copied with `"rule_index": 99` was
 /// kept as a fifth job of a four-job file and shown as a row "rule #99", and
 /// a value of two channels for a scalar was shown with no true error, and a
-/// line whose seed was edited was reused (the hostile probe of issue 10).
+/// line whose seed was edited was reused.
 #[test]
 fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
     let (dir, out, o) = run_text("misfits", VALID);
@@ -2835,8 +2831,7 @@ fn resume_and_merge_reuse_only_results_of_the_files_jobs() {
 /// (a file where its folder goes said "already exists", and a folder named
 /// results.jsonl was named as the experiment's folder); and a run without
 /// `--resume` says it replaces the earlier results of the same file (a rerun
-/// killed at once had turned 360 results into 80 without a word; the
-/// hostile probe of issue 10).
+/// killed at once had turned 360 results into 80 without a word).
 #[test]
 fn what_is_in_the_way_is_named_and_replaced_results_are_said() {
     let dir = scratch("in-the-way");
@@ -2889,8 +2884,7 @@ fn what_is_in_the_way_is_named_and_replaced_results_are_said() {
 }
 
 /// A report file that cannot be written is named with the reason in words
-/// (a full disk during the report said only "No space left on device"; the
-/// hostile probe of issue 10).
+/// (a full disk during the report said only "No space left on device").
 #[test]
 fn a_report_that_cannot_be_written_is_named_and_leaves_no_partial_pages() {
     let dir = scratch("unwritable");
@@ -3012,7 +3006,7 @@ fn reports_written_in_parallel_are_removed_together_and_the_first_failure_is_sai
 /// delta-tracking walk stops within a few thousand look-ups there, and the
 /// guard now lets it through) could never
 /// be merged: `merge`, which runs no job, re-ran the cost guard and had no
-/// flag to lift it (hostile probe, issue 10). And `check` advised lowering
+/// flag to lift it. And `check` advised lowering
 /// the budget, which cannot help there.
 #[test]
 fn shards_run_past_the_cost_limit_merge_and_the_advice_fits_the_cause() {

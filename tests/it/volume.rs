@@ -105,7 +105,7 @@ fn constant_sphere_terms_match_closed_forms_over_six_decades_of_optical_depth() 
 /// point rounds onto the entry point (a hair outside the sphere): the
 /// density read 0 in the layer, and every rule agreed on I_E = 1.5e-17 for
 /// the closed form 1e-20 at sigma = 1e20 (relative error 1.5e3; 3.8e32 at
-/// 1e50), unflagged. Found by the hostile review of issue 10.
+/// 1e50), unflagged.
 #[test]
 fn emission_and_light_of_a_boundary_layer_far_thinner_than_rounding_are_right() {
     let (r, h): (f64, f64) = (1.0, 0.3);
@@ -632,7 +632,7 @@ fn proportional_emission_obeys_the_identity_i_e_equals_k_over_lambda_times_one_m
     }
 }
 
-/// Regression (issue 9, item 2): V-L through a grazing chord. Eye ray at
+/// Regression: V-L through a grazing chord. Eye ray at
 /// height R(1 - eps) in a unit sphere from x = -3, optical depth 1 along the
 /// chord, light straight behind the eye, so the shadow rays run back along the
 /// chord and start next to the surface. Against the closed form
@@ -677,12 +677,12 @@ fn grazing_shadow_rays_are_accurate_to_1e_12() {
     }
 }
 
-/// An eye inside a very large sphere (found by the hostile review of issue
-/// 9): measured from the middle of a chord of 1e20 the graded cuts near the
-/// eye rounded to multiples of 8192, and every rule gave I_E = 4096 against
-/// the closed form `c (1 - e^{-kappa L})`, 1 to 1e-16 here (4.0 at R = 1e17,
-/// 1.22 at 1e16 for a linear gradient). Measured from the start of the
-/// support the terms do not depend on R.
+/// An eye inside a very large sphere: measured from the middle of a chord
+/// of 1e20 the graded cuts near the eye rounded to multiples of 8192, and
+/// every rule gave I_E = 4096 against the closed form `c (1 - e^{-kappa
+/// L})`, 1 to 1e-16 here (4.0 at R = 1e17, 1.22 at 1e16 for a linear
+/// gradient). Measured from the start of the support the terms do not
+/// depend on R.
 #[test]
 fn an_eye_inside_a_huge_medium_sees_the_closed_form() {
     for radius in [1e3, 1e8, 1e16, 1e17, 1e20, 1e100, 1e300] {
@@ -717,7 +717,7 @@ fn an_eye_inside_a_huge_medium_sees_the_closed_form() {
     }
 }
 
-/// Regression (issue 9, item 3): ln tau is a quantity of its own, exact in
+/// Regression: ln tau is a quantity of its own, exact in
 /// log space where tau underflows. One Gaussian blob of width w and peak A
 /// on the ray's line: `int A e^{-t^2/(2 w^2)} dt = A w sqrt(2 pi)` over the
 /// line, here set to an optical depth of 1e5.
@@ -752,7 +752,7 @@ fn ln_tau_is_reported_where_tau_underflows() {
     assert_eq!(tau.flags, [Flag::Underflow]);
 }
 
-/// Regression (issue 9, item 1): V-L with single scattering by the trapezoid
+/// Regression: V-L with single scattering by the trapezoid
 /// rule converges at order 2 in n. The bundled v-l-single-scattering scene
 /// (height 0.2, kappa 1.5, light behind the eye) showed a slope of -1.04
 /// while a chord end read as outside the sphere. Against the closed form.
@@ -781,7 +781,7 @@ fn trapezoid_single_scattering_converges_at_order_two() {
     assert!((order + 2.0).abs() < 0.1, "slope {order}");
 }
 
-/// Regression (issue 9, item 4): the cumulative optical depth does not
+/// Regression: the cumulative optical depth does not
 /// accumulate rounding with the budget. Unit sphere, sigma = 50 (optical
 /// depth 100 along the diameter), light straight ahead: the integrand
 /// `e^{-sigma (t - t_n)} e^{-sigma (t_f - t)}` is the constant `e^{-sigma L}`,
@@ -821,7 +821,7 @@ fn cumulative_depth_error_does_not_grow_with_the_budget() {
     }
 }
 
-/// Regression (issue 9, item 9): a constant emission map emits where the
+/// Regression: a constant emission map emits where the
 /// density is positive (`EmissionMap::Constant`), so a sphere of kappa 0 emits
 /// nothing; the closed form said `c L` and every rule was shown 100% wrong.
 /// With kappa > 0 and lambda = 0 (no extinction) the sphere emits `c L`.
@@ -862,7 +862,7 @@ fn a_constant_emission_map_emits_only_where_the_density_is_positive() {
     }
 }
 
-/// Issue 9, item 12: the printed formulas are runnable. Unit sphere at the
+/// The printed formulas are runnable. Unit sphere at the
 /// origin, eye ray along +x at height h from x = -3, light straight behind
 /// the eye (d = -x), sigma = lambda kappa. On the chord, x in [-a, a] with
 /// a = sqrt(1 - h^2), the printed radicand is <p,d>^2 - <p,p> = -h^2 < 0
@@ -946,10 +946,10 @@ fn printed_formulas_evaluate_to_their_closed_forms_in_every_arithmetic() {
 /// and the smallest normal radius, rays through the centre and offset by
 /// `d = 0.6 r` and `0.999 r`, along an axis and obliquely, from `3r`
 /// before the sphere and from inside it, around a centre away from the
-/// origin (the hostile review of issue 10, M2). The tolerances are the
+/// origin. The tolerances are the
 /// rounding of the origin's coordinates (eps |3r|) times the chord's
 /// sensitivity to the offset (d^2 / (r^2 - d^2): 500 at 0.999). A subnormal radius is
-/// refused (M1: its chord came out as (-inf, inf) and the closed-form ln tau
+/// refused (its chord came out as (-inf, inf) and the closed-form ln tau
 /// as -inf); one built field by field still gets finite roots.
 #[test]
 fn sphere_chords_are_exact_at_every_scale() {
@@ -1008,14 +1008,14 @@ fn sphere_chords_are_exact_at_every_scale() {
     assert!(((t1 - t0) / 2e-310 - 1.0).abs() < 1e-12, "{t0:e} {t1:e}");
 }
 
-/// The cost estimate a job is refused by (`Family::cost`, issue 10 item 4)
-/// against the density lookups the job really makes, for every bundled
-/// volume scene, both depth schemes, every 1-D rule and every quantity: the
-/// cumulative scheme's walk to each node (6-point panels) and
-/// Gauss–Legendre's error-estimate rules (2.5 n more) were not counted, and
-/// jobs cost 12 to 80 times their estimate (the hostile review of issue 10,
-/// H7). Now within [1/8, 1.5] of it (measured: 0.12 to 1.35; adaptive
-/// Gauss–Kronrod down to 0.07, where its tolerance stops it early).
+/// The cost estimate a job is refused by (`Family::cost`) against the
+/// density lookups the job really makes, for every bundled volume scene,
+/// both depth schemes, every 1-D rule and every quantity: the cumulative
+/// scheme's walk to each node (6-point panels) and Gauss–Legendre's
+/// error-estimate rules (2.5 n more) were not counted, and jobs cost 12 to
+/// 80 times their estimate. Now within [1/8, 1.5] of it (measured: 0.12 to
+/// 1.35; adaptive Gauss–Kronrod down to 0.07, where its tolerance stops it
+/// early).
 #[test]
 fn cost_estimates_bound_the_evaluations_of_every_bundled_scene() {
     use lightquad::family::{Family, Method};

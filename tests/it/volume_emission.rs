@@ -1,4 +1,4 @@
-//! V-E beyond a constant emission (issue 9, item 11): a transfer function
+//! V-E beyond a constant emission: a transfer function
 //! `c(v)` as a piecewise-linear table, and an emission field `Le(p)` of its
 //! own. Every value is checked against a closed form derived here or an
 //! independent adaptive Simpson on the exact integrand, never against the

@@ -782,7 +782,7 @@ fn trapezoid_depth(medium: Arc<dyn Medium>, ray: Ray, n: usize) -> f64 {
     .value
 }
 
-/// Regression (issue 9, item 1): a piece's end nodes read the piece's own
+/// Regression: a piece's end nodes read the piece's own
 /// field. Chord ends from the ray–sphere roots round a hair outside the
 /// sphere about half the time; read as outside, the trapezoid rule lost half
 /// a panel there (tau at n = 1023 off by ~1e-3 for 18 of 40 random rays).
@@ -847,8 +847,8 @@ fn end_nodes_read_the_pieces_own_field_so_the_trapezoid_is_exact_on_linear_media
 
 /// A subnormal density is refused, naming `kappa` and the range: 1e-320
 /// keeps a few bits, and the closed form of I_E built from it was off by
-/// 1.2e-4 against `c L`, which every rule got exactly (the hostile probe of
-/// issue 10). Zero and the smallest normal density are accepted.
+/// 1.2e-4 against `c L`, which every rule got exactly. Zero and the smallest
+/// normal density are accepted.
 #[test]
 fn a_subnormal_density_is_refused() {
     use lightquad::volume::constant_sphere::ConstantSphere;

@@ -656,8 +656,8 @@ fn extreme_numbers_anywhere_are_errors_not_panics() {
 }
 
 /// `lightquad render` refuses what it cannot do rather than hanging or
-/// writing undefined pixels, and says the warnings `check` says (the hostile
-/// probe of issue 12): `--samples` of `u64::MAX` overflowed the ray count to
+/// writing undefined pixels, and says the warnings `check` says:
+/// `--samples` of `u64::MAX` overflowed the ray count to
 /// 0 and ran forever; a mirror sphere of radius 1e30 around the camera
 /// wrote 183 NaN pixels of 4800 (black in the PNG) with exit 0; an energy
 /// gain was warned of by `check` but not by `render`.
@@ -864,7 +864,7 @@ fn render_refuses_endless_and_undefined_images_and_warns() {
 }
 
 /// A render whose PFM cannot be written leaves a PNG that was there as it
-/// was: it was removed with "(the PNG was removed)" (hostile probe, issue 10).
+/// was: it was removed with "(the PNG was removed)".
 #[test]
 #[cfg(target_os = "linux")]
 fn a_render_that_fails_leaves_an_existing_png_as_it_was() {

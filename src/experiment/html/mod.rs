@@ -1,8 +1,9 @@
-//! The report as self-contained HTML, beside the Markdown: per experiment
+//! The report as HTML, beside the Markdown: per experiment
 //! `<out>/<name>/index.html` and the top-level `<out>/index.html`. Styles,
-//! plots (inline SVG) and the script that sorts tables are in the page;
-//! nothing is loaded from elsewhere. Every string from a user's file is
-//! escaped ([`escape`]).
+//! plots (inline SVG) and the script that sorts tables are in the page; the
+//! pictures of image quantities (Whitted's `image`) are PNG files beside it
+//! in the experiment's folder, as for the Markdown; nothing is loaded from
+//! another host. Every string from a user's file is escaped ([`escape`]).
 //!
 //! The facts are those of the Markdown ([`super::report`] computes them once,
 //! as [`Section`]s); a rule has the same colour on every page

@@ -21,7 +21,7 @@ use super::{JobKey, JobResult, job_seed, jobs};
 /// of finite values and of errors (or a failure). Returns them and how many
 /// were not: a hand-edited line with `"rule_index": 99` was reused as a job
 /// of a rule the file does not have, and one with two channels of a scalar
-/// shown as a value with no error (the hostile probe of issue 10).
+/// shown as a value with no error.
 pub fn reusable<F: Family>(
     exp: &Experiment<F>,
     results: Vec<JobResult>,

@@ -1,4 +1,4 @@
-//! The rendering-equation family (R-* in docs/EQUATIONS.md) as the experiment
+//! The rendering-equation family (`R-*` in docs/EQUATIONS.md) as the experiment
 //! layer sees it (`"family": "rendering"`): a receiver (a point, its normal
 //! and, for reflected radiance, a BRDF and the direction toward the viewer),
 //! emitters and occluders; irradiance and reflected radiance at the receiver

@@ -1,4 +1,4 @@
-//! The volume-rendering family (V-* in docs/EQUATIONS.md) as the experiment
+//! The volume-rendering family (`V-*` in docs/EQUATIONS.md) as the experiment
 //! layer sees it: the scene format of an experiment file (`"family":
 //! "volume"`), its quantities, the tracking estimators beside the rules, the
 //! closed forms and the converged reference.

@@ -1,4 +1,4 @@
-//! The volume-rendering terms along one eye ray (docs/EQUATIONS.md, V-*), each
+//! The volume-rendering terms along one eye ray (docs/EQUATIONS.md, `V-*`), each
 //! evaluated with any rule and budget, each reporting its cost.
 //!
 //! - V-tau: `tau(t0, t1) = exp(-int_{t0}^{t1} sigma dt)`, reported in log space

@@ -170,7 +170,7 @@ fn check(lambda: f64, t0: f64, t1: f64, n: usize) -> Result<(), QuadError> {
         ));
     }
     // The rules' budget limit holds for walks too: usize::MAX walks ran
-    // without end (the hostile review of issue 10).
+    // without end.
     let max = crate::quadrature::MAX_BUDGET;
     if !(2..=max).contains(&n) {
         return Err(QuadError::invalid(

@@ -1,4 +1,4 @@
-//! Whitted ray tracing (W-* in docs/EQUATIONS.md) as the experiment layer
+//! Whitted ray tracing (`W-*` in docs/EQUATIONS.md) as the experiment layer
 //! sees it (`"family": "whitted"`): a scene of spheres, planes and triangles
 //! with W-6.1 materials, point and directional lights, an ambient intensity
 //! and a pinhole camera; the value of a pixel (or of every pixel) as the
