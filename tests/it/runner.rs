@@ -417,6 +417,36 @@ fn shards_merge_into_the_full_report() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// An experiment file may name its JSON Schema for an editor (`"$schema"`):
+/// every family's branch of the schema `lightquad schema` prints allows the
+/// field (its objects are closed, so an editor would flag it otherwise), and
+/// `check` accepts any string there and names the field when it is not one.
+#[test]
+fn a_schema_named_in_the_file_is_accepted_and_allowed_by_the_schema() {
+    let schema = bin().arg("schema").output().expect("runs");
+    let schema: serde_json::Value =
+        serde_json::from_slice(&schema.stdout).expect("the schema is JSON");
+    for branch in schema["oneOf"].as_array().expect("oneOf") {
+        assert!(
+            branch["properties"]["$schema"].is_object(),
+            "{} lacks $schema",
+            branch["title"]
+        );
+    }
+    let dir = scratch("schema-field");
+    let check = |text: &str| {
+        let file = dir.join("e.json");
+        fs::write(&file, text).expect("write");
+        bin().arg("check").arg(&file).output().expect("runs")
+    };
+    let o = check(&VALID.replacen('{', r#"{"$schema": "./lightquad.schema.json","#, 1));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = check(&VALID.replacen('{', r#"{"$schema": 3,"#, 1));
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("at `$schema`"), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
+}
+
 /// `lightquad run` without files runs the bundled suite from any folder (here
 /// a fresh one without experiments/ or reference/): every experiment of
 /// experiments/, the Mitsuba comparison of every committed values file, and a
