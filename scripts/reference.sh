@@ -2,7 +2,8 @@
 # The Mitsuba 3 reference harness (reference/): creates reference/.venv with the
 # pinned requirements, then
 #   scripts/reference.sh          regenerates every committed values file at full
-#                                 accuracy (about 4 minutes on 2 cores);
+#                                 accuracy (each file records its seconds in
+#                                 `run_seconds`; README.md gives their sum);
 #   scripts/reference.sh --ci     runs the harness's pytest suite, checks that no
 #                                 committed values file is stale, and regenerates
 #                                 one transmittance and one single-scattering value

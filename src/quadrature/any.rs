@@ -8,7 +8,7 @@ use crate::error::QuadError;
 use crate::estimate::Estimate;
 use crate::value::Value;
 
-use super::{AnyRuleSpec, BaseRule, Dimensions, Product, Rule};
+use super::{AnyRuleSpec, BaseRule, Dimensions, Product, Rule, RuleVisitor};
 
 /// Any rule selected at run time, products included. Its serde form is a
 /// single rule's, or `{"rule": "product", "outer": {..}, "inner": {..}}`.
@@ -48,6 +48,16 @@ impl BaseRule {
 }
 
 impl AnyRule {
+    /// Runs `visitor` with the concrete rule (see [`RuleVisitor`]); a product
+    /// is visited as itself, its two rules taking the integrand as a trait
+    /// object.
+    pub fn visit<V: RuleVisitor>(&self, visitor: V) -> V::Output {
+        match self {
+            AnyRule::Base(r) => r.visit(visitor),
+            AnyRule::Product(p) => visitor.visit(p.as_ref()),
+        }
+    }
+
     /// The rule named `name` with its default parameters; `product(A,B)` names
     /// the iterated product of two named rules.
     pub fn by_name(name: &str) -> Result<AnyRule, QuadError> {

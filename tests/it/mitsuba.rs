@@ -173,3 +173,26 @@ fn lightquad_agrees_with_mitsuba_within_four_standard_errors() {
         assert!(kinds.contains(kind), "no {kind} compared: {kinds:?}");
     }
 }
+
+/// The README's time to regenerate every values file is the sum of the
+/// `run_seconds` the committed files record (always the committed folder,
+/// also when LIGHTQUAD_REFERENCE_VALUES names another), so the figure a
+/// reader sees cannot drift from the files.
+#[test]
+fn the_readme_states_the_regeneration_time_the_values_files_record() {
+    let mut total = 0.0;
+    for entry in std::fs::read_dir(root().join("reference/values")).expect("values folder") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|x| x == "json") {
+            let v: Value =
+                serde_json::from_str(&std::fs::read_to_string(&path).expect("read")).expect("JSON");
+            total += v["run_seconds"]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{} has no run_seconds", path.display()));
+        }
+    }
+    let readme = std::fs::read_to_string(root().join("README.md")).expect("README");
+    let readme = readme.split_whitespace().collect::<Vec<_>>().join(" ");
+    let said = format!("the committed ones add up to {total:.0} s");
+    assert!(readme.contains(&said), "README lacks `{said}`");
+}

@@ -1004,3 +1004,33 @@ fn a_product_over_an_inner_rule_without_an_error_estimate_has_an_infinite_error(
         }
     }
 }
+
+/// A rule reached through `visit` (the integrand compiled into the rule)
+/// and through `Rule::integrate` on the enum (the integrand behind a trait
+/// object) is the same rule: the same bits, for every rule and a product.
+#[test]
+fn a_visited_rule_gives_the_bits_of_the_rule_behind_the_enum() {
+    struct Cosine<const D: usize>;
+    impl<const D: usize> lightquad::quadrature::RuleVisitor for Cosine<D> {
+        type Output = Result<lightquad::Estimate<f64>, QuadError>;
+        fn visit<R: Rule>(self, rule: &R) -> Self::Output {
+            rule.integrate(300, &mut rng(3), |u: [f64; D]| {
+                (7.0 * u.iter().sum::<f64>()).cos()
+            })
+        }
+    }
+    for rule in every_rule() {
+        let name = rule.label();
+        let (visited, behind) = if rule.dimensions().contains(1) {
+            let f = |u: [f64; 1]| (7.0 * u.iter().sum::<f64>()).cos();
+            (rule.visit(Cosine::<1>), rule.integrate(300, &mut rng(3), f))
+        } else {
+            let f = |u: [f64; 2]| (7.0 * u.iter().sum::<f64>()).cos();
+            (rule.visit(Cosine::<2>), rule.integrate(300, &mut rng(3), f))
+        };
+        let (visited, behind) = (visited.expect(&name), behind.expect(&name));
+        assert_eq!(visited.value.to_bits(), behind.value.to_bits(), "{name}");
+        assert_eq!(visited.error.to_bits(), behind.error.to_bits(), "{name}");
+        assert_eq!(visited.evaluations, behind.evaluations, "{name}");
+    }
+}
