@@ -27,7 +27,12 @@ fn main() {
             .filter(|o| o.status.success())
             .and_then(|o| String::from_utf8(o.stdout).ok())
     };
+    // A checkout of this crate: build.rs tracked by the repository around
+    // it. A copy of the sources inside another repository (vendored, or
+    // `cargo package`'s build under target/package) has no commit of its own.
+    let checkout = git(&["ls-files", "--error-unmatch", "build.rs"]).is_some();
     let commit = git(&["rev-parse", "--short=12", "HEAD"])
+        .filter(|_| checkout)
         .map(|s| s.trim().to_string())
         .unwrap_or_default();
     let dirty = !commit.is_empty()
@@ -44,26 +49,15 @@ fn main() {
     };
     println!("cargo:rustc-env=LIGHTQUAD_GIT_COMMIT={stamp}");
     // The stamp changes with the sources (their "-dirty") and with the
-    // commit: HEAD naming another branch, or a ref moving, loose or packed.
-    // Only paths that exist are watched: cargo takes a watched path that is
-    // missing for a change and would run this script, and rebuild the crate,
-    // on every build. The refs are watched as folders, so a ref file that
-    // appears (a commit after `git pack-refs`) is seen too. Without git or a
-    // checkout (a source tarball) the stamp is empty ("unknown" in reports).
+    // commit. Only paths that exist are watched: cargo takes a watched path
+    // that is missing for a change and would run this script, and rebuild
+    // the crate, on every build. Without git or a checkout (a source
+    // tarball) the stamp is empty ("unknown" in reports).
     for source in SOURCES {
         watch_if_present(Path::new(source));
     }
     if !commit.is_empty() {
-        for (flag, files) in [
-            ("--git-dir", &["HEAD"][..]),
-            ("--git-common-dir", &["packed-refs", "refs/heads"][..]),
-        ] {
-            if let Some(dir) = git(&["rev-parse", flag]) {
-                for file in files {
-                    watch_if_present(&Path::new(dir.trim()).join(file));
-                }
-            }
-        }
+        watch_refs(&git);
     }
 
     let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("set by cargo"));
@@ -89,6 +83,29 @@ fn main() {
     std::fs::write(&out, code).expect("OUT_DIR is writable");
 }
 
+/// Watches what moves HEAD's commit: HEAD itself (another branch, or a
+/// detached commit), the branch's loose ref file, packed-refs, and a reftable
+/// store. A branch whose ref is packed gets its loose file back at the next
+/// commit, so there the folder it will appear in is watched instead of the
+/// file; other branches and tags are not watched.
+fn watch_refs(git: &dyn Fn(&[&str]) -> Option<String>) {
+    let dir = |flag: &str| git(&["rev-parse", flag]).map(|d| PathBuf::from(d.trim()));
+    let (Some(git_dir), Some(common)) = (dir("--git-dir"), dir("--git-common-dir")) else {
+        return;
+    };
+    watch_if_present(&git_dir.join("HEAD"));
+    watch_if_present(&common.join("packed-refs"));
+    watch_if_present(&common.join("reftable"));
+    if let Some(branch) = git(&["symbolic-ref", "-q", "HEAD"]) {
+        let loose = common.join(branch.trim());
+        if loose.is_file() {
+            watch_if_present(&loose);
+        } else if let Some(folder) = loose.parent() {
+            watch_if_present(folder);
+        }
+    }
+}
+
 /// Asks cargo to run this script again when `path` changes, if it exists.
 fn watch_if_present(path: &Path) {
     if path.exists() {
@@ -107,7 +124,10 @@ fn json_files(dir: &Path) -> Vec<PathBuf> {
         .filter(|p| {
             p.extension().is_some_and(|x| x == "json")
                 && p.file_name().and_then(|n| n.to_str()).is_some()
-                && !p.ends_with("schema.json")
+                && !p
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| n.ends_with("schema.json"))
         })
         .collect();
     files.sort();

@@ -37,8 +37,7 @@ fn scratch(tag: &str) -> PathBuf {
 
 /// Runs the job in a child process and returns that child's own peak
 /// resident memory in bytes (`wait4` on its pid: `getrusage(RUSAGE_CHILDREN)`
-/// would report the largest child of the whole test binary, whose other
-/// tests run children of their own at the same time).
+/// would report the largest of every child this process has waited for).
 #[cfg(target_os = "linux")]
 fn run_and_measure(rule: &str, n: usize) -> f64 {
     use std::io::Read;

@@ -75,13 +75,23 @@ pub(super) fn load_all(registry: &Registry, files: &[Source]) -> Result<Vec<Inpu
     Ok(out)
 }
 
-/// The experiment files of a folder, sorted.
+/// The experiment files of a folder, sorted: every `.json` file but a JSON
+/// Schema kept beside them (a name ending in `schema.json`, as
+/// `lightquad schema > lightquad.schema.json` writes it).
 pub fn experiment_files(dir: &Path) -> Result<Vec<PathBuf>, RunError> {
     let mut files: Vec<PathBuf> = fs::read_dir(dir)
         .map_err(|e| io(dir, e))?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "json") && !p.ends_with("schema.json"))
+        .filter(|p| p.extension().is_some_and(|x| x == "json") && !is_schema(p))
         .collect();
     files.sort();
     Ok(files)
+}
+
+/// Whether `path` names a JSON Schema file (`schema.json`,
+/// `lightquad.schema.json`), which an experiment folder may hold for editors.
+fn is_schema(path: &Path) -> bool {
+    path.file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.ends_with("schema.json"))
 }

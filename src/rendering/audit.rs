@@ -1,4 +1,4 @@
-//! The audit of R-S as printed (docs/EQUATIONS.md): seed 002 writes a surface
+//! The audit of R-S as printed (docs/EQUATIONS.md): the document writes a surface
 //! integral through a parameterization as `int_S g dS = int_u int_v g(u, v)
 //! dv du`, without the area element `|dp/du x dp/dv|`. That is exact only
 //! where the element is 1; elsewhere the printed form integrates another
@@ -149,7 +149,7 @@ pub fn markdown() -> String {
     let mut md = String::from(
         "\n## Rendering family: R-S audit: the printed parameterized surface integral against \
          the one with its area element\n\n\
-         Seed 002 prints `int_S g dS = int_u int_v g(u, v) dv du`, without the area element \
+         R-S is printed as `int_S g dS = int_u int_v g(u, v) dv du`, without the area element \
          `|dp/du x dp/dv|` of the parameterization `p(u, v)` (docs/EQUATIONS.md, R-S). Both \
          forms by 64 x 64 Gauss–Legendre nodes over the parameter box (every integrand is \
          smooth there), against closed forms. The printed form is right only where the element \

@@ -3,8 +3,9 @@
 //! high-precision table in `tests/data/`, another method).
 //!
 //! One binary links the crate once: `cargo test --release` compiles this
-//! crate and `tests/memory_checkpoints.rs`, which owns its process because
-//! it installs a counting global allocator. Tests here share one process,
+//! crate and two that own their process, `tests/memory_checkpoints.rs` (a
+//! counting global allocator) and `tests/memory_peak.rs` (a child's peak
+//! resident memory, which counts its spawner's). Tests here share one process,
 //! so none may change process-wide state (the working folder, environment
 //! variables, rayon's global pool); scratch folders come from
 //! [`common::scratch`], unique per call.
