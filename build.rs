@@ -122,12 +122,11 @@ fn json_files(dir: &Path) -> Vec<PathBuf> {
         .flatten()
         .map(|e| e.path())
         .filter(|p| {
+            // A UTF-8 name, and not a JSON Schema kept for editors.
             p.extension().is_some_and(|x| x == "json")
-                && p.file_name().and_then(|n| n.to_str()).is_some()
-                && !p
-                    .file_name()
+                && p.file_name()
                     .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.ends_with("schema.json"))
+                    .is_some_and(|n| !n.ends_with("schema.json"))
         })
         .collect();
     files.sort();

@@ -90,6 +90,8 @@ pub mod whitted;
 
 pub use error::QuadError;
 pub use estimate::{ErrorKind, Estimate};
+pub use value::{Rgb, Value};
+
 /// The random-number crate of the public API (every rule takes a
 /// [`rand::Rng`]), at the version lightquad uses: code using lightquad needs
 /// no dependency on it of its own.
@@ -103,4 +105,3 @@ pub use rand_pcg;
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeExample;
-pub use value::{Rgb, Value};

@@ -8,9 +8,9 @@
 //! [`validate`](mod@validate) (every number checked, the family builds its
 //! scene) -> [`run`](mod@run) (jobs in parallel, results appended as they
 //! finish) -> [`report`] (Markdown, SVG, CSV, index) and [`html`] (the same as
-//! HTML pages). Nothing here names a
-//! family: it is generic over [`Family`](crate::family::Family), and
-//! [`crate::families`] is the one registry that names them.
+//! HTML pages). Nothing here names a family: it is generic over
+//! [`Family`](crate::family::Family), and [`crate::families`] is the one
+//! registry that names them.
 //!
 //! ```
 //! use lightquad::experiment::validate::parse_json;
