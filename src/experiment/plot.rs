@@ -1,9 +1,10 @@
 //! The plots of a report: error against time or evaluations on log-log
-//! axes, unresolved errors on a dashed floor line, and one colour per rule
-//! name that every page (Markdown SVGs and HTML alike) keeps.
+//! axes, unresolved errors on a dashed floor line, and a colour per rule:
+//! no two rules of a page alike, and a shipped rule's the same on every page
+//! (Markdown SVGs and HTML alike).
 //!
 //! ```
-//! use lightquad::experiment::plot::{rule_css, svg};
+//! use lightquad::experiment::plot::{Palette, rule_css, svg};
 //!
 //! // A rule has its colour on every page: Gauss–Legendre is always red.
 //! assert_eq!(rule_css("gauss-legendre"), "#d62728");
@@ -13,12 +14,13 @@
 //!     ("trapezoid".to_string(), curve(|n| 0.1 / (n * n))),
 //!     ("monte-carlo".to_string(), curve(|n| 0.3 / n.sqrt())),
 //! ];
-//! let page = svg("I_E: error against n", "n", &series, 1e-16)?.ok_or("nothing to plot")?;
+//! let palette = Palette::new(series.iter().map(|s| s.0.as_str()));
+//! let page = svg("I_E: error against n", "n", &series, 1e-16, &palette)?.ok_or("nothing to plot")?;
 //! assert!(page.contains("<svg") && page.contains("I_E: error against n"));
 //! let lower = page.to_lowercase();
 //! assert!(lower.contains(&rule_css("trapezoid")) && lower.contains(&rule_css("monte-carlo")));
 //! // No finite point, no plot.
-//! assert_eq!(svg("t", "n", &[("sobol".to_string(), vec![(4.0, f64::NAN)])], 1e-16)?, None);
+//! assert_eq!(svg("t", "n", &[("sobol".to_string(), vec![(4.0, f64::NAN)])], 1e-16, &palette)?, None);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -40,8 +42,9 @@ const KNOWN: [(&str, RGBColor); 10] = [
 ];
 
 /// Colours for other labels (products, a user family's estimators, a rule
-/// named twice), picked by a hash of the label.
-const OTHER: [RGBColor; 8] = [
+/// named twice): a label takes the one its hash picks unless a rule of the
+/// same page holds it, else the first free one.
+const OTHER: [RGBColor; 12] = [
     RGBColor(0, 0, 0),
     RGBColor(174, 89, 0),
     RGBColor(0, 110, 90),
@@ -50,9 +53,14 @@ const OTHER: [RGBColor; 8] = [
     RGBColor(70, 110, 0),
     RGBColor(0, 70, 140),
     RGBColor(120, 120, 40),
+    RGBColor(230, 50, 130),
+    RGBColor(0, 160, 110),
+    RGBColor(110, 0, 0),
+    RGBColor(60, 60, 60),
 ];
 
-/// The colour of a rule, from its label alone: the same on every page.
+/// The colour a label has wherever it appears alone: a shipped rule's own,
+/// else the one its hash picks.
 pub fn rule_colour(label: &str) -> RGBColor {
     if let Some((_, c)) = KNOWN.iter().find(|(n, _)| *n == label) {
         return *c;
@@ -66,8 +74,91 @@ pub fn rule_colour(label: &str) -> RGBColor {
 
 /// The colour of a rule as CSS `#rrggbb`.
 pub fn rule_css(label: &str) -> String {
-    let RGBColor(r, g, b) = rule_colour(label);
+    css(rule_colour(label))
+}
+
+fn css(RGBColor(r, g, b): RGBColor) -> String {
     format!("#{r:02x}{g:02x}{b:02x}")
+}
+
+/// The colours of one page's rules, no two alike: a shipped rule keeps its
+/// own colour on every page, and every other label takes [`rule_colour`]'s
+/// choice where no rule of the page holds it, else the first free colour.
+///
+/// ```
+/// use lightquad::experiment::plot::{Palette, rule_css};
+///
+/// let labels = ["gauss-legendre", "genz-malik", "centre", "corner", "mis-power"];
+/// let page = Palette::new(labels);
+/// let mut seen: Vec<String> = labels.iter().map(|l| page.css(l)).collect();
+/// assert_eq!(seen[0], rule_css("gauss-legendre"));
+/// seen.sort();
+/// seen.dedup();
+/// assert_eq!(seen.len(), labels.len());
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct Palette(Vec<(String, RGBColor)>);
+
+impl Palette {
+    /// The palette of a page showing `labels` (repeats are one rule).
+    pub fn new<'a>(labels: impl IntoIterator<Item = &'a str>) -> Self {
+        let mut labels: Vec<&str> = labels.into_iter().collect();
+        let mut seen = std::collections::HashSet::new();
+        labels.retain(|l| seen.insert(*l));
+        let shipped = |l: &str| KNOWN.iter().any(|(n, _)| *n == l);
+        let mut taken: Vec<(String, RGBColor)> = labels
+            .iter()
+            .filter(|l| shipped(l))
+            .map(|l| (l.to_string(), rule_colour(l)))
+            .collect();
+        // Beyond the fixed colours, hues a golden angle apart.
+        let spare = OTHER
+            .into_iter()
+            .chain(KNOWN.map(|(_, c)| c))
+            .chain((0..4096).map(|i| hue(0.618_034 * f64::from(i))));
+        for l in labels.iter().filter(|l| !shipped(l)) {
+            let free = |c: &RGBColor| taken.iter().all(|(_, t)| t != c);
+            let own = rule_colour(l);
+            let colour = if free(&own) {
+                own
+            } else {
+                let mut spare = spare.clone();
+                spare.find(free).unwrap_or(own)
+            };
+            taken.push((l.to_string(), colour));
+        }
+        Palette(taken)
+    }
+
+    /// The colour of `label` on this page ([`rule_colour`] for a label the
+    /// page was not told of).
+    pub fn colour(&self, label: &str) -> RGBColor {
+        self.0
+            .iter()
+            .find(|(l, _)| l == label)
+            .map_or_else(|| rule_colour(label), |(_, c)| *c)
+    }
+
+    /// The colour of `label` on this page as CSS `#rrggbb`.
+    pub fn css(&self, label: &str) -> String {
+        css(self.colour(label))
+    }
+}
+
+/// A saturated, mid-dark colour at hue `turns` (fraction of a turn).
+fn hue(turns: f64) -> RGBColor {
+    let h = turns.fract() * 6.0;
+    let x = 1.0 - (h % 2.0 - 1.0).abs();
+    let (r, g, b) = match h as u32 {
+        0 => (1.0, x, 0.0),
+        1 => (x, 1.0, 0.0),
+        2 => (0.0, 1.0, x),
+        3 => (0.0, x, 1.0),
+        4 => (x, 0.0, 1.0),
+        _ => (1.0, 0.0, x),
+    };
+    let c = |v: f64| (40.0 + 150.0 * v).round() as u8;
+    RGBColor(c(r), c(g), c(b))
 }
 
 /// Error against `x` (time or n) as SVG text, one log-log curve per rule
@@ -77,6 +168,7 @@ pub fn svg(
     x_label: &str,
     series: &[(String, Vec<(f64, f64)>)],
     floor: f64,
+    palette: &Palette,
 ) -> Result<Option<String>, String> {
     // Errors at or below `floor` (exact zeros, the rounding floor, the
     // reference's own accuracy) are not resolved: they are drawn on a dashed
@@ -157,7 +249,7 @@ pub fn svg(
             .draw()
             .map_err(|e| e.to_string())?;
         for (i, (name, s)) in series.iter().enumerate() {
-            let colour = rule_colour(name);
+            let colour = palette.colour(name);
             chart
                 .draw_series(LineSeries::new(
                     s.iter().map(|&p| at(p)),
@@ -246,7 +338,8 @@ mod tests {
                     vec![(3.0, f64::INFINITY), (9.0, 1e-300)],
                 ),
             ];
-            let _ = tx.send(svg("wide", "n", &series, 1e-320));
+            let palette = super::Palette::new(series.iter().map(|s| s.0.as_str()));
+            let _ = tx.send(svg("wide", "n", &series, 1e-320, &palette));
         });
         let page = rx
             .recv_timeout(std::time::Duration::from_secs(60))

@@ -372,3 +372,100 @@ fn the_html_report_is_self_contained_linked_plotted_and_escaped() {
     assert_ne!(rule_css("trapezoid"), rule_css("gauss-legendre"));
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// The label and colour of every rule swatch of an HTML page.
+fn swatches(html: &str) -> BTreeSet<(String, String)> {
+    let mut out = BTreeSet::new();
+    let mut rest = html;
+    let head = "<td class=\"rule\" data-sort=\"";
+    while let Some(at) = rest.find(head) {
+        rest = &rest[at + head.len()..];
+        let label = rest[..rest.find('"').expect("label")].to_string();
+        let bg = "background:";
+        let at = rest.find(bg).expect("swatch") + bg.len();
+        out.insert((label, rest[at..at + 7].to_ascii_lowercase()));
+    }
+    out
+}
+
+/// No two rules of one page share a colour, where twelve rules' labels
+/// (several outside the shipped list, products among them) meet on one page
+/// and on the index; each shipped rule keeps its own colour, and the plots
+/// draw each rule in its table's colour.
+#[test]
+fn no_two_rules_of_a_page_share_a_colour() {
+    let dir = scratch("colours");
+    let base = fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("experiments/w-ss-edge-coverage.json"),
+    )
+    .expect("bundled file");
+    let mut exp: serde_json::Value = serde_json::from_str(&base).expect("json");
+    let product = |a: &str, b: &str| serde_json::json!({"rule": "product", "outer": {"rule": a}, "inner": {"rule": b}});
+    let mut rules: Vec<serde_json::Value> = [
+        "gauss-legendre",
+        "genz-malik",
+        "trapezoid",
+        "grid",
+        "centre",
+        "corner",
+        "stratified",
+        "sobol",
+        "monte-carlo",
+    ]
+    .map(|r| serde_json::json!({ "rule": r }))
+    .to_vec();
+    rules.push(serde_json::json!({"rule": "adaptive", "threshold": 0.01}));
+    rules.push(product("gauss-legendre", "trapezoid"));
+    rules.push(product("gauss-kronrod", "stratified"));
+    exp["rules"] = serde_json::Value::Array(rules);
+    exp["budgets"] = serde_json::json!([16, 256]);
+    exp["repeats"] = serde_json::json!(1);
+    exp["quantities"] = serde_json::json!(["coverage"]);
+    let file = dir.join("many.json");
+    fs::write(&file, exp.to_string()).expect("write");
+    let out = dir.join("out");
+    let opts = RunOptions {
+        out: out.clone(),
+        resume: false,
+        shard: None,
+        progress: false,
+    };
+    run_files(&lightquad::families::builtin(), &[file], &opts).unwrap_or_else(|e| panic!("{e}"));
+    for page in [
+        out.join("index.html"),
+        out.join("w-ss-edge-coverage/index.html"),
+    ] {
+        let html = fs::read_to_string(&page).expect("page");
+        let pairs = swatches(&html);
+        let labels: BTreeSet<&str> = pairs.iter().map(|(l, _)| l.as_str()).collect();
+        let colours: BTreeSet<&str> = pairs.iter().map(|(_, c)| c.as_str()).collect();
+        assert_eq!(
+            labels.len(),
+            pairs.len(),
+            "{}: a rule in two colours: {pairs:?}",
+            page.display()
+        );
+        assert_eq!(
+            colours.len(),
+            pairs.len(),
+            "{}: two rules in one colour: {pairs:?}",
+            page.display()
+        );
+        for (label, colour) in &pairs {
+            if ["gauss-legendre", "trapezoid", "sobol", "stratified"].contains(&label.as_str()) {
+                assert_eq!(colour, &rule_css(label), "{label} changed colour");
+            }
+        }
+        if page.ends_with("w-ss-edge-coverage/index.html") {
+            assert_eq!(pairs.len(), 12, "{pairs:?}");
+            let svg = html.to_ascii_lowercase();
+            for (label, colour) in &pairs {
+                assert!(
+                    svg.matches(colour.as_str()).count() >= 3,
+                    "{label}'s {colour} not in its plots"
+                );
+            }
+        }
+    }
+    let _ = fs::remove_dir_all(&dir);
+}

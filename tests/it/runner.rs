@@ -1018,6 +1018,58 @@ fn the_csv_keeps_its_columns_with_product_labels() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// Each CSV line carries its quantity's own time as results.jsonl records it,
+/// not the whole job's (the sum over the job's quantities).
+#[test]
+fn the_csv_times_each_quantity_by_its_own_evaluation() {
+    let (dir, out, o) = run_text("csvtime", VALID);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut own = std::collections::BTreeMap::new();
+    for l in fs::read_to_string(out.join("t/results.jsonl"))
+        .expect("jsonl")
+        .lines()
+    {
+        let v: serde_json::Value = serde_json::from_str(l).expect("json");
+        let job = (
+            v["rule_index"].clone(),
+            v["budget"].clone(),
+            v["repeat"].clone(),
+        );
+        for (q, m) in v["quantities"].as_object().expect("quantities") {
+            let s = m["seconds"].as_f64().expect("a quantity's own seconds");
+            own.insert(
+                (
+                    job.0.to_string(),
+                    job.1.to_string(),
+                    job.2.to_string(),
+                    q.clone(),
+                ),
+                s,
+            );
+        }
+    }
+    let csv = fs::read_to_string(out.join("t/results.csv")).expect("csv");
+    let mut n = 0;
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let key = (
+            f[1].to_string(),
+            f[3].to_string(),
+            f[4].to_string(),
+            f[6].to_string(),
+        );
+        let s: f64 = f[10].parse().expect("seconds");
+        let want = own[&key];
+        assert!(
+            (s - want).abs() <= 1e-9 * want.max(1e-9),
+            "{line}: {s} against {want}"
+        );
+        n += 1;
+    }
+    assert_eq!(n, own.len());
+    let _ = fs::remove_dir_all(&dir);
+}
+
 /// Where shards disagree on a job, `merge` keeps the finished result over a
 /// failed one, whichever folder comes first.
 #[test]

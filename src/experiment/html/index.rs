@@ -29,6 +29,12 @@ pub fn write_index(
     earlier: &[String],
 ) -> Result<(), String> {
     let mut b = String::from("<h1>lightquad report</h1>\n");
+    // One palette for the page: no two of its rules alike.
+    let palette = plot::Palette::new(entries.iter().flat_map(|(_, _, summary)| {
+        summary
+            .iter()
+            .flat_map(|(_, ranking)| ranking.iter().map(|r| r.label.as_str()))
+    }));
     if !problems.is_empty() {
         b.push_str(
             "<div class=\"problems\"><strong>This report is incomplete</strong>, and its rankings may be wrong:<ul>",
@@ -41,7 +47,7 @@ pub fn write_index(
     b.push_str(
         "<p class=\"lead\">Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error \
          (1e-6 unless the experiment says otherwise); <em>not reached</em> means no budget got there. \
-         A rule has the same colour on every page.</p>\n",
+         A rule lightquad ships has the same colour on every page; no two rules of one page share one.</p>\n",
     );
     // The overview table.
     b.push_str("<h2>Experiments</h2>\n<div class=\"scroll\"><table class=\"sortable\"><thead><tr><th>experiment</th><th>description</th><th>quantities</th><th>fastest to the middle target</th></tr></thead><tbody>");
@@ -59,7 +65,7 @@ pub fn write_index(
                     .map(|(r, _)| {
                         format!(
                             "<span class=\"sw\" style=\"background:{}\"></span>{}",
-                            plot::rule_css(&r.label),
+                            palette.css(&r.label),
                             escape(&r.label)
                         )
                     })
@@ -128,7 +134,7 @@ pub fn write_index(
             let _ = write!(
                 b,
                 "<div class=\"chart\">{}</div>",
-                ranking_chart(summary, scale)
+                ranking_chart(summary, scale, &palette)
             );
         }
         b.push_str("<details><summary>as a table</summary><div class=\"scroll\"><table class=\"sortable\"><thead><tr><th>quantity</th><th class=\"num\">rank</th><th>rule</th><th class=\"num\">time to target (s)</th><th>note</th></tr></thead><tbody>");
@@ -153,7 +159,7 @@ pub fn write_index(
                     } else {
                         ranks[i].to_string()
                     },
-                    rule_cell(&r.label),
+                    rule_cell(&palette, &r.label),
                     num_cell(&time, r.seconds.unwrap_or(f64::NAN)),
                     note.join("; ")
                 );
@@ -203,7 +209,7 @@ fn percent(s: &str) -> String {
 /// Horizontal bars of the time to the middle target, one per (quantity,
 /// rule), on a log scale from `scale.0` to `scale.1` seconds shared by the
 /// whole index; a rule that did not reach the target has no bar.
-fn ranking_chart(summary: &Summary, scale: (f64, f64)) -> String {
+fn ranking_chart(summary: &Summary, scale: (f64, f64), palette: &plot::Palette) -> String {
     let (lo, hi) = (scale.0.log10(), scale.1.log10());
     let (left, width, row_h, top) = (300.0, 560.0, 20.0, 28.0);
     let rows: Vec<(&str, crate::experiment::report::Ranked)> = summary
@@ -264,7 +270,7 @@ fn ranking_chart(summary: &Summary, scale: (f64, f64)) -> String {
                     "<rect x=\"{left}\" y=\"{}\" width=\"{w}\" height=\"{}\" fill=\"{}\" fill-opacity=\"{opacity}\"><title>{} {}: {t:.2e} s</title></rect><text x=\"{}\" y=\"{}\" fill=\"#1d1f21\">{t:.1e} s{}</text>",
                     y + 3.0,
                     row_h - 6.0,
-                    plot::rule_css(&r.label),
+                    palette.css(&r.label),
                     escape(q),
                     escape(&r.label),
                     left + w + 6.0,

@@ -151,12 +151,12 @@ fn document(title: &str, body: &str) -> String {
     )
 }
 
-/// A rule's name with its colour swatch.
-fn rule_cell(label: &str) -> String {
+/// A rule's name with its colour swatch on the page of `palette`.
+fn rule_cell(palette: &plot::Palette, label: &str) -> String {
     format!(
         "<td class=\"rule\" data-sort=\"{}\"><span class=\"sw\" style=\"background:{}\"></span>{}</td>",
         escape(label),
-        plot::rule_css(label),
+        palette.css(label),
         escape(label)
     )
 }

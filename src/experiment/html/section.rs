@@ -111,7 +111,7 @@ pub(super) fn section(page: &Page, s: &Section) -> String {
     b.push_str("</tr></thead><tbody>");
     for f in &s.fits {
         b.push_str("<tr>");
-        b.push_str(&rule_cell(&f.label));
+        b.push_str(&rule_cell(&page.palette(), &f.label));
         for text in [&f.slope_budget, &f.slope_evaluations]
             .into_iter()
             .chain(&f.times)
@@ -223,7 +223,7 @@ fn row(page: &Page, r: &Row, multi: bool, display: bool) -> String {
     }
     format!(
         "<tr{class}>{}{}{}{}{extra}{}{}{}<td class=\"flags\">{}</td></tr>",
-        rule_cell(&label(page, r.rule_index)),
+        rule_cell(&page.palette(), &label(page, r.rule_index)),
         num_cell(&r.budget.to_string(), r.budget as f64),
         num_cell(&show_value(&r.value), value),
         num_cell(&cell(r.rel_error), r.rel_error),

@@ -1,4 +1,5 @@
-//! `results.csv`: a line per job and quantity.
+//! `results.csv`: a line per job and quantity, timed by the quantity's own
+//! evaluation (the job's time where the job failed before any quantity).
 
 use std::fmt::Write as _;
 
@@ -42,7 +43,7 @@ pub(super) fn csv(results: &[JobResult]) -> String {
                 join(&m.value),
                 join(&m.error),
                 m.evaluations,
-                r.seconds
+                m.seconds.unwrap_or(r.seconds)
             );
         }
     }

@@ -112,6 +112,13 @@ pub struct Page<'a> {
     pub scene_audit: Option<String>,
 }
 
+impl Page<'_> {
+    /// The colours of this page's rules, no two alike.
+    pub fn palette(&self) -> super::plot::Palette {
+        super::plot::Palette::new(self.rules.iter().map(|r| r.label.as_str()))
+    }
+}
+
 /// A rule or estimator as a report sees it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RuleInfo {

@@ -390,7 +390,7 @@ fn orders_and_plots(
     ];
     for (what, suffix, x_label, series) in drawn {
         let title = format!("{}: {q} error against {what}", page.name);
-        if let Some(text) = plot::svg(&title, x_label, &series, floor)? {
+        if let Some(text) = plot::svg(&title, x_label, &series, floor, &page.palette())? {
             plots.push((what, format!("{base}-{suffix}.svg"), text));
         }
     }
