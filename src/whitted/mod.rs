@@ -11,6 +11,7 @@
 //! | [`shade`] | W-6.1 and W-Phong with shadow rays, reflection, refraction (Snell, total internal reflection) to a maximum depth; rays counted by kind |
 //! | [`pixel`] | the pixel value by the centre ray, W-SS's grid, any core rule (jittered, scrambled Sobol'), W-Corner, adaptive subdivision |
 //! | [`coverage`] | the exact fraction of a pixel inside a half-plane or convex polygon, by clipping |
+//! | [`pieces`] | a pixel cut along the scene's outlines on the film, each piece integrated by a rule (the converged reference) |
 //! | [`image`] | PNG (W-Grey, 8 bits) and PFM output, error heat maps |
 //! | [`render`] | images and pixels of a scene by a scheme, with the rays they traced |
 //! | [`experiment`] | the family of the experiment layer (`"family": "whitted"`) |
@@ -19,6 +20,7 @@ pub mod coverage;
 pub mod experiment;
 pub mod image;
 pub mod intersect;
+pub mod pieces;
 pub mod pixel;
 pub mod render;
 pub mod scene;

@@ -26,6 +26,8 @@ use crate::error::QuadError;
 use crate::quadrature::{AnyRule, Rule};
 use crate::value::{Rgb, Value};
 
+use super::coverage::HalfPlane;
+use super::pieces::by_pieces;
 use super::pixel;
 use super::scene::Scene;
 use super::shade::{RayCount, film};
@@ -46,6 +48,16 @@ pub enum Scheme {
         rule: AnyRule,
         /// Its budget per pixel.
         n: usize,
+    },
+    /// A rule of the core on each piece of the pixel cut along `lines`
+    /// ([`super::pieces`]), `n` evaluations per pixel shared between them.
+    Pieces {
+        /// The rule.
+        rule: AnyRule,
+        /// Its budget per pixel.
+        n: usize,
+        /// The film lines to cut along ([`super::pieces::outlines`]).
+        lines: Vec<HalfPlane>,
     },
     /// W-Corner with `m x m` cells per pixel (`m = 1`: Whitted's corners).
     Corner {
@@ -113,24 +125,14 @@ pub fn estimate<V: Value>(
                         Scheme::Centre => (pixel::centre(&p, &mut f), unknown),
                         Scheme::Grid { n } => (pixel::grid(&p, *n, &mut f), unknown),
                         Scheme::Rule { rule, n } => {
-                            // A ray left undefined by the scene's numbers,
-                            // said with its pixel.
-                            let (pi, pj) = (origin[0] + i as f64, origin[1] + j as f64);
-                            let est =
-                                pixel::by_rule(rule, &p, *n, rng, &mut f).map_err(|e| match e {
-                                    QuadError::NonFiniteIntegrand { point, .. } => {
-                                        QuadError::invalid(
-                                            "scene",
-                                            format!(
-                                                "a value that is not a number from the ray \
-                                                 through pixel [{pi}, {pj}] at {point:?} of its \
-                                                 square"
-                                            ),
-                                            super::experiment::RESOLVED_SCENE,
-                                        )
-                                    }
-                                    other => other,
-                                })?;
+                            let est = pixel::by_rule(rule, &p, *n, rng, &mut f);
+                            let est = est.map_err(|e| undefined_ray(e, &p))?;
+                            out.reliable &= est.reliable;
+                            (est.value, est.error)
+                        }
+                        Scheme::Pieces { rule, n, lines } => {
+                            let est = by_pieces(rule, &p, lines, *n, rng, &mut f);
+                            let est = est.map_err(|e| undefined_ray(e, &p))?;
                             out.reliable &= est.reliable;
                             (est.value, est.error)
                         }
@@ -148,6 +150,23 @@ pub fn estimate<V: Value>(
             }
             Ok(out)
         }
+    }
+}
+
+/// A ray left undefined by the scene's numbers, said with its pixel.
+fn undefined_ray(e: QuadError, pixel: &Pixel) -> QuadError {
+    match e {
+        QuadError::NonFiniteIntegrand { point, .. } => QuadError::invalid(
+            "scene",
+            format!(
+                "a value that is not a number from the ray through pixel [{}, {}] at {point:?} \
+                 of its square",
+                pixel.corner()[0],
+                pixel.corner()[1]
+            ),
+            super::experiment::RESOLVED_SCENE,
+        ),
+        other => other,
     }
 }
 
@@ -263,7 +282,7 @@ pub fn rays_per_pixel(scheme: &Scheme) -> Option<f64> {
     match scheme {
         Scheme::Centre => Some(1.0),
         Scheme::Grid { n } => Some((n * n) as f64),
-        Scheme::Rule { rule, n } => Some(rule.evaluations(*n, 2)),
+        Scheme::Rule { rule, n } | Scheme::Pieces { rule, n, .. } => Some(rule.evaluations(*n, 2)),
         Scheme::Corner { .. } | Scheme::Adaptive { .. } => None,
     }
 }

@@ -33,6 +33,7 @@ use crate::error::{QuadError, require_finite};
 use crate::geometry::{normalize, require_finite_vec};
 use crate::value::Rgb;
 
+use super::coverage::HalfPlane;
 use super::intersect::{Hit, Ray, Shape};
 
 /// The deepest recursion of reflected and transmitted rays a scene may ask
@@ -327,6 +328,66 @@ impl Camera {
         let sx = (2.0 * film[0] / w - 1.0) * self.tan_half * w / h;
         let sy = (1.0 - 2.0 * film[1] / h) * self.tan_half;
         self.forward + self.right * sx + self.up * sy
+    }
+
+    /// The film points whose direction `d(x, y)` has `d . normal <= 0`: with
+    /// `d = d_0 + x d_x + y d_y` (affine, [`Camera::direction`]), the
+    /// half-plane `(d_x . n) x + (d_y . n) y <= -(d_0 . n)`. Its edge is
+    /// where the film meets the plane through the eye normal to `normal`.
+    pub fn film_half_plane(&self, normal: Vec3) -> HalfPlane {
+        let (w, h) = (self.width as f64, self.height as f64);
+        let d0 = self.forward - self.right * (self.tan_half * w / h) + self.up * self.tan_half;
+        let dx = self.right * (2.0 * self.tan_half / h);
+        let dy = -self.up * (2.0 * self.tan_half / h);
+        HalfPlane {
+            a: dx.dot(&normal),
+            b: dy.dot(&normal),
+            c: -d0.dot(&normal),
+        }
+    }
+
+    /// The film lines `x = x_0`, `x = x_1`, `y = y_0`, `y = y_1` bounding
+    /// the outline of the sphere (`centre`, `radius`) where they exist: the
+    /// outline's extreme `s_x = (d . right) / (d . forward)` are the tangents
+    /// from the eye to the sphere's section in the (right, forward) plane,
+    /// `s_x = tan(alpha +- beta)`, `alpha = atan2(w . right, w . forward)`,
+    /// `beta = asin(r / |(w . right, w . forward)|)`, `w = centre - eye`
+    /// (likewise `s_y` with `up`). None beside an eye inside the sphere.
+    pub fn sphere_bounds(&self, centre: Vec3, radius: f64) -> Vec<HalfPlane> {
+        let w = centre - self.eye;
+        let (wf, wr, wu) = (w.dot(&self.forward), w.dot(&self.right), w.dot(&self.up));
+        let (width, height) = (self.width as f64, self.height as f64);
+        let tangents = |across: f64| -> Vec<f64> {
+            let reach = across.hypot(wf);
+            if !(reach > radius) {
+                return Vec::new();
+            }
+            let (alpha, beta) = (across.atan2(wf), (radius / reach).asin());
+            [alpha - beta, alpha + beta]
+                .into_iter()
+                .filter(|t| t.abs() < std::f64::consts::FRAC_PI_2)
+                .map(f64::tan)
+                .collect()
+        };
+        let mut lines = Vec::new();
+        for sx in tangents(wr) {
+            let x = (sx / (self.tan_half * width / height) + 1.0) * width / 2.0;
+            lines.push(HalfPlane {
+                a: 1.0,
+                b: 0.0,
+                c: x,
+            });
+        }
+        for sy in tangents(wu) {
+            let y = (1.0 - sy / self.tan_half) * height / 2.0;
+            lines.push(HalfPlane {
+                a: 0.0,
+                b: 1.0,
+                c: y,
+            });
+        }
+        lines.retain(|l| l.c.is_finite());
+        lines
     }
 
     /// The film point `[x, y]` where the line from the eye through `p`

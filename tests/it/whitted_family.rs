@@ -341,6 +341,85 @@ fn a_planes_horizon_is_a_straight_edge_across_the_pixels() {
     }
 }
 
+/// The 3-D point at depth 2 whose pinhole image is film point `[x, y]` of
+/// an 8 x 6 camera at the origin looking down -z with up +y and a 50 degree
+/// field (the pinhole formula, written out here).
+fn on_film(x: f64, y: f64) -> [f64; 3] {
+    let t = (25.0_f64).to_radians().tan();
+    let (sx, sy) = (
+        (2.0 * x / 8.0 - 1.0) * t * 8.0 / 6.0,
+        (1.0 - 2.0 * y / 6.0) * t,
+    );
+    [2.0 * sx, 2.0 * sy, -2.0]
+}
+
+/// Pixel [3, 2] of a scene holding the one triangle whose film image has
+/// the corners `film`.
+fn film_triangle(film: [[f64; 2]; 3]) -> Experiment<Whitted> {
+    let [a, b, c] = film.map(|p| on_film(p[0], p[1]));
+    experiment(
+        json!({
+            "camera": {"eye": [0.0, 0.0, 0.0], "look_at": [0.0, 0.0, -1.0], "up": [0.0, 1.0, 0.0],
+                       "fov_y": 50.0, "width": 8, "height": 6},
+            "ambient": [1.0, 1.0, 1.0],
+            "objects": [{"type": "triangle", "a": a, "b": b, "c": c, "material": {"k_a": 1.0}}],
+            "pixel": [3, 2]
+        }),
+        &["coverage"],
+    )
+}
+
+/// The converged reference finds what a pixel's covered sliver is, where
+/// an adaptive rule over the whole square never sampled it: an edge a
+/// millionth of the pixel inside its left side (area 1e-6), a corner
+/// covering (6e-8)^2 = 3.6e-15 of it, an edge from the middle of its left
+/// side at 0.001 degrees (area 1/2 + tan(0.001 deg) / 2). The areas are
+/// written here from the film polygons; the closed form (clipping) agrees.
+#[test]
+fn the_converged_coverage_finds_slivers_the_whole_square_misses() {
+    let far = 400.0;
+    let theta = 0.001_f64.to_radians();
+    let cases = [
+        (
+            "edge 1e-6 inside the left side",
+            [[3.0 + 1e-6, -far], [3.0 + 1e-6, far], [-far, 2.5]],
+            1e-6,
+        ),
+        (
+            "corner of (6e-8)^2",
+            [
+                [3.0 + 6e-8, 2.0 + 6e-8],
+                [3.0 + 6e-8 - far, 2.0 + 6e-8],
+                [3.0 + 6e-8, 2.0 + 6e-8 - far],
+            ],
+            3.6e-15,
+        ),
+        (
+            "edge at 0.001 degrees",
+            [
+                [3.0, 2.5],
+                [3.0 + far, 2.5 + far * theta.tan()],
+                [3.0, -far],
+            ],
+            0.5 + theta.tan() / 2.0,
+        ),
+    ];
+    for (what, film, area) in cases {
+        let exp = film_triangle(film);
+        let closed = Whitted::closed_form(&exp.scene, Q::Coverage).expect("a closed form")[0];
+        assert!(
+            (closed / area - 1.0).abs() < 1e-6,
+            "{what}: closed form {closed:e} against {area:e}"
+        );
+        let converged = Whitted::converged(&exp.scene, 400, &[Q::Coverage]).expect("converges");
+        let got = converged[&Q::Coverage].value[0];
+        assert!(
+            (got / area - 1.0).abs() < 1e-6,
+            "{what}: converged {got:e} against {area:e}"
+        );
+    }
+}
+
 // ------------------------------------------------- (3) rays and orders
 
 /// Through the family: W-Corner on the 8 x 6 image traces 9 x 7 primary

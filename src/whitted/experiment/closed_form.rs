@@ -25,24 +25,17 @@ fn footprint(cam: &Camera, shape: &Shape) -> Option<Footprint> {
             Some(Footprint::Polygon(poly))
         }
         Shape::Plane { point, normal } => {
-            // d(x, y) . n is affine in the film point; the ray meets the
-            // plane where its sign is opposite to the eye's side.
+            // The ray meets the plane where d . n has the sign opposite to
+            // the eye's side.
             let side = (cam.eye() - point).dot(&normal);
             if side == 0.0 {
                 return None;
             }
-            let at = |p: [f64; 2]| cam.direction(p).dot(&normal);
-            let (o, x, y) = (at([0.0, 0.0]), at([1.0, 0.0]), at([0.0, 1.0]));
-            let (a, b, c) = (x - o, y - o, -o);
-            // Hit where s (a x + b y - c) < 0 with s the eye's side.
+            let toward = cam.film_half_plane(normal);
             Some(Footprint::HalfPlane(if side > 0.0 {
-                HalfPlane { a, b, c }
+                toward
             } else {
-                HalfPlane {
-                    a: -a,
-                    b: -b,
-                    c: -c,
-                }
+                toward.complement()
             }))
         }
         Shape::Sphere { .. } => None,

@@ -36,11 +36,16 @@
 //! reaches its diffuse or specular terms, no mirror or transmitted ray):
 //! `background + (I_a k_a C - background) coverage`.
 //!
-//! **Converged reference** ([`Whitted::converged`]): adaptive Genz–Malik
-//! (relative tolerance 1e-12) on each pixel with [`CONVERGED_PER_N`]` n`
-//! evaluations (`n / 16` of that per pixel for `image`); an edge inside
-//! the pixel makes it converge algebraically, so the layer's check against
-//! `2n` states the accuracy reached.
+//! **Converged reference** ([`Whitted::converged`]): each pixel cut along
+//! the scene's outlines on the film ([`super::pieces`]: triangle edges,
+//! plane horizons, the lines bounding a sphere's outline), and adaptive
+//! Genz–Malik (relative tolerance 1e-12) on each piece, [`CONVERGED_PER_N`]`
+//! n` evaluations per pixel shared between them (`n / 16` of that per pixel
+//! for `image`): a covered sliver a millionth of the pixel wide is a piece
+//! of its own, so it is sampled. Coverage by triangles and planes is
+//! constant on a piece; a sphere's outline, a shadow's or a reflection's
+//! edge inside a piece makes it converge algebraically, so the layer's
+//! check against `2n` states the accuracy reached.
 //!
 //! **Terms left out.** No transparent material, no refraction ray; no
 //! `k_s`, no reflection ray; no lights, no shadow ray (see
@@ -95,6 +100,7 @@ use crate::family::{self, Family, Flag, Measured, Method, Outcome};
 use crate::quadrature::{AnyRule, BaseRule, GenzMalik, Rule};
 use crate::value::{Rgb, Value};
 use crate::whitted::intersect::Shape;
+use crate::whitted::pieces;
 use crate::whitted::render::{self, Estimated, Scheme as Render};
 use crate::whitted::scene::Scene;
 use crate::whitted::shade::RayCount;
@@ -281,7 +287,16 @@ pub fn evaluate_counted(
     rng: &mut rand_pcg::Pcg64,
     q: WhittedQuantity,
 ) -> Result<(Measured, RayCount), QuadError> {
-    let scheme = scheme(method, budget);
+    by_scheme(built, &scheme(method, budget), rng, q)
+}
+
+/// One quantity by a render scheme, with the rays traced by kind.
+fn by_scheme(
+    built: &Built,
+    scheme: &Render,
+    rng: &mut rand_pcg::Pcg64,
+    q: WhittedQuantity,
+) -> Result<(Measured, RayCount), QuadError> {
     let scene = &built.scene;
     let cam = &scene.camera;
     let (corner, w, h) = match q {
@@ -289,10 +304,10 @@ pub fn evaluate_counted(
         _ => (the_pixel(built)?, 1, 1),
     };
     if q == WhittedQuantity::Coverage {
-        let (est, rays) = render::coverage_block(scene, corner, w, h, &scheme, rng)?;
+        let (est, rays) = render::coverage_block(scene, corner, w, h, scheme, rng)?;
         return Ok((measured(&est, rays.total()), rays));
     }
-    let out = render::render_block(scene, corner, w, h, &scheme, rng).map_err(unresolved)?;
+    let out = render::render_block(scene, corner, w, h, scheme, rng).map_err(unresolved)?;
     defined(&out.image.values, corner, w)?;
     Ok((measured(&out.image, out.rays.total()), out.rays))
 }
@@ -346,6 +361,11 @@ fn pilot(scheme: &Render) -> Option<Render> {
         Render::Rule { rule, n } => Some(Render::Rule {
             rule: rule.clone(),
             n: (n / PILOT_SHARE).max(rule.min_budget(2)),
+        }),
+        Render::Pieces { rule, n, lines } => Some(Render::Pieces {
+            rule: rule.clone(),
+            n: (n / PILOT_SHARE).max(rule.min_budget(2)),
+            lines: lines.clone(),
         }),
         _ => None,
     }
@@ -537,8 +557,9 @@ impl Family for Whitted {
          transmitted ray)"
     }
 
-    /// Adaptive Genz–Malik (relative tolerance 1e-12) per pixel with
-    /// [`CONVERGED_PER_N`]` n` evaluations (`/ 16` for `image`).
+    /// Adaptive Genz–Malik (relative tolerance 1e-12) on each piece of each
+    /// pixel cut along the scene's outlines, [`CONVERGED_PER_N`]` n`
+    /// evaluations per pixel (`/ 16` for `image`).
     fn converged(
         built: &Built,
         n: usize,
@@ -558,11 +579,15 @@ impl Family for Whitted {
                 } else {
                     per_pixel
                 };
-                let method = Method::Rule(rule.clone());
+                let scheme = Render::Pieces {
+                    rule: rule.clone(),
+                    n: budget,
+                    lines: pieces::outlines(&built.scene),
+                };
                 if q == WhittedQuantity::Image {
-                    return Ok((q, image_by_pixels(built, &scheme(&method, budget))?));
+                    return Ok((q, image_by_pixels(built, &scheme)?));
                 }
-                Ok((q, evaluate_counted(built, &method, budget, &mut rng, q)?.0))
+                Ok((q, by_scheme(built, &scheme, &mut rng, q)?.0))
             })
             .collect()
     }
