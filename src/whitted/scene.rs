@@ -359,7 +359,7 @@ impl Camera {
         let (width, height) = (self.width as f64, self.height as f64);
         let tangents = |across: f64| -> Vec<f64> {
             let reach = across.hypot(wf);
-            if !(reach > radius) {
+            if reach.is_nan() || reach <= radius {
                 return Vec::new();
             }
             let (alpha, beta) = (across.atan2(wf), (radius / reach).asin());
