@@ -157,6 +157,7 @@ fn race(
         evaluations: parts.iter().map(|p| p.evaluations).sum(),
         walks: total,
         all_alike: parts.iter().all(|p| p.all_alike),
+        heavy: parts.iter().any(|p| p.heavy),
     })
 }
 

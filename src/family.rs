@@ -335,6 +335,14 @@ pub enum Flag {
         /// The number of walks.
         walks: u64,
     },
+    /// A tracking estimator's scores are carried by a few walks
+    /// ([`crate::volume::tracking::Tracked::heavy`]): the mean rests on
+    /// walks not yet seen, and the standard error can understate the true
+    /// error by orders of magnitude.
+    HeavyWalks {
+        /// The number of walks.
+        walks: u64,
+    },
 }
 
 impl std::fmt::Display for Flag {
@@ -348,6 +356,10 @@ impl std::fmt::Display for Flag {
             Flag::AllWalksAlike { walks } => write!(
                 f,
                 "all {walks} walks scored alike: error is a Wilson half-width / 1.96, not a sample SE"
+            ),
+            Flag::HeavyWalks { walks } => write!(
+                f,
+                "{walks} walks carried by a few: the mean rests on walks not yet seen, the SE can be far too small"
             ),
         }
     }

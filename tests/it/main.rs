@@ -42,6 +42,7 @@ mod runner;
 mod spec_fuzz;
 mod sum_lanes;
 mod tracking_cost;
+mod tracking_diagnostic;
 mod volume;
 mod volume_emission;
 mod volume_estimators;

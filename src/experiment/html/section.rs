@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use crate::experiment::markdown::escape;
 use crate::experiment::report::{Page, Row, RowFlag, Section, cell, label, show_value};
+use crate::family::Flag;
 
 use super::page::q_anchor;
 use super::{num_cell, rule_cell};
@@ -19,6 +20,7 @@ fn alarming(f: &RowFlag) -> bool {
             | RowFlag::EstimateOff
             | RowFlag::ErrorGrew
             | RowFlag::ErrorBeyondRange
+            | RowFlag::Job(Flag::HeavyWalks { .. })
     )
 }
 

@@ -76,7 +76,10 @@ divide by); `underflows` (the value is below the smallest f64 and reads 0; its l
 and `ln I_B = ln B + ln tau`); `no error estimate` (the method had too little to estimate from: \
 stratified sampling on two cells); `at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
 scored alike` (a tracking estimate with zero sample variance: its error is a Wilson half-width \
-/ 1.96, not a sample standard error).";
+/ 1.96, not a sample standard error); `N walks carried by a few` (a tracking estimate whose \
+scores' sample variance is carried by a few walks, as the mean of a product of many factors is: \
+the mean rests on walks not yet seen, and the standard error can be orders of magnitude too \
+small).";
 
 /// One row of a report table: a rule at one budget, aggregated over repeats.
 #[derive(Debug, Clone, PartialEq)]

@@ -69,6 +69,7 @@ pub(super) fn estimate(
                 evaluations: 0,
                 walks: budget as u64,
                 all_alike: false,
+                heavy: false,
             },
             Some(medium) => {
                 let sigma = Extinction {
@@ -127,6 +128,11 @@ pub(super) fn estimate(
             let m = Measured::scalar(t.value, t.error, t.evaluations);
             let m = if t.all_alike {
                 m.flagged(Flag::AllWalksAlike { walks: t.walks })
+            } else {
+                m
+            };
+            let m = if t.heavy {
+                m.flagged(Flag::HeavyWalks { walks: t.walks })
             } else {
                 m
             };

@@ -106,6 +106,7 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
             evaluations: 0,
             walks: n as u64,
             all_alike: false,
+            heavy: false,
         };
         return Ok(Radiance {
             tau: exact(1.0),
@@ -274,6 +275,7 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
                 evaluations,
                 walks: n as u64,
                 all_alike: false,
+                heavy: false,
             }
         }
     };

@@ -34,12 +34,77 @@ pub fn wilson_error(k: u64, n: u64) -> Result<f64, QuadError> {
     Ok((k * (n - k) / n + 0.25 * Z * Z).sqrt() / (n + Z * Z))
 }
 
+/// How the non-zero scores `w_i` share their sum: their effective number
+/// `ESS = (sum |w_i|)^2 / sum w_i^2` (about their count where they are alike
+/// in size, about 1 where one carries the sum), summed relative to the
+/// largest `|w|` so far (rescaled when it grows) so that scores of 1e-200
+/// and less neither underflow when squared nor lose the ratio; and the
+/// sample variance `s^2` of `ln |w_i|`.
+#[derive(Debug, Clone, Default)]
+struct Dispersion {
+    largest: f64,
+    sum: f64,
+    squares: f64,
+    count: u64,
+    logs: Welford<f64>,
+}
+
+impl Dispersion {
+    fn add(&mut self, x: f64) {
+        let a = x.abs();
+        if a == 0.0 || !a.is_finite() {
+            return;
+        }
+        if a > self.largest {
+            let r = if self.largest > 0.0 {
+                self.largest / a
+            } else {
+                0.0
+            };
+            self.sum *= r;
+            self.squares *= r * r;
+            self.largest = a;
+        }
+        let y = a / self.largest;
+        self.sum += y;
+        self.squares += y * y;
+        self.count += 1;
+        self.logs.add(a.ln());
+    }
+
+    /// True when the non-zero scores' mean rests on scores not seen, by
+    /// either of two signs (at least 4 of them):
+    /// - a few carry their sum: `ESS < max(2, count / HEAVY_SHARE)`;
+    /// - their logarithms spread as a log-normal's whose mean is carried by
+    ///   values beyond the largest of `count` draws: for `ln w ~ N(m, s^2)`
+    ///   the mean `E w = exp(m + s^2 / 2)` is carried by draws near
+    ///   `m + s^2`, the largest of `k` draws lies near `m + s sqrt(2 ln k)`,
+    ///   so they are not seen where `s^2 > 2 ln k`.
+    fn carried_by_few(&self) -> bool {
+        let k = self.count as f64;
+        let ess = self.sum * self.sum / self.squares;
+        let few = ess < (k / HEAVY_SHARE).max(2.0);
+        let s2 = self.logs.standard_error() * self.logs.standard_error() * k;
+        let spread = s2 > 2.0 * k.ln();
+        self.count >= 4 && (few || spread)
+    }
+}
+
+/// The walks' non-zero scores are flagged as carried by a few
+/// ([`super::Tracked::heavy`]) when their effective number is below
+/// 1/`HEAVY_SHARE` of their count (or 2). Scores of a product of many
+/// factors (ratio tracking through an optical depth of 200) give an
+/// effective number near 1 at any count; scores with a relative variance
+/// `v` give about `count / (1 + v)`, so the flag asks for `v` above 15.
+const HEAVY_SHARE: f64 = 16.0;
+
 /// Walk scores summed as the tracking errors need them.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Scores {
     walks: Welford<f64>,
     first: Option<f64>,
     alike: bool,
+    dispersion: Dispersion,
 }
 
 impl Scores {
@@ -52,6 +117,7 @@ impl Scores {
             Some(f) => self.alike &= f == x,
         }
         self.walks.add(x);
+        self.dispersion.add(x);
     }
 
     /// The mean with its standard error; when every walk scored alike, the
@@ -72,6 +138,7 @@ impl Scores {
             evaluations,
             walks: n,
             all_alike: self.alike && !exact,
+            heavy: !self.alike && self.dispersion.carried_by_few(),
         }
     }
 
@@ -87,6 +154,7 @@ impl Scores {
             evaluations,
             walks: n,
             all_alike: self.alike,
+            heavy: false,
         }
     }
 }

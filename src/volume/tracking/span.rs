@@ -115,7 +115,15 @@ pub(super) fn spans(
                     "a finite extinction bound (lambda times the medium's density)",
                 ));
             }
+            // A density known constant on the span (its bounds meet) is its
+            // own control, with no residual to track.
+            let floor = match tracker {
+                Tracker::ResidualRatio => lambda * medium.min_density(ray, s0, s1),
+                _ => 0.0,
+            };
+            let constant = floor >= bar && bar > 0.0;
             let control = match tracker {
+                Tracker::ResidualRatio if constant => bar,
                 Tracker::ResidualRatio => {
                     let gl = crate::quadrature::gauss_legendre::unit_nodes(4)?;
                     *evaluations += 4;
@@ -128,9 +136,13 @@ pub(super) fn spans(
                 }
                 _ => 0.0,
             };
-            // The residual |sigma - control| is bounded by max(bar - control, control).
-            let majorant = if control > 0.0 {
-                (bar - control).max(control)
+            // The residual |sigma - control| is bounded by
+            // max(bar - control, control - floor), floor a lower bound of
+            // sigma (0 unless the medium knows better): 0 on a constant span.
+            let majorant = if constant {
+                0.0
+            } else if control > 0.0 {
+                (bar - control).max(control - floor)
             } else {
                 bar
             };
