@@ -158,6 +158,7 @@ fn race(
         walks: total,
         all_alike: parts.iter().all(|p| p.all_alike),
         heavy: parts.iter().any(|p| p.heavy),
+        underflows: parts.iter().any(|p| p.underflows),
     })
 }
 

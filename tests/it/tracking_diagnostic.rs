@@ -223,3 +223,56 @@ fn residual_ratio_tracking_is_exact_and_cheap_in_a_constant_medium() {
         ratio.evaluations
     );
 }
+
+/// Trackers alone on a tau that underflows f64 (optical depth 2e5, e^-2e5
+/// is below 1e-86000): the heading says the true value underflows, no row
+/// shows a true error, and no tracker reaches a target, for an estimate of
+/// 0 is off by all of a value f64 cannot hold.
+#[test]
+fn trackers_alone_on_an_underflowing_tau_reach_nothing() {
+    let dir = crate::common::scratch("under");
+    let file = dir.join("under.json");
+    let text = json!({
+        "name": "under", "family": "volume", "scene": {
+            "ray": {"origin": [-3.0, 0.0, 0.0], "direction": [1.0, 0.0, 0.0]},
+            "medium": {"type": "constant-sphere", "centre": [0.0, 0.0, 0.0], "radius": 1.0, "kappa": 1e5}},
+        "quantities": ["tau"],
+        "rules": [{"rule": "delta-tracking"}, {"rule": "residual-ratio-tracking"}],
+        "budgets": [16, 256], "repeats": 2, "reference": {"type": "closed-form"}
+    });
+    std::fs::write(&file, text.to_string()).expect("write");
+    let out = dir.join("out");
+    let o = crate::common::bin()
+        .args(["run", "--out"])
+        .arg(&out)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = std::fs::read_to_string(out.join("under/report.md")).expect("report");
+    let heading = report
+        .lines()
+        .find(|l| l.starts_with("## tau"))
+        .expect("a tau section");
+    assert!(heading.contains("underflows f64"), "{heading}");
+    for row in report.lines().filter(|l| {
+        l.starts_with("| delta-tracking |") || l.starts_with("| residual-ratio-tracking |")
+    }) {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        if cells.len() > 8 {
+            assert_eq!(cells[4], "—", "a true error shown: {row}");
+            assert!(row.contains("underflows"), "{row}");
+        } else {
+            assert!(
+                cells
+                    .iter()
+                    .skip(3)
+                    .all(|c| c.is_empty() || *c == "—" || *c == "not reached"),
+                "{row}"
+            );
+        }
+    }
+    let index = std::fs::read_to_string(out.join("index.md")).expect("index");
+    assert!(index.contains("delta-tracking (not reached)"), "{index}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

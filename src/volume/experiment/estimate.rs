@@ -70,6 +70,7 @@ pub(super) fn estimate(
                 walks: budget as u64,
                 all_alike: false,
                 heavy: false,
+                underflows: false,
             },
             Some(medium) => {
                 let sigma = Extinction {
@@ -133,6 +134,11 @@ pub(super) fn estimate(
             };
             let m = if t.heavy {
                 m.flagged(Flag::HeavyWalks { walks: t.walks })
+            } else {
+                m
+            };
+            let m = if t.underflows {
+                m.flagged(Flag::Underflow)
             } else {
                 m
             };

@@ -89,7 +89,7 @@ use crate::geometry::Ray;
 use crate::volume::medium::Medium;
 
 use scores::Scores;
-use span::{Crossing, DELTA_SPANS, SPANS, control_factor, spans};
+use span::{Crossing, DELTA_SPANS, SPANS, control_factor, spans, underflows};
 use walks::{delta_walks, walk};
 
 /// Tentative collisions allowed per walk and span before tracking gives up
@@ -176,6 +176,11 @@ pub struct Tracked {
     /// 16 walks are more than 4 standard errors off, unflagged; 3 at 256,
     /// none at 4096).
     pub heavy: bool,
+    /// True when the true `tau` is certainly below the smallest normal f64
+    /// (the optical depth of the medium's lower density bounds along the
+    /// ray exceeds 708.4): an estimate of 0 then says nothing of its
+    /// relative error, and `ln_tau` by quadrature holds the value.
+    pub underflows: bool,
 }
 
 /// Checks the common arguments of the estimators.
@@ -234,9 +239,11 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
             walks: n as u64,
             all_alike: false,
             heavy: false,
+            underflows: false,
         });
     }
     let (control, crossings) = (control_factor(&spans), Crossing::of(&spans));
+    let under = underflows(&spans);
     // Residual ratio tracking on spans whose density is known constant:
     // every residual is 0, no walk draws a collision, and tau is the
     // controls' factor, exact up to the rounding of its exponent.
@@ -249,6 +256,7 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
             walks: n as u64,
             all_alike: false,
             heavy: false,
+            underflows: under,
         });
     }
     if tracker == Tracker::Delta {
@@ -263,6 +271,7 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
             walks: n,
             all_alike: through == 0 || through == n,
             heavy: false,
+            underflows: under,
         });
     }
     let mut scores = Scores::default();
@@ -277,5 +286,8 @@ pub fn transmittance<Rg: rand::Rng + ?Sized>(
         )?);
     }
     // Scores in [0, 1] (residual ratio: a heuristic, see Tracked::all_alike).
-    Ok(scores.tracked(evaluations, |x| x.max(1.0 - x)))
+    Ok(Tracked {
+        underflows: under,
+        ..scores.tracked(evaluations, |x| x.max(1.0 - x))
+    })
 }

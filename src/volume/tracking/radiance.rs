@@ -107,6 +107,7 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
             walks: n as u64,
             all_alike: false,
             heavy: false,
+            underflows: false,
         };
         return Ok(Radiance {
             tau: exact(1.0),
@@ -276,6 +277,7 @@ pub fn radiance<Rg: rand::Rng + ?Sized>(
                 walks: n as u64,
                 all_alike: false,
                 heavy: false,
+                underflows: false,
             }
         }
     };

@@ -139,6 +139,7 @@ impl Scores {
             walks: n,
             all_alike: self.alike && !exact,
             heavy: !self.alike && self.dispersion.carried_by_few(),
+            underflows: false,
         }
     }
 
@@ -155,6 +156,7 @@ impl Scores {
             walks: n,
             all_alike: self.alike,
             heavy: false,
+            underflows: false,
         }
     }
 }

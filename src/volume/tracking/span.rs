@@ -17,6 +17,8 @@ pub(super) struct Span {
     /// The medium's density bound on the span (`bar / lambda`).
     pub(super) v_bar: f64,
     pub(super) control: f64,
+    /// `lambda` times the medium's lower density bound on the span.
+    pub(super) floor: f64,
     /// The rate `walk` and `delta_walks` draw tentative collisions at
     /// (`radiance`, where it is 0, draws at `1 / (b - a)` to score emission
     /// and light).
@@ -117,11 +119,8 @@ pub(super) fn spans(
             }
             // A density known constant on the span (its bounds meet) is its
             // own control, with no residual to track.
-            let floor = match tracker {
-                Tracker::ResidualRatio => lambda * medium.min_density(ray, s0, s1),
-                _ => 0.0,
-            };
-            let constant = floor >= bar && bar > 0.0;
+            let floor = lambda * medium.min_density(ray, s0, s1);
+            let constant = tracker == Tracker::ResidualRatio && floor >= bar && bar > 0.0;
             let control = match tracker {
                 Tracker::ResidualRatio if constant => bar,
                 Tracker::ResidualRatio => {
@@ -152,6 +151,7 @@ pub(super) fn spans(
                 bar,
                 v_bar,
                 control,
+                floor,
                 majorant,
             };
             // Ratio tracking crosses the whole span: about `majorant * length`
@@ -217,6 +217,14 @@ pub(super) fn too_deep(span: &Span, limit: u64) -> QuadError {
 
 /// `exp(-int sigma_c)`: the controls' factor of residual ratio tracking's
 /// score (1 for the other trackers, whose control is 0).
+/// True when `tau` over the spans is certainly below the smallest normal
+/// f64: the optical depth of their lower bounds, `sum floor (b - a)`,
+/// exceeds `-ln(f64::MIN_POSITIVE)` (708.4).
+pub(super) fn underflows(spans: &[Span]) -> bool {
+    let depth: f64 = spans.iter().map(|s| s.floor * (s.b - s.a)).sum();
+    depth > -f64::MIN_POSITIVE.ln()
+}
+
 pub(super) fn control_factor(spans: &[Span]) -> f64 {
     let depth: f64 = spans.iter().map(|s| s.control * (s.b - s.a)).sum();
     (-depth).exp()
