@@ -59,6 +59,13 @@ pub struct Estimate<V: Value> {
     pub kind: ErrorKind,
     /// False when the rule itself doubts its error estimate.
     pub reliable: bool,
+    /// True when a deterministic rule's every evaluation gave the same
+    /// value and its error estimate is 0 in some channel: the 0 says
+    /// nothing of what lies between the nodes (a light no node saw; a
+    /// constant integrand is flagged too, truly). Set by
+    /// [`Rule::try_integrate`](crate::quadrature::Rule::try_integrate);
+    /// a sum of pieces is alike when each piece is.
+    pub alike: bool,
 }
 
 impl<V: Value> Estimate<V> {
@@ -70,6 +77,7 @@ impl<V: Value> Estimate<V> {
             evaluations,
             kind: ErrorKind::Deterministic,
             reliable: true,
+            alike: false,
         }
     }
 
@@ -81,6 +89,7 @@ impl<V: Value> Estimate<V> {
             evaluations,
             kind: ErrorKind::StandardError,
             reliable: true,
+            alike: false,
         }
     }
 
@@ -94,6 +103,7 @@ impl<V: Value> Estimate<V> {
             evaluations: 0,
             kind: ErrorKind::Deterministic,
             reliable: true,
+            alike: false,
         }
     }
 
@@ -141,6 +151,10 @@ impl<V: Value> Estimate<V> {
             evaluations: self.evaluations + other.evaluations,
             kind,
             reliable: self.reliable && other.reliable,
+            // Zero (no evaluations) is neutral.
+            alike: (self.alike || self.evaluations == 0)
+                && (other.alike || other.evaluations == 0)
+                && (self.alike || other.alike),
         }
     }
 }

@@ -343,6 +343,13 @@ pub enum Flag {
         /// The number of walks.
         walks: u64,
     },
+    /// A deterministic rule's every node gave the same value and its error
+    /// estimate is 0 ([`crate::estimate::Estimate::alike`]): the 0 says
+    /// nothing of what lies between the nodes.
+    AllNodesAlike {
+        /// The evaluations.
+        evaluations: u64,
+    },
 }
 
 impl std::fmt::Display for Flag {
@@ -356,6 +363,10 @@ impl std::fmt::Display for Flag {
             Flag::AllWalksAlike { walks } => write!(
                 f,
                 "all {walks} walks scored alike: error is a Wilson half-width / 1.96, not a sample SE"
+            ),
+            Flag::AllNodesAlike { evaluations } => write!(
+                f,
+                "every one of {evaluations} nodes gave the same value: an error of 0 says nothing of what lies between them"
             ),
             Flag::HeavyWalks { walks } => write!(
                 f,
@@ -414,11 +425,15 @@ impl<V: crate::value::Value> From<crate::estimate::Estimate<V>> for Measured {
             value: (0..V::CHANNELS).map(|c| e.value.channel(c)).collect(),
             error: (0..V::CHANNELS).map(|c| e.error.channel(c)).collect(),
             evaluations: e.evaluations,
-            flags: if e.reliable {
-                Vec::new()
-            } else {
-                vec![Flag::UnreliableEstimate]
-            },
+            flags: [
+                (!e.reliable).then_some(Flag::UnreliableEstimate),
+                e.alike.then_some(Flag::AllNodesAlike {
+                    evaluations: e.evaluations,
+                }),
+            ]
+            .into_iter()
+            .flatten()
+            .collect(),
             seconds: None,
         }
     }

@@ -235,6 +235,10 @@ pub(super) fn try_integrate<
         // f64): infinite, no bound a report can show, so doubted.
         let beyond_range = (0..V::CHANNELS)
             .any(|c| estimate.error.channel(c).is_infinite() && pass.error.channel(c).is_finite());
+        let estimate = Estimate {
+            alike: !rule.is_random() && all_alike(&estimate, &points, fresh),
+            ..estimate
+        };
         return if sound(&estimate) {
             Ok(if beyond_range {
                 estimate.doubted()
@@ -249,6 +253,25 @@ pub(super) fn try_integrate<
             })
         };
     }
+}
+
+/// True when `estimate` has an error of 0 in some channel and every one of
+/// the `fresh` evaluations, all held by `points`, gave the same value
+/// (bit for bit); false when the log holds fewer.
+fn all_alike<const D: usize, V: Value>(
+    estimate: &Estimate<V>,
+    points: &replay::Log<([f64; D], V)>,
+    fresh: u64,
+) -> bool {
+    let zero = (0..V::CHANNELS).any(|c| estimate.error.channel(c) == 0.0);
+    if !zero || fresh < 2 || points.len() as u64 != fresh {
+        return false;
+    }
+    let mut first: Option<V> = None;
+    points.fold(true, |same, (_, y)| {
+        let f = *first.get_or_insert(*y);
+        same && (0..V::CHANNELS).all(|c| f.channel(c).to_bits() == y.channel(c).to_bits())
+    })
 }
 
 /// `x 2^e` exactly (while representable), in two steps so that each power

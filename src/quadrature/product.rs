@@ -238,6 +238,7 @@ impl<A: Rule, B: Rule> Rule for Product<A, B> {
             evaluations: inner_evaluations,
             kind,
             reliable: outer.reliable && inner_reliable,
+            alike: false,
         })
     }
 }

@@ -87,6 +87,11 @@ impl<T: Copy> Log<T> {
         }
     }
 
+    /// The number of items logged.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
     /// Folds `f` over every item logged.
     pub fn fold<A>(&self, init: A, f: impl FnMut(A, &T) -> A) -> A {
         self.items.iter().fold(init, f)

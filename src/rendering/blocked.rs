@@ -592,6 +592,7 @@ fn over_fan<K: Kernel>(
             evaluations: 0,
             kind: p.kind,
             reliable: p.reliable,
+            alike: false,
         });
     }
     Ok(Estimate {

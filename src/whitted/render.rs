@@ -83,6 +83,10 @@ pub struct Estimated<V: Value> {
     pub errors: Vec<V>,
     /// False when a rule doubted its estimate for some pixel.
     pub reliable: bool,
+    /// True when, in every pixel, a deterministic rule's nodes all gave
+    /// the same value with an error estimate of 0
+    /// ([`crate::estimate::Estimate::alike`]).
+    pub alike: bool,
 }
 
 /// The `width x height` pixels from pixel `(i0, j0)` of the film function
@@ -101,6 +105,7 @@ pub fn estimate<V: Value>(
         errors: vec![unknown; values.len()],
         values,
         reliable: true,
+        alike: false,
     };
     match scheme {
         Scheme::Corner { m } => Ok(image_wide(pixel::corner_image(
@@ -117,6 +122,7 @@ pub fn estimate<V: Value>(
                 values: Vec::with_capacity(width * height),
                 errors: Vec::with_capacity(width * height),
                 reliable: true,
+                alike: matches!(scheme, Scheme::Rule { .. } | Scheme::Pieces { .. }),
             };
             for j in 0..height {
                 for i in 0..width {
@@ -128,12 +134,14 @@ pub fn estimate<V: Value>(
                             let est = pixel::by_rule(rule, &p, *n, rng, &mut f);
                             let est = est.map_err(|e| undefined_ray(e, &p))?;
                             out.reliable &= est.reliable;
+                            out.alike &= est.alike;
                             (est.value, est.error)
                         }
                         Scheme::Pieces { rule, n, lines } => {
                             let est = by_pieces(rule, &p, lines, *n, rng, &mut f);
                             let est = est.map_err(|e| undefined_ray(e, &p))?;
                             out.reliable &= est.reliable;
+                            out.alike &= est.alike;
                             (est.value, est.error)
                         }
                         Scheme::Corner { .. } | Scheme::Adaptive { .. } => {
@@ -242,12 +250,14 @@ impl Rendered {
             values: Vec::with_capacity(pixels),
             errors: Vec::with_capacity(pixels),
             reliable: true,
+            alike: !parts.is_empty(),
         };
         for part in parts {
             rays.add(part.rays);
             image.values.extend(part.image.values);
             image.errors.extend(part.image.errors);
             image.reliable &= part.image.reliable;
+            image.alike &= part.image.alike;
         }
         Rendered { image, rays }
     }

@@ -1156,3 +1156,82 @@ fn a_blocker_in_the_lights_plane_is_unverified_and_a_ball_under_the_receiver_hid
         );
     }
 }
+
+/// A deterministic rule whose every node missed a small light returns 0
+/// with an error estimate of 0; the flag says every node gave the same
+/// value. The light is a disk of radius 0.01 on the receiver's axis at
+/// height 1, so E = pi L r^2 / (r^2 + h^2) (written here), not 0. A rule
+/// whose nodes did see it carries no such flag.
+#[test]
+fn zero_from_nodes_that_all_missed_a_small_light_is_flagged() {
+    let (r, h) = (0.01_f64, 1.0_f64);
+    let exp = with_scene(
+        json!({"receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+               "emitters": [{"type": "disk", "centre": [0.0, 0.0, h], "normal": [0.0, 0.0, -1.0],
+                             "radius": r, "radiance": 1.0}]}),
+        &["E_hemisphere", "E_cone"],
+    );
+    let exact = PI * r * r / (r * r + h * h);
+    assert!(rel(closed(&exp, Q::EHemisphere), exact) < 1e-12);
+    let flags = |method: Value, q: Q| {
+        let method: Method<Mis> = serde_json::from_value(method).expect("a method");
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(17);
+        let out =
+            Rendering::evaluate(&exp.scene, &method, 1024, &mut rng, &[q]).expect("evaluates");
+        (out[&q].value[0], out[&q].error[0], out[&q].flags.clone())
+    };
+    let alike = |f: &[lightquad::family::Flag]| {
+        f.iter()
+            .any(|x| matches!(x, lightquad::family::Flag::AllNodesAlike { .. }))
+    };
+    let (v, e, f) = flags(json!({"rule": "genz-malik"}), Q::EHemisphere);
+    assert_eq!((v, e), (0.0, 0.0), "every node missed the light");
+    assert!(alike(&f), "{f:?}");
+    let (v, _, f) = flags(json!({"rule": "gauss-legendre"}), Q::ECone);
+    assert!(rel(v, exact) < 1e-6, "{v} against {exact}");
+    assert!(!alike(&f), "{f:?}");
+}
+
+/// Sobol' on a small coaxial disk light, a step in one coordinate of the
+/// uniform hemisphere map 2.7 cells of 1/2048 wide at 16384 points: the
+/// eight scrambles often hold the same 2 or 3 hits, and then their standard
+/// error is thousands of times smaller than the error. Every run more than
+/// 4 standard errors off the closed form pi L r^2 / (r^2 + h^2) (written
+/// here) is flagged by the rule itself; such runs occur.
+#[test]
+fn sobol_scrambles_that_agree_on_a_few_hits_are_doubted() {
+    let (r, h) = (0.0514_f64, 1.0_f64);
+    let exp = with_scene(
+        json!({"receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+               "emitters": [{"type": "disk", "centre": [0.0, 0.0, h], "normal": [0.0, 0.0, -1.0],
+                             "radius": r, "radiance": 1.0}]}),
+        &["E_hemisphere"],
+    );
+    let exact = PI * r * r / (r * r + h * h);
+    let method: Method<Mis> = serde_json::from_value(json!({"rule": "sobol"})).expect("a method");
+    let (mut beyond, mut unflagged) = (0, 0);
+    for n in [16384, 65536] {
+        for seed in 0..40 {
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+            let q = Q::EHemisphere;
+            let out =
+                Rendering::evaluate(&exp.scene, &method, n, &mut rng, &[q]).expect("evaluates");
+            let m = &out[&q];
+            if (m.value[0] - exact).abs() > 4.0 * m.error[0] {
+                beyond += 1;
+                unflagged += usize::from(
+                    !m.flags
+                        .contains(&lightquad::family::Flag::UnreliableEstimate),
+                );
+            }
+        }
+    }
+    assert!(
+        beyond > 0,
+        "no run beyond 4 standard errors: the test sees nothing"
+    );
+    assert_eq!(
+        unflagged, 0,
+        "{unflagged} of {beyond} runs beyond 4 SE unflagged"
+    );
+}

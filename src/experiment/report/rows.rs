@@ -79,7 +79,9 @@ scored alike` (a tracking estimate with zero sample variance: its error is a Wil
 / 1.96, not a sample standard error); `N walks carried by a few` (a tracking estimate whose \
 scores' sample variance is carried by a few walks, as the mean of a product of many factors is: \
 the mean rests on walks not yet seen, and the standard error can be orders of magnitude too \
-small).";
+small); `every one of N nodes gave the same value` (a deterministic rule whose error estimate \
+is 0 because every node saw the same value, as where no node saw a small light: the 0 says \
+nothing of what lies between them; a constant integrand is flagged too, truly).";
 
 /// One row of a report table: a rule at one budget, aggregated over repeats.
 #[derive(Debug, Clone, PartialEq)]

@@ -217,6 +217,7 @@ fn total(res: &VolumeResult) -> Measured {
             evaluations: t.evaluations,
             kind: t.kind,
             reliable: t.reliable,
+            alike: false,
         })
         .fold(Estimate::zero(), Estimate::combine);
     // V-B reuses tau's evaluations: count them once.

@@ -416,10 +416,15 @@ fn measured<V: Value>(est: &Estimated<V>, rays: u64) -> Measured {
         flags: Vec::new(),
         seconds: None,
     };
-    if est.reliable {
+    let m = if est.reliable {
         m
     } else {
         m.flagged(Flag::UnreliableEstimate)
+    };
+    if est.alike {
+        m.flagged(Flag::AllNodesAlike { evaluations: rays })
+    } else {
+        m
     }
 }
 
