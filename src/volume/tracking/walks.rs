@@ -230,6 +230,7 @@ mod tests {
                     bar: majorant,
                     v_bar: majorant,
                     control: 0.0,
+                    floor: 0.0,
                     majorant,
                 };
                 a += w;
