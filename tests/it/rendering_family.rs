@@ -1235,3 +1235,44 @@ fn sobol_scrambles_that_agree_on_a_few_hits_are_doubted() {
         "{unflagged} of {beyond} runs beyond 4 SE unflagged"
     );
 }
+
+/// A rectangle light facing away from the receiver (it emits on the side
+/// of edge_u x edge_v, here +z, and the receiver is below it at z = 0 with
+/// the light at z = 1) lights nothing: `check` accepts it with a warning at
+/// the emitter's path; swapping the edges lights the receiver, with no
+/// warning. The light's irradiance from below is 0 by Lambert's formula
+/// (nothing emitted toward -z); the swapped one's closed form is positive.
+#[test]
+fn an_emitter_facing_away_from_the_receiver_is_a_warning_at_its_path() {
+    let text = |u: [f64; 3], v: [f64; 3]| {
+        json!({
+            "name": "away", "family": "rendering",
+            "scene": {"receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]},
+                      "emitters": [{"type": "rectangle", "origin": [-0.5, -0.5, 1.0],
+                                    "edge_u": u, "edge_v": v, "radiance": 1.0}]},
+            "quantities": ["E_cone"], "rules": [{"rule": "gauss-legendre"}], "budgets": [16],
+            "repeats": 1, "reference": {"type": "closed-form"}
+        })
+        .to_string()
+    };
+    let dir = scratch("away");
+    let check = |name: &str, body: String| {
+        let file = dir.join(name);
+        fs::write(&file, body).expect("write");
+        bin().arg("check").arg(&file).output().expect("runs")
+    };
+    let away = check("away.json", text([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]));
+    assert!(away.status.success(), "{}", stderr(&away));
+    let msg = stderr(&away);
+    assert!(
+        msg.contains("warning") && msg.contains("at `scene.emitters[0]`"),
+        "{msg}"
+    );
+    assert!(msg.contains("faces away from the receiver"), "{msg}");
+    let toward = check("toward.json", text([0.0, 1.0, 0.0], [1.0, 0.0, 0.0]));
+    assert!(toward.status.success(), "{}", stderr(&toward));
+    assert!(!stderr(&toward).contains("warning"), "{}", stderr(&toward));
+    let exp = load(serde_json::from_str(&text([0.0, 1.0, 0.0], [1.0, 0.0, 0.0])).expect("json"));
+    assert!(closed(&exp, Q::ECone) > 0.1);
+    let _ = fs::remove_dir_all(&dir);
+}

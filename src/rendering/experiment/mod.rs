@@ -370,6 +370,9 @@ pub struct Built {
     pub brdf: Option<AnyBrdf>,
     /// `wo`, unit, above the horizon (with the BRDF).
     pub toward_viewer: Option<Vec3>,
+    /// Doubts about the scene, each at its JSON path (an emitter facing
+    /// away from the receiver).
+    pub warnings: Vec<SpecError>,
 }
 
 /// The work of one evaluation beyond the integrand evaluations of the
@@ -405,6 +408,10 @@ impl Family for Rendering {
 
     fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         build(spec)
+    }
+
+    fn warnings(built: &Built) -> Vec<SpecError> {
+        built.warnings.clone()
     }
 
     /// Every form is an integral over a 2-D domain.

@@ -574,6 +574,7 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         ));
     }
     let mut emitters = Vec::with_capacity(spec.emitters.len());
+    let mut warnings = Vec::new();
     for (i, e_spec) in spec.emitters.iter().enumerate() {
         let at = format!("scene.emitters[{i}]");
         let e = emitter(e_spec).map_err(|err| SpecError::from_quad(&at, err))?;
@@ -608,6 +609,9 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
                 ),
             ));
         }
+        if let Some(w) = facing_away(&at, &e, &receiver) {
+            warnings.push(w);
+        }
         emitters.push(e);
     }
     let mut occluders = Vec::with_capacity(spec.occluders.len());
@@ -622,6 +626,35 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         receiver,
         brdf,
         toward_viewer,
+        warnings,
+    })
+}
+
+/// The warning at `at` for a finite emitter whose emitting side faces away
+/// from the receiver (the receiver behind it or in its plane): it sends the
+/// receiver no light. A one-sided emitter emits on the side of its normal:
+/// `edge_u x edge_v` for a rectangle, `(b - a) x (c - a)` for a triangle,
+/// `normal` for a disk, outward for a sphere.
+fn facing_away(at: &str, e: &AnyEmitter<f64>, receiver: &Receiver) -> Option<SpecError> {
+    if e.at_infinity() {
+        return None;
+    }
+    let (y, _) = crate::domain::Domain::map(&e.surface(receiver).ok()?, [0.5, 0.5]);
+    let n = e.normal_at(y);
+    let x = receiver.point();
+    ((x - y).dot(&n) <= 0.0).then(|| {
+        SpecError::at(
+            at,
+            format!(
+                "faces away from the receiver: it emits on the side of its normal {:?} \
+                 (edge_u x edge_v for a rectangle, (b - a) x (c - a) for a triangle, `normal` \
+                 for a disk), and the receiver at {:?} is behind it or in its plane, so every \
+                 quantity gets 0 from it (reverse the normal, or swap edge_u and edge_v, or b \
+                 and c, to light the receiver)",
+                n.as_slice(),
+                x.as_slice()
+            ),
+        )
     })
 }
 
