@@ -102,7 +102,7 @@ pub fn pieces(pixel: &Pixel, lines: &[HalfPlane], max: usize) -> (Vec<Vec<[f64; 
 
 /// The mean of `f` over `pixel` by `rule` on each piece of the pixel cut
 /// along `lines` ([`pieces`]), `n` evaluations in all: each fan triangle
-/// first at [`PILOT_SHARE`] of an even share (at least the rule's least),
+/// first at [`PILOT_SHARE`] of an even share (at least 4 times the rule's least),
 /// then the rest of `n` shared in proportion to those estimates' errors,
 /// so a piece the integrand is smooth on costs little and one an outline
 /// crosses gets the budget. Values and error estimates add, scaled by the
@@ -121,7 +121,9 @@ pub fn by_pieces<R: Rule, V: Value>(
         .flat_map(|p| (1..p.len() - 1).map(move |k| [p[0], p[k], p[k + 1]]))
         .collect();
     let least = rule.min_budget(2);
-    let pilot = (n / fans.len().max(1) / PILOT_SHARE).max(least);
+    // At least a few boxes of an adaptive rule, so that even a piece it
+    // finds constant has a history to check its estimate against.
+    let pilot = (n / fans.len().max(1) / PILOT_SHARE).max(4 * least);
     let mut parts = Vec::with_capacity(fans.len());
     for fan in &fans {
         parts.push(on_triangle(rule, *fan, pilot, rng, &mut f)?);

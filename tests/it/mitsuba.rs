@@ -196,3 +196,34 @@ fn the_readme_states_the_regeneration_time_the_values_files_record() {
     let said = format!("the committed ones add up to {total:.0} s");
     assert!(readme.contains(&said), "README lacks `{said}`");
 }
+
+/// The cross-check rows of the white furnace and of W-SS's coverage:
+/// lightquad's converged value meets the closed form to 1e-12 (the W-SS
+/// coverage was 3.4e-5 off when its pixel was integrated whole), and no
+/// row is marked unverified where the closed form confirms it.
+#[test]
+fn cross_check_rows_with_a_closed_form_agree_and_are_verified() {
+    use lightquad::experiment::reference::crosscheck;
+    use lightquad::experiment::source::Origin;
+    use lightquad::experiment::validate::validate_from;
+    fn rows<F: Family>(name: &str) -> Vec<lightquad::experiment::reference::Crosscheck> {
+        let text = std::fs::read_to_string(root().join(format!("experiments/{name}.json")))
+            .expect("bundled");
+        let exp = parse_json(&text)
+            .and_then(deserialize::<F>)
+            .and_then(|spec| validate_from::<F>(spec, &file_hash(text.as_bytes()), Origin::Bundled))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        crosscheck(&exp)
+    }
+    let mut all = rows::<Furnace>("mitsuba-r-furnace-bounces");
+    all.extend(rows::<Whitted>("w-ss-edge-coverage"));
+    let checked: Vec<_> = all.iter().filter(|r| r.lightquad.is_finite()).collect();
+    assert!(checked.len() >= 3, "{all:?}");
+    for r in checked {
+        let closed = r
+            .closed_form
+            .unwrap_or_else(|| panic!("{r:?}: a closed form"));
+        assert!(((r.lightquad - closed) / closed).abs() <= 1e-12, "{r:?}");
+        assert!(r.verified, "{r:?}");
+    }
+}

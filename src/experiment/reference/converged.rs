@@ -171,9 +171,10 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
             }
         }
     }
-    // A converged evaluation that doubts its own error estimate (the
-    // rendering family's, across outlines it does not split at) is not
-    // called converged, whatever its change between budgets.
+    // A converged evaluation that doubts its own error estimate (across a
+    // discontinuity it does not split at, a feature one node carries, a
+    // history that contradicts it) is not called converged, whatever its
+    // change between budgets.
     let doubted: Vec<String> = exp
         .spec
         .quantities
@@ -191,8 +192,9 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
         .collect();
     unconverged.extend(doubted.iter().map(|q| {
         format!(
-            "{q} (unverified: its evaluation crosses discontinuities it does not split at, where \
-             the change between budgets can understate the error)"
+            "{q} (unverified: its evaluation doubts its own error estimate, as across a \
+             discontinuity it does not split at, where the change between budgets can \
+             understate the error)"
         )
     }));
     let floor = if goal == CONVERGED_FLOOR {

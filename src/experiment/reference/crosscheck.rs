@@ -19,8 +19,8 @@ pub struct Crosscheck {
     pub quantity: &'static str,
     /// lightquad's converged value (the family's converged evaluation at n = 400).
     pub lightquad: f64,
-    /// False when that evaluation doubts its own error (it crosses outlines
-    /// it does not split at): the table marks the value unverified.
+    /// False when that evaluation doubts its own error estimate and no
+    /// closed form confirms it (to 1e-12): the table marks it unverified.
     pub verified: bool,
     /// Mitsuba's value and standard error, when it has one.
     pub mitsuba: Option<(f64, f64)>,
@@ -140,15 +140,19 @@ pub fn crosscheck<F: Family>(exp: &Experiment<F>) -> Vec<Crosscheck> {
                     .unwrap_or("")
                     .to_string()
             });
+            let value = scalar(lightquad.get(q).map(|m| &m.value)).unwrap_or(f64::NAN);
+            let closed_form = scalar(F::closed_form(&exp.scene, *q).as_ref());
+            let confirmed = closed_form.is_some_and(|c| relative_distance(&[value], &[c]) <= 1e-12);
+            let trusted = lightquad
+                .get(q)
+                .is_none_or(|m| !m.flags.contains(&crate::family::Flag::UnreliableEstimate));
             Crosscheck {
                 experiment: exp.spec.name.clone(),
                 quantity: q.name(),
-                lightquad: scalar(lightquad.get(q).map(|m| &m.value)).unwrap_or(f64::NAN),
-                verified: lightquad
-                    .get(q)
-                    .is_none_or(|m| !m.flags.contains(&crate::family::Flag::UnreliableEstimate)),
+                lightquad: value,
+                verified: confirmed || trusted,
                 mitsuba,
-                closed_form: scalar(F::closed_form(&exp.scene, *q).as_ref()),
+                closed_form,
                 note,
             }
         })
@@ -191,7 +195,7 @@ pub fn crosscheck_markdown(rows: &[Crosscheck]) -> String {
         let unverified = if r.verified {
             ""
         } else {
-            " (unverified: across outlines it does not split at)"
+            " (unverified: its evaluation doubts its own error estimate)"
         };
         // A colour or an image has no single number to show.
         let lightquad = if r.lightquad.is_finite() {

@@ -39,7 +39,7 @@
 //! **Converged reference** ([`Whitted::converged`]): each pixel cut along
 //! the scene's outlines on the film ([`super::pieces`]: triangle edges,
 //! plane horizons, the lines bounding a sphere's outline), and adaptive
-//! Genz–Malik (relative tolerance 1e-12) on each piece, [`CONVERGED_PER_N`]`
+//! Genz–Malik (its whole budget) on each piece, [`CONVERGED_PER_N`]`
 //! n` evaluations per pixel shared between them (`n / 16` of that per pixel
 //! for `image`): a covered sliver a millionth of the pixel wide is a piece
 //! of its own, so it is sampled. Coverage by triangles and planes is
@@ -562,7 +562,7 @@ impl Family for Whitted {
          transmitted ray)"
     }
 
-    /// Adaptive Genz–Malik (relative tolerance 1e-12) on each piece of each
+    /// Adaptive Genz–Malik (its whole budget) on each piece of each
     /// pixel cut along the scene's outlines, [`CONVERGED_PER_N`]` n`
     /// evaluations per pixel (`/ 16` for `image`).
     fn converged(
@@ -572,7 +572,7 @@ impl Family for Whitted {
     ) -> Result<Outcome<WhittedQuantity>, QuadError> {
         let rule = AnyRule::Base(BaseRule::GenzMalik(GenzMalik {
             abs_tol: 0.0,
-            rel_tol: 1e-12,
+            rel_tol: 0.0,
         }));
         let per_pixel = CONVERGED_PER_N.saturating_mul(n);
         let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
