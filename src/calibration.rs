@@ -138,7 +138,8 @@ impl Family for Calibration {
     const ABOUT: &'static str =
         "integrals with closed forms over a segment, a disk and the hemisphere, to calibrate rules";
     const EQUATIONS: &'static [&'static str] = &[];
-    const BUDGET_UNIT: &'static str = "integrand evaluations";
+    const BUDGET_UNIT: &'static str = "the points a rule is given (the evaluations column counts \
+                                       what it spent, its error estimate included)";
 
     type SceneSpec = NoScene;
     type Scene = NoScene;

@@ -249,8 +249,9 @@ impl Family for Furnace {
                                  sphere (the white furnace when every wall emits) by its Neumann \
                                  series with any 2-D rule per bounce, and by path tracing";
     const EQUATIONS: &'static [&'static str] = &["R-H", "R-3P"];
-    const BUDGET_UNIT: &'static str = "evaluations per hemisphere integral (rules: the series \
-                                       reuses them every bounce); paths (path-tracing)";
+    const BUDGET_UNIT: &'static str = "points per hemisphere integral (rules: the series \
+                                       reuses them every bounce; the evaluations column counts \
+                                       what they spent); paths (path-tracing)";
     const OVER_BUDGET: &'static str = "the series integrates two functions over the hemisphere \
         (the cap's emission and 1), each with the rule's own error estimate: about 2 n, or 7 n \
         for Gauss–Legendre";

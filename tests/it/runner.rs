@@ -3123,3 +3123,47 @@ fn shards_run_past_the_cost_limit_merge_and_the_advice_fits_the_cause() {
     assert!(merged.join("blob").join("report.md").is_file(), "{msg}");
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// The findings paragraph states what theory says of a case built for it:
+/// int_0^1 e^u by the trapezoid rule on n points has error (e - 1) h^2 / 12,
+/// h = 1/(n - 1) (3.6e-5 at 64 points, 5.5e-7 at 512: it reaches 1e-3 and
+/// never 1e-9, at a slope of -2n/(n - 1), -2.03 to -2.00 here), while
+/// Gauss–Legendre is at rounding from 64 nodes (the only one to reach 1e-9).
+#[test]
+fn the_findings_say_what_theory_says_of_a_case_built_for_it() {
+    let (dir, out, o) = run_text(
+        "findings",
+        r#"{ "name": "f", "family": "calibration", "scene": {}, "quantities": ["exp"],
+        "rules": [{ "rule": "trapezoid" }, { "rule": "gauss-legendre" }],
+        "budgets": [64, 128, 256, 512], "repeats": 1, "targets": [1e-3, 1e-9],
+        "reference": { "type": "closed-form" } }"#,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = fs::read_to_string(out.join("f/report.md")).expect("report");
+    let findings = report
+        .lines()
+        .find(|l| l.starts_with("Findings"))
+        .expect("findings");
+    assert!(
+        findings.contains("Only gauss-legendre reaches 1e-9"),
+        "{findings}"
+    );
+    assert!(!findings.contains("No rule reaches 1e-3"), "{findings}");
+    let fitted = findings
+        .split("against log evaluations: ")
+        .nth(1)
+        .expect("fitted slopes");
+    let slope: f64 = fitted
+        .split("trapezoid ")
+        .nth(1)
+        .and_then(|t| t.split([',', ' ']).next())
+        .and_then(|t| t.trim_end_matches('.').parse().ok())
+        .expect("a trapezoid slope");
+    assert!((slope + 2.0).abs() < 0.05, "{slope}: {findings}");
+    let html = fs::read_to_string(out.join("f/index.html")).expect("html");
+    assert!(
+        html.contains("<p class=\"findings\">Findings"),
+        "the HTML page shows them too"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -49,6 +49,9 @@ pub(super) fn section(page: &Page, s: &Section) -> String {
         escape(q),
         escape(reference)
     );
+    if let Some(f) = crate::experiment::report::findings(page, s) {
+        let _ = writeln!(b, "<p class=\"findings\">{}</p>", escape(&f));
+    }
     b.push_str("<div class=\"plots\">");
     for (what, file, svg) in &s.plots {
         let _ = write!(

@@ -44,6 +44,7 @@
 //! ```
 
 mod csv;
+mod findings;
 mod index;
 mod order;
 mod page;
@@ -54,6 +55,7 @@ mod section;
 
 use std::collections::BTreeMap;
 
+pub use findings::findings;
 pub use index::write_index;
 pub use order::{Against, ERRATIC, FIT_ROWS, fit_floor, order, order_and_scatter, time_to};
 pub use page::{SHARED, provenance, write_experiment};

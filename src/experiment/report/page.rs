@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::Page;
 use super::csv::csv;
+use super::findings::findings;
 use super::ranking::Summary;
 use super::rows::{FLAG_LEGEND, Row, RowFlag};
 use super::section::{
@@ -38,11 +39,11 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
             }
         };
         let display = page.displays.get(i).copied().flatten();
-        let _ = writeln!(
-            md,
-            "## {q} (reference {reference})\n\n{}",
-            table(page, &s.rows, display.as_ref())
-        );
+        let _ = writeln!(md, "## {q} (reference {reference})\n");
+        if let Some(f) = findings(page, s) {
+            let _ = writeln!(md, "{}\n", crate::experiment::markdown::plain(&f));
+        }
+        let _ = writeln!(md, "{}", table(page, &s.rows, display.as_ref()));
         if let (Some(d), Some(values)) = (
             extra_columns(&s.rows, display.as_ref()).1,
             page.reference.values.get(q),

@@ -65,6 +65,11 @@ pub struct Fit {
     pub slope_evaluations: String,
     /// Per target: the time in seconds, "not reached" or "below reference accuracy".
     pub times: Vec<String>,
+    /// Per target: the time in seconds where the rule reached it.
+    pub seconds: Vec<Option<f64>>,
+    /// The fitted slope against evaluations and whether it is erratic
+    /// (not an order), where one was fitted.
+    pub order: Option<(f64, bool)>,
 }
 
 /// Computes the sections of a page, one per quantity in the file's order.
@@ -301,6 +306,7 @@ fn orders_and_plots(
         }
         let label = label(page, i);
         let reach = |t: f64| (t >= accuracy).then(|| time_to(&mine, t)).flatten();
+        let seconds: Vec<Option<f64>> = page.targets.iter().map(|&t| reach(t)).collect();
         let times: Vec<String> = page
             .targets
             .iter()
@@ -343,6 +349,9 @@ fn orders_and_plots(
             }),
             slope_evaluations: slope(Against::Evaluations),
             times,
+            seconds,
+            order: order_and_scatter(&mine, Against::Evaluations, accuracy)
+                .map(|(o, off, grew)| (o, off > limit || (deterministic && grew))),
         });
         let first = mine
             .iter()

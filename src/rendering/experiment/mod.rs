@@ -398,8 +398,10 @@ impl Family for Rendering {
                                  spheres, caps and an environment, with occluders, by the \
                                  hemispherical (R-H) and area (R-A) forms and MIS";
     const EQUATIONS: &'static [&'static str] = &["R-3P", "R-H", "R-A", "R-S"];
-    const BUDGET_UNIT: &'static str = "integrand evaluations (per emitter for the cone and area \
-                                       forms; samples per strategy for MIS)";
+    const BUDGET_UNIT: &'static str = "the points a rule is given (per emitter for the cone and \
+                                       area forms; samples per strategy for MIS), not the \
+                                       evaluations it spends: those are the evaluations column, \
+                                       a rule's error estimate and refinement included";
 
     type SceneSpec = SceneSpec;
     type Scene = Built;
