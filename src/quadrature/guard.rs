@@ -61,6 +61,9 @@ pub(super) fn try_integrate<
     let mut underflowed: Option<Estimate<V>> = None;
     let mut rescaled_overflow = false;
     let mut passes = 0;
+    // The first pass's first value, and whether every value since matched
+    // it bit for bit (for Estimate::alike).
+    let (mut first, mut same) = (None::<V>, true);
     loop {
         passes += 1;
         points.rewind();
@@ -83,6 +86,8 @@ pub(super) fn try_integrate<
                 |u| {
                     let y = f(u)?;
                     fresh += 1;
+                    let f0 = *first.get_or_insert(y);
+                    same = same && bitwise_equal(&f0, &y);
                     // The log keeps the largest |f| of what it holds
                     // (folded only when needed); past it, it is kept here.
                     if points.push((u, y)) {
@@ -235,8 +240,14 @@ pub(super) fn try_integrate<
         // f64): infinite, no bound a report can show, so doubted.
         let beyond_range = (0..V::CHANNELS)
             .any(|c| estimate.error.channel(c).is_infinite() && pass.error.channel(c).is_finite());
+        let zero = (0..V::CHANNELS).any(|c| estimate.error.channel(c) == 0.0);
+        let alike = if passes == 1 {
+            same && fresh >= 2
+        } else {
+            all_alike(&points, fresh)
+        };
         let estimate = Estimate {
-            alike: !rule.is_random() && all_alike(&estimate, &points, fresh),
+            alike: !rule.is_random() && zero && alike,
             ..estimate
         };
         return if sound(&estimate) {
@@ -255,23 +266,23 @@ pub(super) fn try_integrate<
     }
 }
 
-/// True when `estimate` has an error of 0 in some channel and every one of
-/// the `fresh` evaluations, all held by `points`, gave the same value
-/// (bit for bit); false when the log holds fewer.
-fn all_alike<const D: usize, V: Value>(
-    estimate: &Estimate<V>,
-    points: &replay::Log<([f64; D], V)>,
-    fresh: u64,
-) -> bool {
-    let zero = (0..V::CHANNELS).any(|c| estimate.error.channel(c) == 0.0);
-    if !zero || fresh < 2 || points.len() as u64 != fresh {
+/// True when every one of the `fresh` evaluations, all held by `points`,
+/// gave the same value (bit for bit); false when the log holds fewer.
+fn all_alike<const D: usize, V: Value>(points: &replay::Log<([f64; D], V)>, fresh: u64) -> bool {
+    if fresh < 2 || points.len() as u64 != fresh {
         return false;
     }
     let mut first: Option<V> = None;
     points.fold(true, |same, (_, y)| {
         let f = *first.get_or_insert(*y);
-        same && (0..V::CHANNELS).all(|c| f.channel(c).to_bits() == y.channel(c).to_bits())
+        same && bitwise_equal(&f, y)
     })
+}
+
+/// `a` and `b` are the same in every channel, bit for bit.
+#[inline(always)]
+fn bitwise_equal<V: Value>(a: &V, b: &V) -> bool {
+    (0..V::CHANNELS).all(|c| a.channel(c).to_bits() == b.channel(c).to_bits())
 }
 
 /// `x 2^e` exactly (while representable), in two steps so that each power

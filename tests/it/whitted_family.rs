@@ -420,6 +420,31 @@ fn the_converged_coverage_finds_slivers_the_whole_square_misses() {
     }
 }
 
+/// Gauss–Legendre and Genz–Malik on a pixel whose covered part is a sliver
+/// 1e-6 of its width: no node lands in it, so both read 0 +- 0, and the
+/// value carries the flag that every node gave the same value (the clipped
+/// area is 1e-6, not 0).
+#[test]
+fn zero_from_nodes_that_all_missed_a_sliver_is_flagged() {
+    let far = 400.0;
+    let exp = film_triangle([[3.0 + 1e-6, -far], [3.0 + 1e-6, far], [-far, 2.5]]);
+    for rule in ["gauss-legendre", "genz-malik"] {
+        let method: Method<Scheme> =
+            serde_json::from_value(json!({ "rule": rule })).expect("method");
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(0);
+        let (m, _) =
+            evaluate_counted(&exp.scene, &method, 65536, &mut rng, Q::Coverage).expect("evaluates");
+        assert_eq!((m.value[0], m.error[0]), (0.0, 0.0), "{rule}");
+        assert!(
+            m.flags
+                .iter()
+                .any(|f| matches!(f, lightquad::family::Flag::AllNodesAlike { .. })),
+            "{rule}: {:?}",
+            m.flags
+        );
+    }
+}
+
 // ------------------------------------------------- (3) rays and orders
 
 /// Through the family: W-Corner on the 8 x 6 image traces 9 x 7 primary

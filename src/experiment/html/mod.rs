@@ -57,6 +57,7 @@ h3 { font-size: 1.15rem; margin-top: 1.6rem; }
 a { color: #0b5cad; }
 nav.top { font-size: .95rem; color: var(--muted); }
 p.lead { font-size: 1.08rem; max-width: 70rem; }
+p.findings { max-width: 75rem; border-left: 3px solid var(--muted); padding-left: .8rem; }
 dl.facts { display: grid; grid-template-columns: max-content 1fr; gap: .25rem 1.2rem; margin: 1rem 0; }
 dl.facts dt { font-weight: 600; color: var(--muted); }
 dl.facts dd { margin: 0; }

@@ -139,14 +139,29 @@ fn flags(page: &Page, s: &Section) -> String {
         .map(|((i, k), mut budgets)| {
             budgets.sort_unstable();
             budgets.dedup();
-            let at = match budgets.as_slice() {
-                [one] => format!("n = {one}"),
-                [a, b] => format!("n = {a} and {b}"),
-                [a, .., b] => format!("n = {a} to {b} ({} budgets)", budgets.len()),
-                [] => String::new(),
-            };
-            format!("{} {k} at {at}", label(page, i))
+            format!("{} {k} at {}", label(page, i), at(page.budgets, &budgets))
         })
         .collect();
     format!("Flags: {}.", clauses.join("; "))
+}
+
+/// The budgets a flag shows at, in words: a run of the page's budgets as
+/// its ends, a few others one by one.
+fn at(all: &[usize], budgets: &[usize]) -> String {
+    let run = |a: usize, b: usize| {
+        let between: Vec<usize> = all.iter().copied().filter(|&n| n >= a && n <= b).collect();
+        between == budgets
+    };
+    match budgets {
+        [one] => format!("n = {one}"),
+        [a, .., b] if budgets.len() > 2 && run(*a, *b) => {
+            format!("every budget from n = {a} to {b}")
+        }
+        _ if budgets.len() <= 6 => {
+            let list: Vec<String> = budgets.iter().map(ToString::to_string).collect();
+            format!("n = {}", list.join(", "))
+        }
+        [a, .., b] => format!("{} of the budgets from n = {a} to {b}", budgets.len()),
+        [] => String::new(),
+    }
 }
