@@ -26,7 +26,7 @@
 //! the same mean (in any channel: a standard error of 0), or when the
 //! values at all the points fail the tail check of plain Monte Carlo
 //! ([`Welford::doubtful`]: all alike, or a sample variance whose estimated
-//! relative error exceeds [`variance_doubt_threshold`](super::monte_carlo::variance_doubt_threshold)).
+//! relative error exceeds [`variance_doubt_threshold`]).
 //! From 256 points a scramble the tail check also runs at a scramble's own
 //! count: a light that is a step in one coordinate (a small coaxial disk
 //! in the uniform hemisphere map, 2.7 cells of 1/2048 wide) gets the same

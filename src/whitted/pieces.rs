@@ -6,7 +6,7 @@
 //! The cuts ([`outlines`]) are the film lines of every straight outline
 //! (each triangle edge: the plane through the eye and the edge; each plane's
 //! horizon: the plane through the eye parallel to it) and the four lines
-//! bounding each sphere's outline ([`Camera::sphere_bounds`]). Between the
+//! bounding each sphere's outline ([`super::scene::Camera::sphere_bounds`]). Between the
 //! straight cuts the set of film points whose ray meets a triangle or a
 //! plane is constant, so coverage is constant on a piece; a sphere's curved
 //! outline lies in the pieces inside its bounding lines, where it covers a
