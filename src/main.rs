@@ -167,6 +167,21 @@ fn run(command: Command) -> Result<(), Failure> {
                     )
                     .into());
                 }
+                // Threads past a cap do not fail to start: one aborts the
+                // process when its signal stack cannot be mapped. Refused
+                // first, where the cap is known.
+                let need = experiment::memory::thread_reserve(t);
+                if let Some(cap) = experiment::memory::hard_cap().filter(|c| need > c.room) {
+                    return Err(format!(
+                        "invalid --threads = {t}: {t} worker threads reserve about {} of \
+                         address space (their stacks and allocator arenas), and {} leaves {}: \
+                         expected fewer threads",
+                        experiment::memory::bytes(need),
+                        cap.what,
+                        experiment::memory::bytes(cap.room)
+                    )
+                    .into());
+                }
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(t)
                     .build_global()

@@ -33,6 +33,15 @@ pub fn warm_workers() {
     rayon::broadcast(|_| std::hint::black_box(vec![0u8; 64]).len());
 }
 
+/// The address space `threads` worker threads reserve as they start: a
+/// 2 MiB stack each (Rust's default), and glibc's 64 MiB arena for each of
+/// the first `8 x cores` of them that allocate.
+pub fn thread_reserve(threads: usize) -> f64 {
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+    let arenas = threads.min(8 * cores) as f64;
+    threads as f64 * 2.0 * 1024.0 * 1024.0 + arenas * 64.0 * 1024.0 * 1024.0
+}
+
 /// A number of bytes as a person reads it: `512 KB`, `42.0 MB`, `1.50 GB`
 /// (0.00 GB beside 0.00 GB told two sizes apart by nothing).
 pub fn bytes(b: f64) -> String {
