@@ -62,7 +62,10 @@ pub(super) fn try_integrate<
     let mut rescaled_overflow = false;
     let mut passes = 0;
     // The first pass's first value, and whether every value since matched
-    // it bit for bit (for Estimate::alike).
+    // it bit for bit (for Estimate::alike). Measured on e^u at 65536 (one
+    // thread, medians of 9): Gauss–Legendre 1.146x the time without it
+    // (about 0.6 ns of its 229373 evaluations), the other rules 0.98 to
+    // 1.05x; a branch-free running min and max cost every rule 4 to 10%.
     let (mut first, mut same) = (None::<V>, true);
     loop {
         passes += 1;
@@ -86,8 +89,13 @@ pub(super) fn try_integrate<
                 |u| {
                     let y = f(u)?;
                     fresh += 1;
-                    let f0 = *first.get_or_insert(y);
-                    same = same && bitwise_equal(&f0, &y);
+                    // One predictable branch once a value differed.
+                    if same {
+                        match first {
+                            None => first = Some(y),
+                            Some(f0) => same = bitwise_equal(&f0, &y),
+                        }
+                    }
                     // The log keeps the largest |f| of what it holds
                     // (folded only when needed); past it, it is kept here.
                     if points.push((u, y)) {
