@@ -233,7 +233,7 @@ fn genz_malik_box<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Quad
 /// totals `(Q_half, E_half)` at the last doubling of the evaluations at or
 /// below half the final count against the final `(Q, E)`.
 ///
-/// Were both estimates honest, `|Q - Q_half| <= E + E_half`; a change of
+/// Were both estimates honest, `|Q - Q_half| <= E + E_half` (plus rounding, `4 sqrt(evaluations)` ulps); a change of
 /// more than twice that shows the estimates miss part of the error (a
 /// narrow ridge or peak that the boxes found only late and may still not
 /// resolve: the product Lorentzian `1/(((x - 0.3)^2 + w^2)((y - 0.3)^2 +
@@ -252,9 +252,14 @@ pub(crate) fn contradicted<V: Value>(
     else {
         return true;
     };
+    // A change within rounding of the sums (4 sqrt(evaluations) ulps of
+    // the values, the boxes' rounding added up) is no contradiction: a
+    // constant integrand's estimates differ by that much.
+    let ulps = 4.0 * (last.evaluations as f64).sqrt();
     (0..V::CHANNELS).any(|c| {
-        let change = (last.value.channel(c) - half_value.channel(c)).abs();
-        change > last.error.channel(c) + half_error.channel(c)
+        let (q, h) = (last.value.channel(c), half_value.channel(c));
+        let rounding = ulps * f64::EPSILON * (q.abs() + h.abs());
+        (q - h).abs() > last.error.channel(c) + half_error.channel(c) + rounding
     })
 }
 
