@@ -83,7 +83,14 @@ pub fn pieces(pixel: &Pixel, lines: &[HalfPlane], max: usize) -> (Vec<Vec<[f64; 
     let (w, h) = (pixel.width(), pixel.height());
     let mut out = vec![vec![[x, y], [x + w, y], [x + w, y + h], [x, y + h]]];
     let mut left_out = false;
-    for &line in lines {
+    let corners = [[x, y], [x + w, y], [x + w, y + h], [x, y + h]];
+    // A line with every corner of the pixel on one side cuts nothing: it is
+    // skipped before any piece is clipped (an image's lines are mostly so).
+    let crossing = lines.iter().filter(|l| {
+        let sides = corners.map(|p| l.side(p));
+        sides.iter().any(|&s| s < 0.0) && sides.iter().any(|&s| s > 0.0)
+    });
+    for &line in crossing {
         let mut next = Vec::with_capacity(out.len() + 1);
         for piece in &out {
             let (inside, outside) = (clip(piece, line), clip(piece, line.complement()));

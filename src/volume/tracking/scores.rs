@@ -90,8 +90,8 @@ impl Dispersion {
     }
 }
 
-/// The walks' non-zero scores are flagged as carried by a few
-/// ([`super::Tracked::heavy`]) when their effective number is below
+/// One of the two signs that the walks' non-zero scores are carried by a
+/// few ([`super::Tracked::heavy`]): their effective number below
 /// 1/`HEAVY_SHARE` of their count (or 2). Scores of a product of many
 /// factors (ratio tracking through an optical depth of 200) give an
 /// effective number near 1 at any count; scores with a relative variance
