@@ -564,6 +564,27 @@ pub trait Family: Sized + Send + Sync + 'static {
         }
     }
 
+    /// About how many simple evaluations (counted as [`Family::cost`] counts
+    /// them) and how many bytes at once the converged evaluation
+    /// ([`Family::converged`]) of `quantities` at `n` takes: `check` refuses
+    /// a converged reference whose first two evaluations (at `n` and `2n`)
+    /// pass the job limits, and the reference stops doubling before an
+    /// evaluation that would. By default the price of adaptive
+    /// Gauss–Kronrod at its cap of `15 + 30 n` evaluations a piece, which a
+    /// family whose converged evaluation uses another rule or budget
+    /// overrides.
+    fn converged_cost(scene: &Self::Scene, n: usize, quantities: &[Self::Quantity]) -> [f64; 2] {
+        let Ok(gk) = crate::quadrature::AnyRule::by_name("gauss-kronrod") else {
+            return [f64::NAN; 2];
+        };
+        job_cost::<Self>(
+            scene,
+            &Method::Rule(gk),
+            n.saturating_mul(30).saturating_add(15),
+            quantities,
+        )
+    }
+
     /// Evaluates `quantities` with `method` at `budget`, drawing randomness from
     /// `rng` only.
     fn evaluate(
@@ -703,4 +724,23 @@ pub mod json_f64 {
             Vec::<Num>::deserialize(d)?.into_iter().map(read).collect()
         }
     }
+}
+
+/// The evaluations (summed over `quantities`, [`Family::cost`]) and bytes
+/// (the largest, [`Family::memory`]) of one job of `method` at `budget`.
+pub fn job_cost<F: Family>(
+    scene: &F::Scene,
+    method: &Method<F::Estimator>,
+    budget: usize,
+    quantities: &[F::Quantity],
+) -> [f64; 2] {
+    let evaluations = quantities
+        .iter()
+        .map(|&q| F::cost(scene, method, budget, q))
+        .sum();
+    let bytes = quantities
+        .iter()
+        .map(|&q| F::memory(scene, method, budget, q))
+        .fold(0.0, f64::max);
+    [evaluations, bytes]
 }

@@ -243,9 +243,16 @@ fn run(command: Command) -> Result<(), Failure> {
                     );
                 }
                 let (rules, budgets, repeats) = exp.shape();
+                let [jobs, reference] = exp.cost();
+                let reference = if reference > 0.0 {
+                    format!(", its reference stage up to {reference:.1e} at the rules' caps")
+                } else {
+                    String::new()
+                };
                 writeln!(
                     out,
-                    "{}: ok ({}, family {}, {rules} rule(s) x {budgets} budget(s) x {repeats} repeat(s), hash {})",
+                    "{}: ok ({}, family {}, {rules} rule(s) x {budgets} budget(s) x {repeats} repeat(s), hash {}; \
+                     its jobs about {jobs:.1e} integrand evaluations{reference})",
                     f.display(),
                     exp.name(),
                     exp.family(),

@@ -54,3 +54,51 @@ pub(super) fn finished(
         bar.println(line);
     }
 }
+
+/// How often a run without a bar (a log file, a pipe) says how far the
+/// running experiment is: a long one printed nothing for minutes.
+pub const LINE_EVERY: Duration = Duration::from_secs(30);
+
+/// The jobs of one experiment finished so far, said as a line every
+/// [`LINE_EVERY`] where no bar shows them.
+pub struct Ticker {
+    name: String,
+    total: usize,
+    started: std::time::Instant,
+    state: std::sync::Mutex<(usize, std::time::Instant)>,
+    show: bool,
+}
+
+impl Ticker {
+    /// A ticker for `total` jobs of experiment `name`, `done` of them
+    /// finished before; silent unless `show`.
+    pub fn new(name: &str, total: usize, done: usize, show: bool) -> Self {
+        let now = std::time::Instant::now();
+        Ticker {
+            name: name.to_string(),
+            total,
+            started: now,
+            state: std::sync::Mutex::new((done, now)),
+            show,
+        }
+    }
+
+    /// Counts a finished job, and says the count if the last line is older
+    /// than [`LINE_EVERY`].
+    pub fn tick(&self) {
+        let Ok(mut state) = self.state.lock() else {
+            return;
+        };
+        state.0 += 1;
+        if self.show && state.1.elapsed() >= LINE_EVERY {
+            state.1 = std::time::Instant::now();
+            crate::say!(
+                "{}: {}/{} jobs finished, {:.0} s",
+                self.name,
+                state.0,
+                self.total,
+                self.started.elapsed().as_secs_f64()
+            );
+        }
+    }
+}

@@ -62,6 +62,10 @@ pub trait Loaded: Send + Sync {
     /// The `n` of a converged reference, which the report computes first
     /// (it can take longer than the jobs; the runner says so).
     fn converged_reference(&self) -> Option<usize>;
+    /// Its estimated evaluations, as `check` prices them: its jobs' in all
+    /// ([`super::validate::jobs_cost`]) and its reference stage's
+    /// ([`super::validate::reference_cost`]).
+    fn cost(&self) -> [f64; 2];
     /// Doubts about its scene that do not stop it ([`Family::warnings`]),
     /// each at its JSON path.
     fn warnings(&self) -> Vec<SpecError>;
@@ -105,6 +109,17 @@ impl<F: Family> Loaded for Experiment<F> {
     }
     fn warnings(&self) -> Vec<SpecError> {
         F::warnings(&self.scene)
+    }
+    fn cost(&self) -> [f64; 2] {
+        let named = match &self.spec.reference {
+            super::spec::ReferenceSpec::Mitsuba(m) => Some(m.file.as_str()),
+            _ => None,
+        };
+        let compared = super::reference::compares(&self.origin, &self.spec.name, &self.hash, named);
+        [
+            super::validate::jobs_cost(&self.spec, &self.scene, &self.budgets)[1],
+            super::validate::reference_cost(&self.spec, &self.scene, compared),
+        ]
     }
     fn max_job_bytes(&self, jobs: &[JobKey]) -> f64 {
         // Repeats hold the same memory: each (rule, budget) is costed once.

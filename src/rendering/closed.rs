@@ -325,6 +325,13 @@ impl Family for Furnace {
         "every furnace quantity has one"
     }
 
+    /// [`Self::converged`]'s Genz–Malik at `n^2` evaluations a hemisphere
+    /// integral, priced as a job of it.
+    fn converged_cost(built: &Built, n: usize, quantities: &[FurnaceQuantity]) -> [f64; 2] {
+        let method = Method::Rule(converged_rule());
+        family::job_cost::<Self>(built, &method, converged_budget(n), quantities)
+    }
+
     /// The series with adaptive Genz–Malik (relative tolerance 1e-12) at
     /// `n^2` evaluations per hemisphere integral: for `L_K` to the file's
     /// `K`, for `L` to as many bounces as a truncation of 1e-16 of `L` needs
@@ -335,10 +342,7 @@ impl Family for Furnace {
         n: usize,
         quantities: &[FurnaceQuantity],
     ) -> Result<Outcome<FurnaceQuantity>, QuadError> {
-        let rule = AnyRule::Base(BaseRule::GenzMalik(GenzMalik {
-            abs_tol: 0.0,
-            rel_tol: 1e-12,
-        }));
+        let rule = converged_rule();
         let mut out = Outcome::new();
         for &q in quantities {
             let mut series = built.clone();
@@ -352,7 +356,7 @@ impl Family for Furnace {
             let mut m = Self::evaluate(
                 &series,
                 &Method::Rule(rule.clone()),
-                n.saturating_mul(n).max(17),
+                converged_budget(n),
                 &mut rng,
                 &[q],
             )?
@@ -439,4 +443,19 @@ fn truncation_section(built: &Built) -> String {
         needs.join("; ")
     );
     md
+}
+
+/// The converged evaluation's rule: adaptive Genz–Malik to a relative
+/// tolerance of 1e-12.
+fn converged_rule() -> AnyRule {
+    AnyRule::Base(BaseRule::GenzMalik(GenzMalik {
+        abs_tol: 0.0,
+        rel_tol: 1e-12,
+    }))
+}
+
+/// The converged evaluation's budget a hemisphere integral at `n`: `n^2`,
+/// at least Genz–Malik's 17 of one region.
+fn converged_budget(n: usize) -> usize {
+    n.saturating_mul(n).max(17)
 }

@@ -28,6 +28,7 @@ mod memory_estimate;
 mod mitsuba;
 mod parallel;
 mod properties;
+mod reference_bounds;
 mod rendering_brdf;
 mod rendering_contour;
 mod rendering_convergence;

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use crate::error::SpecError;
 use crate::experiment::validate::Experiment;
+use crate::experiment::validate::{MAX_JOB_BYTES, MAX_JOB_EVALUATIONS, cost_limit_lifted};
 use crate::family::{Family, Measured, Quantity};
 
 use super::{Reference, names, relative_distance, rms};
@@ -52,6 +53,49 @@ pub const CONVERGED_FLOOR: f64 = 1e-13;
 /// Doublings of `n` the converged reference may take past the spec's `n`.
 const MAX_DOUBLINGS: u32 = 6;
 
+/// The evaluations an evaluation of every quantity made.
+fn evaluations<Q>(out: &BTreeMap<Q, Measured>) -> f64 {
+    out.values().map(|m| m.evaluations as f64).sum()
+}
+
+/// Why the converged reference stops doubling after its evaluation at `m`
+/// (`last` evaluations; `spent` in all so far), if it must: the next, at
+/// `2m`, priced as `last` times the growth of [`Family::converged_cost`]
+/// from `m` to `2m`, would take the reference past [`MAX_JOB_EVALUATIONS`]
+/// in all, or hold more than [`MAX_JOB_BYTES`] at once: the limits of a
+/// job. `--no-cost-limit` lifts them. (A scene that never settled doubled
+/// six times, each evaluation dearer, at costs no check had seen.)
+fn too_dear<F: Family>(exp: &Experiment<F>, m: usize, spent: f64, last: f64) -> Option<String> {
+    if cost_limit_lifted() {
+        return None;
+    }
+    let next = m.saturating_mul(2);
+    let [now, _] = F::converged_cost(&exp.scene, m, &exp.spec.quantities);
+    let [then, bytes] = F::converged_cost(&exp.scene, next, &exp.spec.quantities);
+    let growth = (then / now).clamp(2.0, 16.0);
+    let growth = if growth.is_nan() { 2.0 } else { growth };
+    let cost = last * growth;
+    let why = if spent + cost > MAX_JOB_EVALUATIONS {
+        format!(
+            "about {:.1e} integrand evaluations in all, beyond the {MAX_JOB_EVALUATIONS:.0e} \
+             a job may make",
+            spent + cost
+        )
+    } else if bytes.is_nan() || bytes > MAX_JOB_BYTES {
+        format!(
+            "about {:.1} GB at once, beyond the {:.1} GB a job may hold",
+            bytes / 1e9,
+            MAX_JOB_BYTES / 1e9
+        )
+    } else {
+        return None;
+    };
+    Some(format!(
+        "it stopped doubling at n = {m}: the next evaluation, at n = {next}, would take {why} \
+         (pass --no-cost-limit to run it)"
+    ))
+}
+
 /// The converged reference: the family's converged evaluation at `n`, `2n`,
 /// `4n`, ... nodes per piece until every quantity's relative change from one
 /// to the next is at most `goal` (a hundredth of the tightest target, but not
@@ -83,12 +127,15 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
         Err(e) => return failed(e),
     };
     let mut m = n;
+    let mut spent = evaluations(&coarse);
+    let mut stopped = None;
     let (fine, changes, per_channel) = loop {
         m *= 2;
         let fine = match converged_measured(exp, m) {
             Ok(b) => b,
             Err(e) => return failed(e),
         };
+        spent += evaluations(&fine);
         let changes: BTreeMap<String, f64> = exp
             .spec
             .quantities
@@ -110,7 +157,22 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
             })
             .collect();
         let done = changes.values().all(|c| *c <= goal);
-        if done || m >= n << MAX_DOUBLINGS {
+        if !done && m < n << MAX_DOUBLINGS {
+            stopped = too_dear::<F>(exp, m, spent, evaluations(&fine));
+        }
+        if !done && m < n << MAX_DOUBLINGS && stopped.is_none() {
+            // A reference that goes on doubling says so, or a long one looks
+            // like a hang.
+            let largest = changes.values().copied().fold(0.0, f64::max);
+            crate::say!(
+                "{}: the converged reference changed by {largest:.1e} from n = {} to {m} (goal \
+                 {goal:.0e}): doubling to n = {}",
+                exp.spec.name,
+                m / 2,
+                m * 2
+            );
+        }
+        if done || m >= n << MAX_DOUBLINGS || stopped.is_some() {
             // Each channel's change or own error estimate, the larger.
             let per_channel: BTreeMap<String, Vec<f64>> = exp
                 .spec
@@ -205,11 +267,13 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
     } else {
         String::new()
     };
+    let stopped = stopped.map_or(String::new(), |why| format!("; {why}"));
     let verdict = if unconverged.is_empty() {
         format!("every quantity converged to {goal:.0e} or better{floor}")
     } else {
         format!(
-            "NOT converged to {goal:.0e}{floor}: {}; errors below that are not resolved",
+            "NOT converged to {goal:.0e}{floor}: {}; errors below that are not \
+             resolved{stopped}",
             unconverged.join(", ")
         )
     };

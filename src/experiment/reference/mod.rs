@@ -45,7 +45,9 @@ mod mitsuba;
 
 use converged::converged_reference;
 pub use converged::{CONVERGED_FLOOR, MAX_CONVERGED_N, check_converged_n, converged};
-pub use crosscheck::{CROSSCHECK_INTRO, Crosscheck, crosscheck, crosscheck_markdown};
+pub use crosscheck::{
+    CROSSCHECK_INTRO, CROSSCHECK_N, Crosscheck, compares, crosscheck, crosscheck_markdown,
+};
 pub use mitsuba::mitsuba_values;
 use mitsuba::{not_values, stale_values, values_from_json};
 

@@ -453,7 +453,14 @@ pub fn run_experiment_in_lanes(
     // threads idle while it ran (the longest-first order balances the
     // threads best; the results are sorted after).
     pending.sort_by_key(|&(rule, budget, repeat)| (std::cmp::Reverse(budget), rule, repeat));
-    progress.inc((exp.jobs(opts.shard).len() - pending.len()) as u64);
+    let all_jobs = exp.jobs(opts.shard).len();
+    progress.inc((all_jobs - pending.len()) as u64);
+    let ticker = super::progress::Ticker::new(
+        exp.name(),
+        all_jobs,
+        all_jobs - pending.len(),
+        opts.progress && progress.is_hidden(),
+    );
     let file = Mutex::new(OpenOptions::new().append(true).open(&path)?);
     let run = |&key: &JobKey| {
         let result = exp.run_job(key);
@@ -465,6 +472,7 @@ pub fn run_experiment_in_lanes(
         f.write_all(line.as_bytes())?;
         f.flush()?;
         progress.inc(1);
+        ticker.tick();
         Ok(result)
     };
     // Dealt one at a time in that order to whichever lane is free: rayon's

@@ -3,7 +3,7 @@
 
 use crate::error::SpecError;
 use crate::experiment::spec::ExperimentSpec;
-use crate::family::{Family, Method};
+use crate::family::Family;
 
 use super::min_budget;
 
@@ -57,40 +57,12 @@ pub(super) fn check_cost<F: Family>(
     if cost_limit_lifted() {
         return Ok(());
     }
-    // The converged reference runs before the report: adaptive
-    // Gauss–Kronrod capped at 15 + 30 n evaluations a piece, at n and 2n at
-    // least (then doubled until it converges; its tolerance usually stops it
-    // far below the cap, so the cap of the first two evaluations is the
-    // bound checked). A scene of radius 1e308 with n = 1e5 passed and ran
-    // without end.
-    if let crate::experiment::spec::ReferenceSpec::Converged(c) = &spec.reference
-        && let Ok(gk) = crate::quadrature::AnyRule::by_name("gauss-kronrod")
-    {
+    if let crate::experiment::spec::ReferenceSpec::Converged(c) = &spec.reference {
         // Its range first: an n beyond it is refused whatever the cost limit
         // (the cost was reported first, and lifting the limit then met the
         // range).
         crate::experiment::reference::check_converged_n(c.n)?;
-        let budget = c.n.saturating_mul(60).saturating_add(15);
-        let method = Method::Rule(gk);
-        let cost: f64 = 1.5
-            * spec
-                .quantities
-                .iter()
-                .map(|&q| F::cost(scene, &method, budget, q))
-                .sum::<f64>();
-        if cost.is_nan() || cost > MAX_JOB_EVALUATIONS {
-            return Err(SpecError::at(
-                "reference.n",
-                format!(
-                    "the converged reference's first evaluations, at n = {} and {}, cost up \
-                     to about {cost:.1e} integrand evaluations: expected at most \
-                     {MAX_JOB_EVALUATIONS:.0e} (lower n, or pass --no-cost-limit to check and \
-                     run to go ahead)",
-                    c.n,
-                    2 * c.n
-                ),
-            ));
-        }
+        check_converged_cost::<F>(scene, c.n, &spec.quantities)?;
     }
     let Some(&largest) = budgets.last() else {
         return Ok(());
@@ -151,21 +123,7 @@ pub(super) fn check_cost<F: Family>(
             ));
         }
     }
-    // The whole experiment: every rule at each budget it runs, every repeat.
-    let repeats = spec.repeats as f64;
-    let (mut jobs, mut total) = (0.0, 0.0);
-    for m in &spec.rules {
-        let need = min_budget::<F>(scene, m, &spec.quantities);
-        for &b in budgets.iter().filter(|&&b| b >= need) {
-            jobs += repeats;
-            total += repeats
-                * spec
-                    .quantities
-                    .iter()
-                    .map(|&q| F::cost(scene, m, b, q))
-                    .sum::<f64>();
-        }
-    }
+    let [jobs, total] = jobs_cost(spec, scene, budgets);
     let channels: f64 = spec
         .quantities
         .iter()
@@ -204,4 +162,134 @@ pub(super) fn check_cost<F: Family>(
         ));
     }
     Ok(())
+}
+
+/// Refuses a converged reference at `n` whose first two evaluations (at
+/// `n` and `2n`, [`Family::converged_cost`]) pass the job limits, at
+/// `reference.n`: later doublings stop before passing them
+/// ([`crate::experiment::reference`]), but these two are the least the
+/// reference is. A furnace reference at n = 1e5 (Genz–Malik at n^2 a
+/// hemisphere) passed `check`, ran every job and then failed for 80 GB.
+pub(super) fn check_converged_cost<F: Family>(
+    scene: &F::Scene,
+    n: usize,
+    quantities: &[F::Quantity],
+) -> Result<(), SpecError> {
+    let [c1, b1] = F::converged_cost(scene, n, quantities);
+    let [c2, b2] = F::converged_cost(scene, n.saturating_mul(2), quantities);
+    let (cost, bytes) = (c1 + c2, b1.max(b2));
+    let lift = "lower n, or pass --no-cost-limit to check and run to go ahead";
+    if cost.is_nan() || cost > MAX_JOB_EVALUATIONS {
+        return Err(SpecError::at(
+            "reference.n",
+            format!(
+                "the converged reference's first evaluations, at n = {n} and {}, cost up to \
+                 about {cost:.1e} integrand evaluations: expected at most \
+                 {MAX_JOB_EVALUATIONS:.0e} ({lift})",
+                n.saturating_mul(2)
+            ),
+        ));
+    }
+    if bytes.is_nan() || bytes > MAX_JOB_BYTES {
+        return Err(SpecError::at(
+            "reference.n",
+            format!(
+                "the converged reference's evaluation at n = {} needs about {:.1} GB of memory: \
+                 expected at most {:.1} GB ({lift})",
+                n.saturating_mul(2),
+                bytes / 1e9,
+                MAX_JOB_BYTES / 1e9
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses an experiment whose Mitsuba comparison would evaluate lightquad's
+/// converged value ([`crate::experiment::reference::CROSSCHECK_N`]) past
+/// the job limits, at `scene`: the comparison runs where a values file
+/// made from this very file is found, whatever the file's own reference.
+pub(super) fn check_crosscheck_cost<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    hash: &str,
+    origin: &crate::experiment::source::Origin,
+) -> Result<(), SpecError> {
+    use crate::experiment::reference::{CROSSCHECK_N, compares};
+    use crate::experiment::spec::{MitsubaReference, ReferenceSpec};
+    let named = match &spec.reference {
+        ReferenceSpec::Mitsuba(MitsubaReference { file }) => Some(file.as_str()),
+        _ => None,
+    };
+    if cost_limit_lifted() || !compares(origin, &spec.name, hash, named) {
+        return Ok(());
+    }
+    let [cost, bytes] = F::converged_cost(scene, CROSSCHECK_N, &spec.quantities);
+    if cost.is_nan() || cost > MAX_JOB_EVALUATIONS || bytes.is_nan() || bytes > MAX_JOB_BYTES {
+        return Err(SpecError::at(
+            "scene",
+            format!(
+                "the Mitsuba comparison evaluates lightquad's converged value at n = \
+                 {CROSSCHECK_N}, which in this scene costs about {cost:.1e} integrand evaluations \
+                 and {:.1} GB: expected at most {MAX_JOB_EVALUATIONS:.0e} and {:.1} GB (pass \
+                 --no-cost-limit to check and run to go ahead)",
+                bytes / 1e9,
+                MAX_JOB_BYTES / 1e9
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The experiment's jobs (every rule at each budget it runs, every repeat)
+/// and their evaluations in all, by the family's estimates
+/// ([`Family::cost`]).
+pub fn jobs_cost<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    budgets: &[usize],
+) -> [f64; 2] {
+    let repeats = spec.repeats as f64;
+    let (mut jobs, mut total) = (0.0, 0.0);
+    for m in &spec.rules {
+        let need = min_budget::<F>(scene, m, &spec.quantities);
+        for &b in budgets.iter().filter(|&&b| b >= need) {
+            jobs += repeats;
+            total += repeats
+                * spec
+                    .quantities
+                    .iter()
+                    .map(|&q| F::cost(scene, m, b, q))
+                    .sum::<f64>();
+        }
+    }
+    [jobs, total]
+}
+
+/// The evaluations of the reference stage by the family's estimates: a
+/// converged reference's first two evaluations (at `n` and `2n`; later
+/// doublings stop before [`MAX_JOB_EVALUATIONS`] in all), and lightquad's
+/// value for the Mitsuba comparison where it is computed.
+pub fn reference_cost<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    compared: bool,
+) -> f64 {
+    let converged = match &spec.reference {
+        crate::experiment::spec::ReferenceSpec::Converged(c) => {
+            F::converged_cost(scene, c.n, &spec.quantities)[0]
+                + F::converged_cost(scene, c.n.saturating_mul(2), &spec.quantities)[0]
+        }
+        _ => 0.0,
+    };
+    let crosscheck = if compared {
+        F::converged_cost(
+            scene,
+            crate::experiment::reference::CROSSCHECK_N,
+            &spec.quantities,
+        )[0]
+    } else {
+        0.0
+    };
+    converged + crosscheck
 }

@@ -38,11 +38,11 @@ use crate::quadrature::Rule;
 mod cost;
 mod parse;
 
-use cost::check_cost;
+use cost::{check_cost, check_crosscheck_cost};
 
 pub use cost::{
     MAX_EXPERIMENT_EVALUATIONS, MAX_JOB_BYTES, MAX_JOB_EVALUATIONS, MAX_JOBS, MAX_RESULTS_BYTES,
-    cost_limit_lifted, lift_cost_limit,
+    cost_limit_lifted, jobs_cost, lift_cost_limit, reference_cost,
 };
 
 pub use parse::{deserialize, parse_and_load, parse_json};
@@ -117,6 +117,7 @@ pub fn validate_from<F: Family>(
     }
     check_cost::<F>(&spec, &scene, &budgets)?;
     let known = known_values::<F>(&spec, &scene, hash, &origin)?;
+    check_crosscheck_cost::<F>(&spec, &scene, hash, &origin)?;
     Ok(Experiment {
         spec,
         scene,

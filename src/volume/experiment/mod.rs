@@ -172,6 +172,44 @@ pub struct Built {
     pub field_sphere_value: Option<f64>,
 }
 
+/// Why `q` is identically 0 in `scene` because a term it integrates is not
+/// in the scene (I_L without a light, or without a medium to scatter it;
+/// I_E without emission; I_B without a background; I without any of them):
+/// every method and the reference would agree on 0, which measures nothing.
+/// None where the term is there (its value may still be 0, as with a
+/// medium of density 0).
+fn missing_term(scene: &VolumeScene, q: VolumeQuantity) -> Option<String> {
+    use VolumeQuantity::*;
+    let light = match (&scene.light, &scene.medium) {
+        (None, _) => Some("the scene has no light (add scene.light)"),
+        (Some(_), None) => Some(
+            "the scene has a light but no medium to scatter it toward the eye (add scene.medium)",
+        ),
+        _ => None,
+    };
+    let emission = scene
+        .emission
+        .is_none()
+        .then_some("the scene has no emission (add scene.emission)");
+    let background = scene
+        .background
+        .is_none()
+        .then_some("the scene has no background (add scene.background)");
+    let why = match q {
+        Light => light,
+        Emission => emission,
+        Background => background,
+        Total if light.is_some() && emission.is_some() && background.is_some() => Some(
+            "the scene has no light scattered by a medium, no emission and no background (add \
+             scene.light with scene.medium, scene.emission or scene.background)",
+        ),
+        Total | Tau | LnTau => None,
+    }?;
+    Some(format!(
+        "{why}: it would be 0 for every method and for the reference"
+    ))
+}
+
 impl Family for Volume {
     const NAME: &'static str = "volume";
     const ABOUT: &'static str =
@@ -270,6 +308,9 @@ impl Family for Volume {
     /// term alone is integrated with the integrand rescaled, and fails its
     /// job, with the reason, only where its value itself overflows.)
     fn lacks(built: &Built, q: VolumeQuantity) -> Option<String> {
+        if let Some(why) = missing_term(&built.scene, q) {
+            return Some(why);
+        }
         let (e, b, l) = term_bounds(&built.scene);
         let beyond = |x: f64| !x.is_finite();
         match q {
