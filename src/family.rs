@@ -362,7 +362,7 @@ impl std::fmt::Display for Flag {
             Flag::UnreliableEstimate => write!(f, "error estimate unreliable (rule's own check)"),
             Flag::AllWalksAlike { walks } => write!(
                 f,
-                "all {walks} walks scored alike: error is a Wilson half-width / 1.96, not a sample SE"
+                "all {walks} walks scored alike: error is a Wilson-type bound / 1.96, not a sample SE"
             ),
             Flag::AllNodesAlike { evaluations } => write!(
                 f,

@@ -108,7 +108,7 @@ impl Rule for Stratified {
     }
 
     fn about(&self) -> &'static str {
-        "stratified (jittered) Monte Carlo, one sample per cell; second-difference standard error, Student-t interval"
+        "stratified (jittered) Monte Carlo, one sample per cell; second-difference standard error, Student-t interval, conservative at few cells (an upper bound)"
     }
 
     /// Two cells per axis: the standard error compares neighbouring cells.

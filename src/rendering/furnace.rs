@@ -283,8 +283,15 @@ impl IntegratingSphere {
     /// Lambertian BRDF's own sampling, so `f_r cos / pdf = rho`) and
     /// surviving each bounce with probability `rho` (so the weight stays 1:
     /// the analog estimator, unbiased, `1/(1 - rho)` bounces a path on
-    /// average). The mean with its standard error; `evaluations` counts
-    /// bounces.
+    /// average). The mean with its standard error widened to the
+    /// Student-t interval of `paths - 1` degrees of freedom
+    /// ([`Welford::interval_error`]), doubted where the paths' scores do
+    /// not support it ([`Welford::doubtful`]: every path alike, as when 16
+    /// paths all miss an emitting cap, or a sample variance carried by a
+    /// few paths, as the geometric number of bounces at albedo 0.9 is at 16
+    /// paths); `evaluations` counts bounces. Before both, the plain
+    /// standard error covered 77.5% at 16 paths under a cap (all-missed
+    /// runs read 0 +- 0).
     pub fn path_trace<R: Rng + ?Sized>(
         &self,
         x: &Vec3,
@@ -331,11 +338,12 @@ impl IntegratingSphere {
             }
             stats.add(sum);
         }
-        Ok(Estimate::random(
-            stats.mean(),
-            stats.standard_error(),
-            bounces,
-        ))
+        let estimate = Estimate::random(stats.mean(), stats.interval_error(), bounces);
+        Ok(if stats.doubtful() {
+            estimate.doubted()
+        } else {
+            estimate
+        })
     }
 }
 

@@ -86,7 +86,7 @@ fn sphere_exact(kappa: f64, albedo: Option<f64>, q: Q) -> f64 {
     }
 }
 
-fn built(scene: VolumeScene, scheme: DepthScheme, shadow: ShadowMethod) -> Built {
+pub(crate) fn built(scene: VolumeScene, scheme: DepthScheme, shadow: ShadowMethod) -> Built {
     Built {
         scene,
         scheme,
@@ -196,7 +196,7 @@ fn delta_tracking_covers_95_percent_on_every_quantity_it_estimates() {
 
 /// Two overlapping Gaussian blobs crossed off-centre: density varies along
 /// the ray, so tracking draws null collisions.
-fn blobs() -> VolumeScene {
+pub(crate) fn blobs() -> VolumeScene {
     let medium = GaussianBlobs::new(vec![
         GaussianBlob {
             centre: Vec3::new(0.0, 0.1, 0.0),
@@ -221,7 +221,7 @@ fn blobs() -> VolumeScene {
 
 /// tau of the blob scene in closed form, and I_E with `c = k v`:
 /// `int tau k v dt = (k / lambda) int sigma tau dt = (k / lambda) (1 - tau)`.
-fn blobs_exact(q: Q) -> f64 {
+pub(crate) fn blobs_exact(q: Q) -> f64 {
     let s = blobs();
     let medium = s.medium.as_deref().expect("medium");
     let depth = s.lambda

@@ -14,6 +14,7 @@ mod common;
 
 mod anywhere;
 mod coverage;
+mod coverage_small_n;
 mod domains;
 mod estimate_honesty;
 mod family_plugin;

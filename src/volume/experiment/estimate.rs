@@ -161,7 +161,11 @@ pub(super) fn collect(
                 VolumeQuantity::Tau => {
                     let tau = measured(Term {
                         value: res.transmittance,
-                        error: transmittance_error(res.transmittance, res.optical_depth.error),
+                        error: transmittance_error(
+                            res.transmittance,
+                            res.optical_depth.error,
+                            res.optical_depth.kind,
+                        ),
                         ..res.optical_depth
                     });
                     if res.underflow {

@@ -35,12 +35,13 @@
 //!
 //! **Errors.** A tracking estimate's error is the standard error of its walks,
 //! except where that is known to mislead:
-//! - delta tracking's `tau` scores are 0 or 1: the error is the half-width
-//!   of the Wilson score interval at `z = 1.96`, divided by 1.96 (so
-//!   `value +- 1.96 error` is an interval as wide as Wilson's and the error
-//!   still reads as one standard error: it is the ordinary standard error up
-//!   to O(1/n) once `k` and `n - k` are large, and stays honest at `k = 0`
-//!   or `k = n`, where the sample standard error is 0);
+//! - delta tracking's `tau` scores are 0 or 1: the error is the standard
+//!   error of a proportion taken at the Wilson score interval's centre
+//!   (`z = 1.96`) instead of at the mean ([`wilson_error`]): the ordinary
+//!   standard error up to O(1/n) once `k` and `n - k` are large, and
+//!   honest at `k = 0` or `k = n`, where the sample standard error is 0,
+//!   and at few walks, where Wilson's half-width put around the mean
+//!   covered 86% (16 walks, `tau = 0.2`);
 //! - any estimate whose walks all scored alike (zero sample variance, which
 //!   says nothing about outcomes not yet seen) carries `W(n) D`, with
 //!   `W(n) = z / (2 (n + z^2))` the Wilson half-width at `k = 0` divided by
@@ -140,7 +141,8 @@ pub struct Tracked {
     pub value: f64,
     /// One standard error widened to the Student-t interval
     /// ([`Welford::interval_error`](crate::quadrature::monte_carlo::Welford::interval_error)), or its honest substitute (module documentation):
-    /// the Wilson half-width over 1.96 for 0/1 scores, `W(n) D` when every
+    /// the Wilson-centred standard error for 0/1 scores
+    /// ([`wilson_error`]), `W(n) D` when every
     /// walk scored alike.
     pub error: f64,
     /// Density evaluations spent (shared by every quantity of one set of walks).

@@ -17,21 +17,34 @@ fn wilson_unseen(n: u64) -> f64 {
     Z / (2.0 * (n + Z * Z))
 }
 
-/// The error of `k` successes in `n` 0/1 trials: the half-width of the
-/// Wilson score interval, `z/(n + z^2) sqrt(k (n - k)/n + z^2/4)`, divided
-/// by `z`. Up to O(1/n) it is the standard error `sqrt(p (1 - p) / n)` once
-/// `k` and `n - k` are large; at `k = 0` or `k = n` it is `W(n)`, not 0.
-/// `k > n` or `n = 0` is an error.
+/// The error of `k` successes in `n` 0/1 trials, read around `p = k / n`:
+/// the standard error of a proportion taken at Wilson's centre instead of
+/// at `p`,
+///
+/// ```text
+/// error = sqrt(c (1 - c) / (n - 1)),   c = (k + z^2/2) / (n + z^2),
+/// ```
+///
+/// the ordinary standard error up to O(1/n) once `k` and `n - k` are large,
+/// and not 0 at `k = 0` or `k = n` (about `1.39 / n` there). Exact binomial
+/// sums over the runs with `0 < k < n` (those at 0 or `n` are flagged as
+/// all alike) give the coverage of `p +- 1.96 error` at 92-100% at 16
+/// trials and 93-96% at 256 for success rates from 0.03 to 0.5 (at 16 the
+/// runs of a small rate with `k >= 1` cover more by construction); Wilson's
+/// half-width around `p` (the interval centred at `c`, read around `p`)
+/// covered 86-88% at 16 trials for rates 0.2 to 0.4. `k > n`, `n < 2`
+/// are errors.
 pub fn wilson_error(k: u64, n: u64) -> Result<f64, QuadError> {
-    if n == 0 || k > n {
+    if n < 2 || k > n {
         return Err(QuadError::invalid(
             "k",
             format!("{k} of n = {n}"),
-            "0 <= k <= n successes of n >= 1 trials",
+            "0 <= k <= n successes of n >= 2 trials",
         ));
     }
     let (k, n) = (k as f64, n as f64);
-    Ok((k * (n - k) / n + 0.25 * Z * Z).sqrt() / (n + Z * Z))
+    let centre = (k + 0.5 * Z * Z) / (n + Z * Z);
+    Ok((centre * (1.0 - centre) / (n - 1.0)).sqrt())
 }
 
 /// How the non-zero scores `w_i` share their sum: their effective number
@@ -151,7 +164,7 @@ impl Scores {
         let k = ((x * n as f64).round() as u64).min(n);
         Tracked {
             value: x,
-            error: wilson_error(k, n.max(1)).unwrap_or(f64::INFINITY),
+            error: wilson_error(k, n).unwrap_or(f64::INFINITY),
             evaluations,
             walks: n,
             all_alike: self.alike,
