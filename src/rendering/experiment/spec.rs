@@ -619,6 +619,12 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         let at = format!("scene.occluders[{j}]");
         let o = occluder(o_spec).map_err(|err| SpecError::from_quad(&at, err))?;
         bounded(&at, &o, &occluder_numbers(o_spec))?;
+        warnings.extend(super::doubts::occluder_doubts(
+            j,
+            &o,
+            &emitters,
+            receiver.point(),
+        ));
         occluders.push(o);
     }
     Ok(Built {
