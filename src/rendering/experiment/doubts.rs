@@ -1,8 +1,10 @@
-//! Warnings about occluders that run but may not be what was meant, each
-//! at the occluder's JSON path (`scene.occluders[j]`):
+//! Warnings about occluders and lights that run but may not be what was
+//! meant, each at the JSON path of the shape (`scene.occluders[j]`,
+//! `scene.emitters[i]`):
 //!
-//! | case | what every form gives |
+//! | case | what the forms give |
 //! |---|---|
+//! | a flat light more than `1/eps` times as large as its plane's distance from the receiver | R-A's integrand is a peak narrower than f64's spacing in the light's map: its rules are far off (the cone and hemisphere forms and the reference are not) |
 //! | the receiver strictly inside a sphere occluder | 0 from every light outside the sphere |
 //! | a planar occluder in the plane of a planar light, over it | that light unblocked: an occluder blocks only what lies strictly behind it |
 //! | a planar occluder whose plane passes the receiver within f64's rounding at its coordinates | whether it is in front of the receiver is rounding's choice |
@@ -12,6 +14,34 @@ use crate::error::SpecError;
 use crate::rendering::emitter::{AnyEmitter, Emitter};
 use crate::rendering::occluder::Occluder;
 use crate::whitted::intersect::gamma;
+
+/// The ratio of a light's size to its distance, beyond which R-A's peak
+/// (about `distance / size` of the map wide) is narrower than f64 resolves
+/// in map coordinates near 1: `1 / eps`.
+pub const AREA_FORM_RATIO: f64 = 1.0 / f64::EPSILON;
+
+/// The warning about emitter `i`, `e`, for a receiver at `x`: a flat light
+/// whose size (its bounding sphere's diameter) is more than
+/// [`AREA_FORM_RATIO`] times the distance of its plane from `x`.
+pub(super) fn emitter_doubt(i: usize, e: &AnyEmitter<f64>, x: Vec3) -> Option<SpecError> {
+    let body = e.occluder()?;
+    let (p, n) = plane(&body)?;
+    let (_, r) = body.bounding_sphere();
+    let distance = n.dot(&(p - x)).abs();
+    let ratio = 2.0 * r / distance;
+    (distance > 0.0 && ratio > AREA_FORM_RATIO).then(|| {
+        SpecError::at(
+            format!("scene.emitters[{i}]"),
+            format!(
+                "is {ratio:.1e} times as large as its plane's distance from the receiver \
+                 ({distance:e}), more than {AREA_FORM_RATIO:.1e}: the area form's integrand is a \
+                 peak narrower than f64 resolves in the light's map, so the rules on E_area and \
+                 L_area are far off whatever the budget (the cone and hemisphere forms and the \
+                 reference are not; shrink the light to measure the area form)"
+            ),
+        )
+    })
+}
 
 /// The warnings about occluder `j`, `o`, among `emitters`, for a receiver
 /// at `x`.

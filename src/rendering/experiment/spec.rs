@@ -612,6 +612,7 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         if let Some(w) = facing_away(&at, &e, &receiver) {
             warnings.push(w);
         }
+        warnings.extend(super::doubts::emitter_doubt(i, &e, receiver.point()));
         emitters.push(e);
     }
     let mut occluders = Vec::with_capacity(spec.occluders.len());
