@@ -397,6 +397,37 @@ pub fn hidden_by_arcs<K: Kernel>(
     Ok(Some(total))
 }
 
+/// True when the receiver `x` is strictly inside a sphere occluder that
+/// emitter `e` lies wholly outside of (or `e` is at infinity): every ray
+/// from `x` toward `e` leaves through the sphere first, so `e` adds exactly
+/// 0. Strictly: `R - |x - c| > gamma_8 (R + |x - c|)`, and for a finite
+/// emitter `max(|c_e - c| - r_e, d_plane) > R` with `(c_e, r_e)` its
+/// bounding sphere and `d_plane` the distance of `c` from a planar light's
+/// plane.
+pub fn enclosed(scene: &Scene<f64>, x: Vec3, e: &AnyEmitter<f64>) -> bool {
+    // A lower bound on the distance of the light from `c`: its bounding
+    // sphere's gap, and for a planar light the distance to its plane.
+    let outside = |c: Vec3, r: f64| match e.occluder() {
+        None => true,
+        Some(body) => {
+            let (ce, re) = body.bounding_sphere();
+            let plane = match body {
+                Occluder::Sphere(_) => 0.0,
+                _ => body.normal_at(ce).dot(&(ce - c)).abs(),
+            };
+            ((ce - c).norm() - re).max(plane) > r
+        }
+    };
+    scene.occluders().iter().any(|o| match o {
+        Occluder::Sphere(s) => {
+            let d = (x - s.centre).norm();
+            s.radius - d > crate::whitted::intersect::gamma(8) * (s.radius + d)
+                && outside(s.centre, s.radius)
+        }
+        _ => false,
+    })
+}
+
 /// [`hidden_by_arcs`]' term of `blocker`, less the directions of `before`.
 fn hidden_by<K: Kernel>(
     receiver: &Receiver,

@@ -12,7 +12,17 @@
 //! | triangle | the watertight test of Woop, Benthin and Wald (JCGT 2(1), 2013): edge functions in a ray-aligned shear frame, so that a ray through a shared edge or vertex of two triangles hits at least one of them |
 //!
 //! Every routine returns the smallest `t` in the open interval `(t_min,
-//! t_max)` along a unit direction, both faces counted, or `None`.
+//! t_max)` along a unit direction, both faces counted, or `None`. A hit
+//! counts only where it lies in the interval beyond the rounding of `t`
+//! itself ([`plane_t`], [`sphere_rounding`]): `t - err > t_min` and `t + err
+//! < t_max`. So a surface through the ray's origin (a receiver on a floor)
+//! or through the far end (an occluder in the plane of a light, a shadow
+//! ray's end point) is not met by rounding, while a surface `1e-12` in
+//! front of the origin, where `t` is known to a few ulps, is. No offset
+//! proportional to the scene's size is needed (a fixed `1e-10` of it hid
+//! everything within `1e-10` of the receiver, and everything at all where
+//! one edge was `1e23` long). The bounds use Higham's `gamma_k = k u / (1 -
+//! k u)` ([`crate::whitted::intersect::gamma`]).
 //!
 //! ```
 //! use lightquad::domain::Vec3;
@@ -35,6 +45,7 @@
 use crate::domain::{Disk, Rectangle, Triangle, Vec3};
 use crate::error::QuadError;
 use crate::geometry::Sphere;
+use crate::whitted::intersect::gamma;
 
 /// An opaque surface that blocks light.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -137,12 +148,40 @@ impl Occluder {
     }
 }
 
-/// `t` if it lies in `(t_min, t_max)`.
-fn in_range(t: f64, t_min: f64, t_max: f64) -> Option<f64> {
-    (t > t_min && t < t_max).then_some(t)
+/// `t` if it lies in `(t_min, t_max)` beyond its rounding bound `err`.
+fn certain(t: f64, err: f64, t_min: f64, t_max: f64) -> Option<f64> {
+    (t - err > t_min && t + err < t_max).then_some(t)
 }
 
-/// The nearer of the two roots of [`Sphere::line_roots`] in `(t_min, t_max)`.
+/// Where `o + t d` meets the plane through `p0` with unit normal `n`, with
+/// a bound on the rounding of `t`:
+///
+/// `t = n . (p0 - o) / (n . d)`,
+/// `err = (gamma_8 |n| . |p0 - o| + gamma_6 |t| |n| . |d|) / |n . d|`
+///
+/// (the difference, the dot products and the normal's own rounding in the
+/// numerator, the denominator's relative error carried to `t`). `None` for
+/// a ray parallel to the plane or a non-finite `t`.
+pub fn plane_t(n: Vec3, p0: Vec3, o: Vec3, d: Vec3) -> Option<(f64, f64)> {
+    let denom = n.dot(&d);
+    let to_plane = p0 - o;
+    let t = n.dot(&to_plane) / denom;
+    if denom == 0.0 || !t.is_finite() {
+        return None;
+    }
+    let (an, ad) = (n.abs(), d.abs());
+    let err = (gamma(8) * an.dot(&to_plane.abs()) + gamma(6) * t.abs() * an.dot(&ad)) / denom.abs();
+    Some((t, err))
+}
+
+/// The rounding bound of [`Sphere::line_roots`]'s roots for a line from
+/// `o`: `gamma_16 (|o - c| + R)`.
+pub fn sphere_rounding(s: &Sphere, o: Vec3) -> f64 {
+    gamma(16) * ((o - s.centre).norm() + s.radius)
+}
+
+/// The nearer of the two roots of [`Sphere::line_roots`] in `(t_min, t_max)`
+/// beyond their rounding ([`sphere_rounding`]).
 pub fn intersect_sphere(
     s: &Sphere,
     origin: Vec3,
@@ -151,25 +190,22 @@ pub fn intersect_sphere(
     t_max: f64,
 ) -> Option<f64> {
     let (t0, t1) = s.line_roots(origin, dir)?;
-    in_range(t0, t_min, t_max).or_else(|| in_range(t1, t_min, t_max))
+    let err = sphere_rounding(s, origin);
+    certain(t0, err, t_min, t_max).or_else(|| certain(t1, err, t_min, t_max))
 }
 
-/// `t = n . (c - o) / (n . d)`, then `|o + t d - c|^2 <= R^2`.
+/// The plane's `t` ([`plane_t`]), then `|o + t d - c|^2 <= R^2`.
 pub fn intersect_disk(d: &Disk, origin: Vec3, dir: Vec3, t_min: f64, t_max: f64) -> Option<f64> {
-    let n = d.frame().n;
-    let denom = n.dot(&dir);
-    if denom == 0.0 {
-        return None;
-    }
-    let to_centre = d.centre() - origin;
-    let t = in_range(n.dot(&to_centre) / denom, t_min, t_max)?;
-    let q = dir * t - to_centre;
+    let (t, err) = plane_t(d.frame().n, d.centre(), origin, dir)?;
+    let t = certain(t, err, t_min, t_max)?;
+    let q = dir * t - (d.centre() - origin);
     (q.norm_squared() <= d.radius() * d.radius()).then_some(t)
 }
 
-/// Möller–Trumbore on a parallelogram: with `P = d x e_2`, `det = e_1 .
-/// P`, `T = o - origin_of_patch`, `Q = T x e_1`: `a = T . P / det`, `b = d .
-/// Q / det`, `t = e_2 . Q / det`; a hit when `a, b` are in `[0, 1]`.
+/// Möller–Trumbore's coordinates on a parallelogram: with `P = d x e_2`,
+/// `det = e_1 . P`, `T = o - origin_of_patch`, `Q = T x e_1`: `a = T . P /
+/// det`, `b = d . Q / det`, a hit when `a, b` are in `[0, 1]`; `t` from the
+/// plane with its rounding bound ([`plane_t`]).
 pub fn intersect_parallelogram(
     r: &Rectangle,
     origin: Vec3,
@@ -194,7 +230,8 @@ pub fn intersect_parallelogram(
     if !(0.0..=1.0).contains(&b) {
         return None;
     }
-    in_range(e2.dot(&q) * inv, t_min, t_max)
+    let (t, err) = plane_t(r.normal(), r.origin(), origin, dir)?;
+    certain(t, err, t_min, t_max)
 }
 
 /// The watertight ray–triangle test (Woop, Benthin, Wald, "Watertight
@@ -203,8 +240,8 @@ pub fn intersect_parallelogram(
 /// largest component of `d`, `S = (d_x/d_z, d_y/d_z, 1/d_z)`); the edge
 /// functions `U = C_x B_y - C_y B_x`, `V = A_x C_y - A_y C_x`, `W = B_x A_y
 /// - B_y A_x` of the sheared 2-D vertices decide the hit (all of one sign;
-/// an edge exactly through the ray counts for both triangles sharing it),
-/// and `t = (U A_z + V B_z + W C_z) / (U + V + W)`.
+/// an edge exactly through the ray counts for both triangles sharing it);
+/// `t` from the triangle's plane with its rounding bound ([`plane_t`]).
 pub fn intersect_triangle(
     tri: &Triangle,
     origin: Vec3,
@@ -221,12 +258,11 @@ pub fn intersect_triangle(
     }
     let sx = dir[kx] / dir[kz];
     let sy = dir[ky] / dir[kz];
-    let sz = 1.0 / dir[kz];
     let [a, b, c] = tri.vertices().map(|v| v - origin);
-    let shear = |v: Vec3| (v[kx] - sx * v[kz], v[ky] - sy * v[kz], sz * v[kz]);
-    let (ax, ay, az) = shear(a);
-    let (bx, by, bz) = shear(b);
-    let (cx, cy, cz) = shear(c);
+    let shear = |v: Vec3| (v[kx] - sx * v[kz], v[ky] - sy * v[kz]);
+    let (ax, ay) = shear(a);
+    let (bx, by) = shear(b);
+    let (cx, cy) = shear(c);
     let u = cx * by - cy * bx;
     let v = ax * cy - ay * cx;
     let w = bx * ay - by * ax;
@@ -237,5 +273,6 @@ pub fn intersect_triangle(
     if det == 0.0 || !det.is_finite() {
         return None;
     }
-    in_range((u * az + v * bz + w * cz) / det, t_min, t_max)
+    let (t, err) = plane_t(tri.normal(), tri.vertices()[0], origin, dir)?;
+    certain(t, err, t_min, t_max)
 }

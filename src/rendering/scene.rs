@@ -8,16 +8,18 @@
 //! hidden by it; the back of a one-sided light is dark and opaque). Lights
 //! at infinity block nothing and add up.
 //!
-//! **Offsets.** A ray from a point on a surface of the scene (a receiver
-//! on a floor that is also an occluder) can meet that surface again at a
-//! rounding-sized `t`; a shadow ray toward a point `y` on a light can meet
-//! the light at `t ~ |y - x|`. Hits count only in `(delta, |y - x| -
-//! delta)` with `delta = SHADOW_OFFSET (s + |x|_inf)`, `s` the largest
-//! coordinate of any surface of the scene ([`Occluder::extent`]), and the
-//! light that `y` lies on is not tested. `SHADOW_OFFSET = 1e-10` covers the
-//! rounding of a plane intersection (`~eps s / cos`) down to grazing angles
-//! of about `1e-5` rad; the price is that a blocker within `delta` of either
-//! end of a shadow ray is not seen.
+//! **Offsets.** The receiver `x` is exact (it is given, not computed), so
+//! a ray from it needs no offset: the intersection routines count a hit
+//! only beyond the rounding bound of its own `t`
+//! ([`crate::rendering::occluder`]), so a surface through `x` (a receiver
+//! on a floor that is also an occluder) is not met, and one `1e-12` above it
+//! is. A shadow ray toward a point `y` on a light (computed, so off the
+//! light by its rounding) ends `delta = gamma_8 (|x|_inf + |y|_inf) +
+//! gamma_4 |y - x|` short of it, and the light that `y` lies on is not
+//! tested. A surface in the plane of a light, over it, is not in front of
+//! it: it does not block it in any form (R-A's shadow ray stops short of
+//! it; along a ray of R-H the light is what is seen where the two are met
+//! at the same `t` within [`TIE`] of it), and the family warns of it.
 //!
 //! ```
 //! use lightquad::domain::Vec3;
@@ -40,9 +42,18 @@ use crate::domain::Vec3;
 use crate::rendering::emitter::{AnyEmitter, Emitter};
 use crate::rendering::occluder::Occluder;
 use crate::value::Value;
+use crate::whitted::intersect::gamma;
 
-/// The relative offset of shadow and incident rays (module documentation).
-pub const SHADOW_OFFSET: f64 = 1e-10;
+/// True when the first hit so far is an occluder.
+fn best_is_occluder<V: Value>(best: &FirstHit<V>) -> bool {
+    matches!(best, FirstHit::Occluder { .. })
+}
+
+/// The relative distance within which an emitter and an occluder met by
+/// one ray are at the same place (module documentation): `64 eps` of the
+/// distance and of the origin's coordinates, the rounding of two plane
+/// intersections at angles down to about `1e-2` rad from grazing.
+pub const TIE: f64 = 64.0 * f64::EPSILON;
 
 /// What a ray meets first among the finite surfaces.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,23 +81,25 @@ pub enum FirstHit<V: Value> {
 pub struct Scene<V: Value> {
     emitters: Vec<AnyEmitter<V>>,
     occluders: Vec<Occluder>,
-    /// The largest coordinate of any finite surface (for the offsets).
-    scale: f64,
 }
 
 impl<V: Value> Scene<V> {
     /// The scene of `emitters` and `occluders` (each validated when built).
     pub fn new(emitters: Vec<AnyEmitter<V>>, occluders: Vec<Occluder>) -> Self {
-        let scale = emitters
-            .iter()
-            .filter_map(|e| e.occluder())
-            .chain(occluders.iter().copied())
-            .fold(0.0_f64, |m, o| m.max(o.extent()));
         Scene {
             emitters,
             occluders,
-            scale,
         }
+    }
+
+    /// The same scene with emitter `k`'s radiance set to `radiance` (its
+    /// shape, and so what it blocks, unchanged).
+    pub fn with_radiance(&self, k: usize, radiance: V) -> Self {
+        let mut emitters = self.emitters.clone();
+        if let Some(e) = emitters.get_mut(k) {
+            *e = e.with_radiance(radiance);
+        }
+        Scene::new(emitters, self.occluders.clone())
     }
 
     /// The emitters.
@@ -99,9 +112,11 @@ impl<V: Value> Scene<V> {
         &self.occluders
     }
 
-    /// The offset `delta` of rays from `x` (and toward `y`).
+    /// The offset `delta = gamma_8 (|x|_inf + |y|_inf) + gamma_4 |y - x|`
+    /// at which a shadow ray from `x` stops short of the computed point `y`
+    /// (module documentation).
     fn offset(&self, x: Vec3, y: Vec3) -> f64 {
-        SHADOW_OFFSET * (self.scale + x.amax().max(y.amax()))
+        gamma(8) * (x.amax() + y.amax()) + gamma(4) * (y - x).norm()
     }
 
     /// True when some surface can stand between a receiver and emitter
@@ -132,10 +147,11 @@ impl<V: Value> Scene<V> {
                 .any(|(i, e)| Some(i) != skip && e.occluder().is_some())
     }
 
-    /// The offset `delta` below which a ray from `x` ignores hits (module
-    /// documentation).
-    pub fn ray_offset(&self, x: Vec3) -> f64 {
-        self.offset(x, x)
+    /// The offset below which a ray from the exact point `x` ignores hits:
+    /// none, for the intersections count only hits beyond their own rounding
+    /// (module documentation).
+    pub fn ray_offset(&self, _x: Vec3) -> f64 {
+        0.0
     }
 
     /// True when some blocker (every occluder, every finite emitter but
@@ -151,28 +167,29 @@ impl<V: Value> Scene<V> {
             })
     }
 
-    /// R-A's visibility `V(p, q)`: 1 when no occluder and no finite emitter
-    /// but `skip` (the one `q` lies on) meets the open segment between them,
-    /// shortened by the offset at each end.
+    /// R-A's visibility `V(p, q)` from the receiver `p` (exact): 1 when no
+    /// occluder and no finite emitter but `skip` (the one `q` lies on) meets
+    /// the open segment between them, shortened by the offset at `q`.
     pub fn visible(&self, p: Vec3, q: Vec3, skip: Option<usize>) -> bool {
         let d = q - p;
         let len = d.norm();
         let delta = self.offset(p, q);
-        if len <= 2.0 * delta || len.is_nan() {
+        if len <= delta || len.is_nan() {
             return true;
         }
-        !self.blocked(p, d / len, delta, len - delta, skip)
+        // From the exact receiver `p` no offset; short of the computed `q`.
+        !self.blocked(p, d / len, 0.0, len - delta, skip)
     }
 
     /// Visibility of the lights at infinity from `x` along the unit `w`: no
     /// finite surface beyond the offset.
     pub fn visible_to_infinity(&self, x: Vec3, w: Vec3) -> bool {
-        !self.blocked(x, w, self.offset(x, x), f64::INFINITY, None)
+        !self.blocked(x, w, self.ray_offset(x), f64::INFINITY, None)
     }
 
     /// The first finite surface along `x + t w`, `t` beyond the offset.
     pub fn first_hit(&self, x: Vec3, w: Vec3) -> FirstHit<V> {
-        let t_min = self.offset(x, x);
+        let t_min = self.ray_offset(x);
         let mut best = FirstHit::Escaped;
         let mut nearest = f64::INFINITY;
         for o in &self.occluders {
@@ -185,8 +202,11 @@ impl<V: Value> Scene<V> {
             if e.at_infinity() {
                 continue;
             }
+            // An emitter met where the nearest occluder is (within TIE) is
+            // the one seen: an occluder in its plane does not block it.
+            let tie = TIE * (nearest + x.amax());
             if let Some(h) = e.hit(x, w, t_min)
-                && h.distance < nearest
+                && (h.distance < nearest || h.distance <= nearest + tie && best_is_occluder(&best))
             {
                 nearest = h.distance;
                 best = FirstHit::Emitter {

@@ -35,6 +35,7 @@ mod rendering_contour;
 mod rendering_convergence;
 mod rendering_emitters;
 mod rendering_exact;
+mod rendering_extreme;
 mod rendering_family;
 mod rendering_forms;
 mod rendering_furnace;

@@ -19,6 +19,13 @@ pub struct DiskLight<V: Value> {
 }
 
 impl<V: Value> DiskLight<V> {
+    /// The same light with radiance `radiance` (for the converged
+    /// reference, which evaluates each light at radiance 1 and scales: `E`
+    /// is linear in `L_e`).
+    pub(crate) fn with_radiance(self, radiance: V) -> Self {
+        Self { radiance, ..self }
+    }
+
     /// The disk about `centre` with normal `normal` (the emitting side) and
     /// radius `radius`, of radiance `radiance` (finite, `>= 0`).
     pub fn new(centre: Vec3, normal: Vec3, radius: f64, radiance: V) -> Result<Self, QuadError> {

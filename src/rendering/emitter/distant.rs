@@ -23,6 +23,13 @@ pub struct EnvironmentLight<V: Value> {
 }
 
 impl<V: Value> EnvironmentLight<V> {
+    /// The same light with radiance `radiance` (for the converged
+    /// reference, which evaluates each light at radiance 1 and scales: `E`
+    /// is linear in `L_e`).
+    pub(crate) fn with_radiance(self, radiance: V) -> Self {
+        Self { radiance }
+    }
+
     /// The environment of radiance `radiance` (finite, `>= 0`).
     pub fn new(radiance: V) -> Result<Self, QuadError> {
         Ok(EnvironmentLight {
@@ -77,6 +84,13 @@ pub struct CapLight<V: Value> {
 }
 
 impl<V: Value> CapLight<V> {
+    /// The same light with radiance `radiance` (for the converged
+    /// reference, which evaluates each light at radiance 1 and scales: `E`
+    /// is linear in `L_e`).
+    pub(crate) fn with_radiance(self, radiance: V) -> Self {
+        Self { radiance, ..self }
+    }
+
     /// The light of half-angle `half_angle` in `(0, pi]` about `axis`
     /// (finite, non-zero), `1 - cos alpha = 2 sin^2(alpha / 2)` without
     /// cancellation.

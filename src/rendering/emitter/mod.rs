@@ -374,6 +374,21 @@ pub enum AnyEmitter<V: Value> {
     Cap(CapLight<V>),
 }
 
+impl<V: Value> AnyEmitter<V> {
+    /// The same emitter with radiance `radiance` (the converged reference
+    /// evaluates each light at radiance 1 and scales the value by its own).
+    pub(crate) fn with_radiance(self, radiance: V) -> Self {
+        match self {
+            AnyEmitter::Rectangle(e) => AnyEmitter::Rectangle(e.with_radiance(radiance)),
+            AnyEmitter::Disk(e) => AnyEmitter::Disk(e.with_radiance(radiance)),
+            AnyEmitter::Triangle(e) => AnyEmitter::Triangle(e.with_radiance(radiance)),
+            AnyEmitter::Sphere(e) => AnyEmitter::Sphere(e.with_radiance(radiance)),
+            AnyEmitter::Environment(e) => AnyEmitter::Environment(e.with_radiance(radiance)),
+            AnyEmitter::Cap(e) => AnyEmitter::Cap(e.with_radiance(radiance)),
+        }
+    }
+}
+
 /// Forwards a method of [`Emitter`] to the variant's type.
 macro_rules! forward {
     ($self:ident, $e:ident => $call:expr) => {

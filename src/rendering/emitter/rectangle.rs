@@ -18,6 +18,13 @@ pub struct RectangleLight<V: Value> {
 }
 
 impl<V: Value> RectangleLight<V> {
+    /// The same light with radiance `radiance` (for the converged
+    /// reference, which evaluates each light at radiance 1 and scales: `E`
+    /// is linear in `L_e`).
+    pub(crate) fn with_radiance(self, radiance: V) -> Self {
+        Self { radiance, ..self }
+    }
+
     /// The light at `origin` spanned by `edge_u`, `edge_v` (finite, not
     /// parallel) of radiance `radiance` (finite, `>= 0`).
     pub fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3, radiance: V) -> Result<Self, QuadError> {

@@ -28,6 +28,13 @@ pub struct SphereLight<V: Value> {
 }
 
 impl<V: Value> SphereLight<V> {
+    /// The same light with radiance `radiance` (for the converged
+    /// reference, which evaluates each light at radiance 1 and scales: `E`
+    /// is linear in `L_e`).
+    pub(crate) fn with_radiance(self, radiance: V) -> Self {
+        Self { radiance, ..self }
+    }
+
     /// The sphere about `centre` (finite) of radius `radius` (finite, `> 0`)
     /// of radiance `radiance`.
     pub fn new(centre: Vec3, radius: f64, radiance: V) -> Result<Self, QuadError> {

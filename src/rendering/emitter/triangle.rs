@@ -18,6 +18,13 @@ pub struct TriangleLight<V: Value> {
 }
 
 impl<V: Value> TriangleLight<V> {
+    /// The same light with radiance `radiance` (for the converged
+    /// reference, which evaluates each light at radiance 1 and scales: `E`
+    /// is linear in `L_e`).
+    pub(crate) fn with_radiance(self, radiance: V) -> Self {
+        Self { radiance, ..self }
+    }
+
     /// The triangle `abc` (finite, non-degenerate) of radiance `radiance`.
     pub fn new(a: Vec3, b: Vec3, c: Vec3, radiance: V) -> Result<Self, QuadError> {
         Ok(TriangleLight {

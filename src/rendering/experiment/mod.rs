@@ -127,6 +127,7 @@ use crate::domain::Vec3;
 use crate::error::{QuadError, SpecError};
 use crate::family::{self, Family, Measured, Method, Outcome};
 
+mod doubts;
 mod evaluate;
 mod reference;
 mod spec;
@@ -441,9 +442,17 @@ impl Family for Rendering {
     fn cost(built: &Built, method: &Method<Mis>, budget: usize, q: RenderingQuantity) -> f64 {
         let n = budget as f64;
         let emitters = built.scene.emitters().len() as f64;
-        // Each sample's shadow ray tests every occluder (100 000 triangles
-        // made a sample about 1 ms).
-        let visibility = 1.0 + built.scene.occluders().len() as f64;
+        // Each sample's shadow ray tests every occluder and every finite
+        // emitter (100 000 triangles made a sample about 1 ms; 100 000
+        // sphere lights ran without a bound, each of their cone forms' rays
+        // testing the other lights).
+        let finite = built
+            .scene
+            .emitters()
+            .iter()
+            .filter(|e| !super::emitter::Emitter::at_infinity(*e))
+            .count();
+        let visibility = 1.0 + (built.scene.occluders().len() + finite) as f64;
         visibility
             * match (method, q.form()) {
                 (Method::Estimator(_), _) => 2.0 * n,

@@ -88,129 +88,199 @@ fn converged_by_emitter<K: Kernel>(
     let (scene, receiver) = (&built.scene, &built.receiver);
     let mut total = Estimate::zero();
     for (k, e) in scene.emitters().iter().enumerate() {
-        // Under a peaked lobe the lit polygons' area integrand holds the
-        // lobe's peak where the lobe is narrower than them; the blockers'
-        // exact arcs with adaptive pieces resolve it instead.
-        let lit = match lobe {
-            None => lit_triangles(scene, receiver.point(), k),
-            Some(_) => None,
+        // A dark light adds exactly nothing, nor does one the receiver is
+        // shut off from; the others are evaluated at radiance 1 and scaled
+        // (E is linear in L_e), so that the relative tolerance is never
+        // relative to a subnormal value that rounding cannot meet (a sky
+        // of radiance 1e-320 kept the rule refining for over 300 s).
+        let radiance = e.radiance();
+        if radiance == 0.0 || blocked::enclosed(scene, receiver.point(), e) {
+            continue;
+        }
+        let unit = Built {
+            scene: scene.with_radiance(k, 1.0),
+            ..built.clone()
         };
-        // Where something can stand in the way and the shadow boundaries are
-        // not computed, the light is taken with nothing in the way, and what
-        // each blocker hides is subtracted over the blocker's own cone (an
-        // adaptive rule over the light's domain can miss a small blocker:
-        // crate::rendering::blocked).
-        let split = lit.is_none() && scene.has_blockers(Some(k));
-        let along = || {
-            let free = blocked::unblocked(e, receiver, kernel);
-            let seen = forms::cone_integrand(scene, receiver, kernel, k);
-            move |w: Vec3| if split { free(w) } else { seen(w) }
-        };
-        let by_lobe = |lobe: &Reflected<'_, AnyBrdf>, rng: &mut rand_pcg::Pcg64| {
-            integrate_over(&rule, &BrdfSampled::new(*lobe), budget, rng, along())
-        };
-        let part = match (e, lobe) {
-            // Under a peaked lobe the environment's integrand is the lobe:
-            // smooth in the BRDF's own map, but for the horizon where it
-            // cuts the lobe; a Phong lobe is split there (clipped.rs), the
-            // two checked against each other.
-            (AnyEmitter::Environment(_), Some(lobe)) => match phong_cone(built)? {
-                Some(pieces) => {
-                    let mut sum = Estimate::zero();
-                    for piece in &pieces {
-                        sum = sum.combine(integrate_over(&rule, piece, budget, &mut rng, along())?);
-                    }
-                    cross_checked(sum, by_lobe(lobe, &mut rng)?)
-                }
-                None => by_lobe(lobe, &mut rng)?,
-            },
-            _ => {
-                let own = if exact_cone(e, receiver) && lobe.is_none() {
-                    // A flat kernel over an exact cone: exact pieces (a rule
-                    // over the cone ends at one box and cannot vouch for it).
-                    blocked::over_cone(receiver, kernel, e, &e.cone(receiver)?)?
-                } else if exact_cone(e, receiver) {
-                    integrate_over(&rule, &e.cone(receiver)?, budget, &mut rng, along())?
-                } else if crosses(e, receiver, kernel)
-                    && (split || !scene.has_blockers(Some(k)))
-                    && let Some(own) = blocked::over_shape(receiver, kernel, e)?
-                {
-                    // Cut where the horizon or the lobe's clamp crosses the
-                    // light: over its surface the integrand kinks there.
-                    own
-                } else if let Some(lit) = &lit {
-                    // Split at the shadow boundaries: smooth on every piece.
-                    let g = forms::area_integrand_with(scene, receiver, kernel, k, |_| true)?;
-                    let per = (budget / lit.len().max(1)).max(rule.min_budget(2));
-                    let mut sum = Estimate::zero();
-                    for t in lit {
-                        sum = sum.combine(integrate_over(&rule, t, per, &mut rng, &g)?);
-                    }
-                    sum
-                } else if split {
-                    let g = forms::area_integrand_with(scene, receiver, kernel, k, |_| true)?;
-                    integrate_over(&rule, &e.surface(receiver)?, budget, &mut rng, g)?
-                } else {
-                    let g = forms::area_integrand(scene, receiver, kernel, k)?;
-                    integrate_over(&rule, &e.surface(receiver)?, budget, &mut rng, g)?
-                };
-                match lobe {
-                    // A lobe narrower than the light is smooth in the BRDF's
-                    // map and a peak in the light's; one crossing the
-                    // light's outline the other way round: both, the one
-                    // with the smaller error kept, checked by the other.
-                    Some(lobe) => cross_checked(own, by_lobe(lobe, &mut rng)?),
-                    None => own,
-                }
-            }
-        };
-        let part = if split {
-            // Where each blocker is wholly in front of the light or behind
-            // it, piece by piece between the exact outlines; else over each
-            // blocker's domain with a visibility test, trusted only where
-            // nothing cuts it.
-            let exact = blocked::hidden_by_arcs(scene, receiver, kernel, k)?;
-            let mut hidden = exact.unwrap_or_else(Estimate::zero);
-            let fallback = if exact.is_some() {
-                Vec::new()
-            } else {
-                blocked::blockers(scene, k)
-            };
-            for (j, o) in fallback.iter().enumerate() {
-                let h = blocked::hidden(scene, receiver, kernel, k, j)?;
-                let domain = blocked::domain(o, receiver.point())?;
-                let own = integrate_over(&rule, &domain, budget, &mut rng, &h)?;
-                let checked = match lobe {
-                    Some(lobe) => cross_checked(
-                        own,
-                        integrate_over(
-                            &rule,
-                            &BrdfSampled::new(*lobe),
-                            budget,
-                            &mut rng,
-                            blocked::hidden_along(scene, receiver, kernel, k, j)?,
-                        )?,
-                    ),
-                    None => own,
-                };
-                // Outlines, the horizon or other blockers crossing the
-                // domain make the evaluation's own error estimate unsafe.
-                let trusted = blocked::smooth(scene, receiver, k, j);
-                hidden = hidden.combine(Estimate {
-                    reliable: checked.reliable && trusted,
-                    ..checked
-                });
-            }
-            part.combine(Estimate {
-                value: -hidden.value,
-                ..hidden
-            })
-        } else {
-            part
-        };
-        total = total.combine(part);
+        let part = emitter_term(&unit, kernel, lobe, budget, k, &rule, &mut rng)?;
+        total = total.combine(Estimate {
+            value: part.value * radiance,
+            error: part.error * radiance,
+            ..part
+        });
     }
     Ok(total)
+}
+
+/// Emitter `k`'s term of the converged value, in `built`'s scene (module
+/// documentation).
+fn emitter_term<K: Kernel>(
+    built: &Built,
+    kernel: &K,
+    lobe: Option<&Reflected<'_, AnyBrdf>>,
+    budget: usize,
+    k: usize,
+    rule: &GenzMalik,
+    rng: &mut rand_pcg::Pcg64,
+) -> Result<Estimate<f64>, QuadError> {
+    let (scene, receiver) = (&built.scene, &built.receiver);
+    let Some(e) = scene.emitters().get(k) else {
+        return Ok(Estimate::zero());
+    };
+    // Under a peaked lobe the lit polygons' area integrand holds the
+    // lobe's peak where the lobe is narrower than them; the blockers'
+    // exact arcs with adaptive pieces resolve it instead.
+    let lit = match lobe {
+        None => lit_triangles(scene, receiver.point(), k),
+        Some(_) => None,
+    };
+    // Where something can stand in the way and the shadow boundaries are
+    // not computed, the light is taken with nothing in the way, and what
+    // each blocker hides is subtracted over the blocker's own cone (an
+    // adaptive rule over the light's domain can miss a small blocker:
+    // crate::rendering::blocked).
+    let split = lit.is_none() && scene.has_blockers(Some(k));
+    let along = || {
+        let free = blocked::unblocked(e, receiver, kernel);
+        let seen = forms::cone_integrand(scene, receiver, kernel, k);
+        move |w: Vec3| if split { free(w) } else { seen(w) }
+    };
+    let by_lobe = |lobe: &Reflected<'_, AnyBrdf>, rng: &mut rand_pcg::Pcg64| {
+        integrate_over(rule, &BrdfSampled::new(*lobe), budget, rng, along())
+    };
+    let part = match (e, lobe) {
+        // Under a peaked lobe the environment's integrand is the lobe:
+        // smooth in the BRDF's own map, but for the horizon where it
+        // cuts the lobe; a Phong lobe is split there (clipped.rs), the
+        // two checked against each other.
+        (AnyEmitter::Environment(_), Some(lobe)) => match phong_cone(built)? {
+            Some(pieces) => {
+                let mut sum = Estimate::zero();
+                for piece in &pieces {
+                    sum = sum.combine(integrate_over(rule, piece, budget, rng, along())?);
+                }
+                cross_checked(sum, by_lobe(lobe, rng)?)
+            }
+            None => by_lobe(lobe, rng)?,
+        },
+        _ => {
+            let own = if exact_cone(e, receiver) && lobe.is_none() {
+                // A flat kernel over an exact cone: exact pieces (a rule
+                // over the cone ends at one box and cannot vouch for it).
+                blocked::over_cone(receiver, kernel, e, &e.cone(receiver)?)?
+            } else if exact_cone(e, receiver) {
+                integrate_over(rule, &e.cone(receiver)?, budget, rng, along())?
+            } else if crosses(e, receiver, kernel)
+                && (split || !scene.has_blockers(Some(k)))
+                && let Some(own) = blocked::over_shape(receiver, kernel, e)?
+            {
+                // Cut where the horizon or the lobe's clamp crosses the
+                // light: over its surface the integrand kinks there.
+                own
+            } else if let Some(lit) = &lit {
+                // Split at the shadow boundaries: exact by Lambert's contour
+                // on every piece (a light 1e24 long is a peak no rule
+                // resolves in its map), or smooth on every piece.
+                if let Some(exact) = lit_by_contour(e, receiver, kernel, lit) {
+                    return Ok(exact);
+                }
+                let g = forms::area_integrand_with(scene, receiver, kernel, k, |_| true)?;
+                let per = (budget / lit.len().max(1)).max(rule.min_budget(2));
+                let mut sum = Estimate::zero();
+                for t in lit {
+                    sum = sum.combine(integrate_over(rule, t, per, rng, &g)?);
+                }
+                sum
+            } else if split {
+                let g = forms::area_integrand_with(scene, receiver, kernel, k, |_| true)?;
+                integrate_over(rule, &e.surface(receiver)?, budget, rng, g)?
+            } else {
+                let g = forms::area_integrand(scene, receiver, kernel, k)?;
+                integrate_over(rule, &e.surface(receiver)?, budget, rng, g)?
+            };
+            match lobe {
+                // A lobe narrower than the light is smooth in the BRDF's
+                // map and a peak in the light's; one crossing the
+                // light's outline the other way round: both, the one
+                // with the smaller error kept, checked by the other.
+                Some(lobe) => cross_checked(own, by_lobe(lobe, rng)?),
+                None => own,
+            }
+        }
+    };
+    let part = if split {
+        // Where each blocker is wholly in front of the light or behind
+        // it, piece by piece between the exact outlines; else over each
+        // blocker's domain with a visibility test, trusted only where
+        // nothing cuts it.
+        let exact = blocked::hidden_by_arcs(scene, receiver, kernel, k)?;
+        let mut hidden = exact.unwrap_or_else(Estimate::zero);
+        let fallback = if exact.is_some() {
+            Vec::new()
+        } else {
+            blocked::blockers(scene, k)
+        };
+        for (j, o) in fallback.iter().enumerate() {
+            let h = blocked::hidden(scene, receiver, kernel, k, j)?;
+            let domain = blocked::domain(o, receiver.point())?;
+            let own = integrate_over(rule, &domain, budget, rng, &h)?;
+            let checked = match lobe {
+                Some(lobe) => cross_checked(
+                    own,
+                    integrate_over(
+                        rule,
+                        &BrdfSampled::new(*lobe),
+                        budget,
+                        rng,
+                        blocked::hidden_along(scene, receiver, kernel, k, j)?,
+                    )?,
+                ),
+                None => own,
+            };
+            // Outlines, the horizon or other blockers crossing the
+            // domain make the evaluation's own error estimate unsafe.
+            let trusted = blocked::smooth(scene, receiver, k, j);
+            hidden = hidden.combine(Estimate {
+                reliable: checked.reliable && trusted,
+                ..checked
+            });
+        }
+        part.combine(Estimate {
+            value: -hidden.value,
+            ..hidden
+        })
+    } else {
+        part
+    };
+    Ok(part)
+}
+
+/// The flat kernel's value over the lit triangles `lit` of planar light
+/// `e` (no lobe: [`lit_triangles`] is only asked then), by Lambert's contour
+/// formula on each: `K L_e pi sum_i F_i`, `F_i` the form factor of
+/// triangle `i` ([`exact::polygon_form_factor`]), `K` the kernel's constant
+/// weight; 0 where the light faces away. Its error: `gamma_8` of the value
+/// per triangle. `None` where a form factor fails.
+fn lit_by_contour<K: Kernel>(
+    e: &AnyEmitter<f64>,
+    receiver: &Receiver,
+    kernel: &K,
+    lit: &[Triangle],
+) -> Option<Estimate<f64>> {
+    let (x, n) = (receiver.point(), receiver.normal());
+    let Some(first) = lit.first() else {
+        return Some(Estimate::deterministic(0.0, 0.0, 0));
+    };
+    let y = first.vertices()[0];
+    if e.normal_at(y).dot(&(x - y)) <= 0.0 {
+        return Some(Estimate::deterministic(0.0, 0.0, 0));
+    }
+    let mut sum = 0.0;
+    for t in lit {
+        sum += exact::polygon_form_factor(x, n, &t.vertices()).ok()?;
+    }
+    let value = kernel.weight(n) * e.radiance() * PI * sum;
+    let error = crate::whitted::intersect::gamma(8) * value.abs() * lit.len() as f64;
+    Some(Estimate::deterministic(value, error, lit.len() as u64))
 }
 
 /// The pieces of a Phong lobe's cone about its mirror direction, cut at

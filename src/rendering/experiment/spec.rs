@@ -612,6 +612,7 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         if let Some(w) = facing_away(&at, &e, &receiver) {
             warnings.push(w);
         }
+        warnings.extend(super::doubts::emitter_doubt(i, &e, receiver.point()));
         emitters.push(e);
     }
     let mut occluders = Vec::with_capacity(spec.occluders.len());
@@ -619,6 +620,12 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         let at = format!("scene.occluders[{j}]");
         let o = occluder(o_spec).map_err(|err| SpecError::from_quad(&at, err))?;
         bounded(&at, &o, &occluder_numbers(o_spec))?;
+        warnings.extend(super::doubts::occluder_doubts(
+            j,
+            &o,
+            &emitters,
+            receiver.point(),
+        ));
         occluders.push(o);
     }
     Ok(Built {
