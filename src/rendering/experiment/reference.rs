@@ -360,6 +360,17 @@ pub fn lit_triangles(scene: &Scene<f64>, x: Vec3, k: usize) -> Option<Vec<Triang
             .collect();
         let mut next = Vec::new();
         for piece in pieces {
+            // A piece wholly outside one of the wedge's planes is wholly lit
+            // by this blocker: kept whole, not cut by the other planes (each
+            // cut across the light multiplied the pieces, so that 1000
+            // small blockers took seconds and 10 000 ran for minutes).
+            if planes
+                .iter()
+                .any(|m| piece.iter().all(|&p| m.dot(&(p - x)) <= 0.0))
+            {
+                next.push(piece);
+                continue;
+            }
             let mut inside = piece;
             for m in &planes {
                 // The part outside this plane is lit; the rest goes on.
