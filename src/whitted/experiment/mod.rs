@@ -28,8 +28,10 @@
 //! them by kind.
 //!
 //! **Closed forms.** `coverage` when the scene's only object is a triangle
-//! in front of the eye (its projection, clipped to the pixel:
-//! [`super::coverage::polygon_fraction`]) or a plane the eye is not on
+//! (the film points whose rays meet it: the common part of three film
+//! half-planes, one per plane through the eye and an edge, clipped to the
+//! pixel: [`super::coverage::convex_fraction`]; a vertex behind the eye or
+//! far beyond it is never divided by its depth) or a plane the eye is not on
 //! (the film points whose rays meet it form a half-plane of the film:
 //! [`super::coverage::half_plane_fraction`]); `pixel` and `image` when, in
 //! addition, the object's intensity is the same everywhere (no light
@@ -556,7 +558,7 @@ impl Family for Whitted {
     }
 
     fn closed_forms_available() -> &'static str {
-        "coverage when the scene's one object is a triangle in front of the eye or a plane the \
+        "coverage when the scene's one object is a triangle or a plane the \
          eye is not on; pixel and image when, besides, the object's intensity is the same \
          everywhere (ambient only: no light reaches its k_d or k_s terms, no mirror or \
          transmitted ray)"
