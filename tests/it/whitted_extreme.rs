@@ -2,7 +2,7 @@
 //! inputs: closed forms against values derived by hand in the test, and
 //! refusals that name the JSON path or the flag.
 
-use crate::common::root;
+use crate::common::{bin, root, scratch, stderr};
 use lightquad::family::Family;
 use lightquad::whitted::experiment::{SceneSpec, Whitted, WhittedQuantity};
 use serde_json::{Value as Json, json};
@@ -98,4 +98,104 @@ fn distant_vertex_bounds_a_strip() {
         worst < 1e-2,
         "a pixel's coverage is {worst} off the strip's"
     );
+}
+
+/// `render --png` or `--pfm` naming a FIFO blocked forever (the image was
+/// written in place into a pipe no one reads): refused at once with the
+/// flag and what the path is, and nothing written.
+#[test]
+fn render_refuses_a_fifo_as_output() {
+    let dir = scratch("render-fifo");
+    let fifo = dir.join("pipe");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success(), "mkfifo failed");
+    for (flag, other) in [("--png", "--pfm"), ("--pfm", "--png")] {
+        let mut child = bin()
+            .args(["render", "--width", "8", "--height", "6", flag])
+            .arg(&fifo)
+            .arg(other)
+            .arg(dir.join("other.img"))
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("spawns");
+        // Ten seconds for a refusal that takes milliseconds; a render
+        // blocked on the pipe is killed and fails the test.
+        let start = std::time::Instant::now();
+        while child.try_wait().expect("waits").is_none() {
+            if start.elapsed().as_secs() > 10 {
+                let _ = child.kill();
+                let _ = child.wait();
+                panic!("render {flag} <FIFO> still running after 10 s");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let o = child.wait_with_output().expect("output");
+        let msg = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{msg}");
+        for want in [flag, "FIFO"] {
+            assert!(msg.contains(want), "no `{want}` in {msg}");
+        }
+        assert!(
+            !dir.join("other.img").exists(),
+            "the other file was written"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `render` under `ulimit -v` 300 000 KiB (as `prlimit --as` sets it).
+fn render_capped(dir: &std::path::Path, side: usize) -> std::process::Output {
+    std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 300000 && exec \"$0\" render --png \"$1\" --width {side} --height {side} \
+             --samples 1"
+        ))
+        .arg(env!("CARGO_BIN_EXE_lightquad"))
+        .arg(dir.join("out.png"))
+        .output()
+        .expect("runs")
+}
+
+/// Under a 307 MB address-space cap a 2048 x 2048 render aborted (exit 134,
+/// "memory allocation of 100663296 bytes failed"): its 4.2e6 pixels alone
+/// hold 4.2e6 x 64 = 268 MB (values, errors, image, file bytes), beside two
+/// 64 MiB allocator arenas. It is refused with the cap and the flags named,
+/// exit 1, nothing written; a 64 x 64 render (0.26 MB) runs under the same
+/// cap.
+#[test]
+fn render_past_a_memory_cap_is_refused_not_aborted() {
+    let dir = scratch("render-cap");
+    let o = render_capped(&dir, 2048);
+    let msg = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{msg}");
+    for want in ["--width", "268.4 MB", "address-space limit"] {
+        assert!(msg.contains(want), "no `{want}` in {msg}");
+    }
+    assert!(!dir.join("out.png").exists(), "a PNG was written");
+    let o = render_capped(&dir, 64);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.join("out.png").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A render of more than 8192 x 8192 = 67 108 864 pixels (4 GiB at 64
+/// bytes a pixel) is refused by its flags before anything is traced.
+#[test]
+fn render_refuses_absurd_sizes_by_flag() {
+    let dir = scratch("render-size");
+    let o = bin()
+        .args(["render", "--width", "16384", "--height", "8193", "--png"])
+        .arg(dir.join("out.png"))
+        .output()
+        .expect("runs");
+    let msg = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{msg}");
+    for want in ["--width x --height", "16384 x 8193", "67108864"] {
+        assert!(msg.contains(want), "no `{want}` in {msg}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -86,7 +86,10 @@ use build::build;
 use closed_form::closed_form;
 
 pub use build::{RESOLVED_SCENE, SMALLEST_RESOLVED, SMALLEST_SIZE};
-pub use render_spec::{MAX_RENDER_RAYS, RENDER_BYTES_PER_PIXEL, render_spec, scene_of};
+pub use render_spec::{
+    MAX_RENDER_PIXELS, MAX_RENDER_RAYS, RENDER_BYTES_PER_PIXEL, RENDER_RESERVE, render_spec,
+    scene_of,
+};
 pub use spec::{
     CameraSpec, DirectionalLightSpec, LightSpec, MAX_COORDINATE, MaterialSpec, ObjectSpec,
     PlaneSpec, PointLightSpec, SceneSpec, SphereSpec, TriangleSpec,
