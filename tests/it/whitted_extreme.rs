@@ -199,3 +199,58 @@ fn render_refuses_absurd_sizes_by_flag() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Ten mirror-and-glass spheres (`k_s`, `k_t` > 0) at depth 16, two lights,
+/// the pixel looking past them: each primary ray may have 2^17 - 1 =
+/// 131071 rays below it, each with 2 shadow rays, each tested against 10
+/// objects, and the converged pixel spends 100 n = 40 000 primary rays at n
+/// = 400: 40 000 x 131071 x 3 x 10 = 1.57e11 ray-object tests, past the
+/// 1e11 a job may cost. Refused at once with `reference.n`, the estimate
+/// and `scene.max_depth` named (it ran; four such spheres the pixel sees
+/// ran for more than 300 s).
+#[test]
+fn a_bushy_ray_tree_bounds_the_converged_reference() {
+    let mut e = bundled("w-6-1-phong-pixel");
+    let glass = json!({"k_a": 0.1, "k_s": 0.5, "k_t": 0.5, "ior": 1.5});
+    let spheres: Vec<Json> = (0..10)
+        .map(|k| json!({"type": "sphere", "centre": [k as f64, 40.0, -3.0], "radius": 0.4, "material": glass}))
+        .collect();
+    e["scene"]["objects"] = Json::Array(spheres);
+    e["scene"]["max_depth"] = json!(16);
+    e["reference"] = json!({"type": "converged", "n": 400});
+    let spec: SceneSpec = serde_json::from_value(e["scene"].clone()).expect("scene");
+    let built = Whitted::build(&spec).expect("built");
+    let start = std::time::Instant::now();
+    let got = Whitted::converged(&built, 400, &[WhittedQuantity::Pixel]);
+    let msg = match got {
+        Err(err) => err.to_string(),
+        Ok(_) => panic!(
+            "the converged pixel ran ({:.1} s) past an estimate of 1.57e11 ray-object tests",
+            start.elapsed().as_secs_f64()
+        ),
+    };
+    for want in ["reference.n", "1.6e11", "scene.max_depth", "131071"] {
+        assert!(msg.contains(want), "no `{want}` in {msg}");
+    }
+    // At n = 200 the estimate is 7.9e10: allowed, and it runs (the pixel
+    // sees only the background, so few rays are traced).
+    let half = Whitted::converged(&built, 200, &[WhittedQuantity::Pixel]).expect("runs");
+    let background = [0.1, 0.2, 0.4];
+    for (c, v) in half[&WhittedQuantity::Pixel].value.iter().enumerate() {
+        assert!((v - background[c]).abs() < 1e-12, "{v}");
+    }
+    // `check` of the file at n = 200, which the layer's own reference
+    // estimate passes, warns at `scene.max_depth` with the tree's size.
+    e["reference"] = json!({"type": "converged", "n": 200});
+    let dir = scratch("bushy");
+    let file = dir.join("e.json");
+    std::fs::write(&file, e.to_string()).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    let msg = stderr(&o);
+    assert!(o.status.success(), "{msg}");
+    assert!(
+        msg.contains("at `scene.max_depth`") && msg.contains("131071"),
+        "{msg}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
