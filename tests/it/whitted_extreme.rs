@@ -194,7 +194,7 @@ fn render_refuses_absurd_sizes_by_flag() {
         .expect("runs");
     let msg = stderr(&o);
     assert_eq!(o.status.code(), Some(1), "{msg}");
-    for want in ["--width x --height", "16384 x 8193", "67108864"] {
+    for want in ["--width x --height", "16384 x 8193 pixels", "67108864"] {
         assert!(msg.contains(want), "no `{want}` in {msg}");
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -115,9 +115,9 @@ fn fits(width: usize, height: usize) -> Result<(), SpecError> {
         return Err(SpecError::at(
             "width",
             format!(
-                "--width x --height = {width} x {height} = {pixels:.0} pixels, which hold about \
-                 {} while rendering: expected at most {MAX_RENDER_PIXELS:.0} pixels (8192 x \
-                 8192; a smaller --width, --height)",
+                "--width x --height = {width} x {height} pixels ({pixels:.0}) hold about {} \
+                 while rendering: expected at most {MAX_RENDER_PIXELS:.0} pixels (8192 x 8192; \
+                 a smaller --width, --height)",
                 memory::bytes(bytes)
             ),
         ));
