@@ -315,6 +315,20 @@ fn run(command: Command) -> Result<(), Failure> {
                     Some(f) if !f.as_os_str().is_empty() => f,
                     _ => std::path::Path::new("."),
                 };
+                // A FIFO or a device is written in place, never renamed
+                // over: a FIFO no one reads blocked the render forever.
+                if let Ok(meta) = std::fs::metadata(path)
+                    && !meta.is_dir()
+                    && !meta.is_file()
+                {
+                    return Err(format!(
+                        "invalid {flag} = {}: it {}: expected a regular file or a new name \
+                         (the image is written beside it and renamed into place)",
+                        path.display(),
+                        experiment::source::not_regular(&meta)
+                    )
+                    .into());
+                }
                 if path.is_dir() || !folder.is_dir() {
                     return Err(format!(
                         "invalid {flag} = {}: expected a file in an existing folder ({})",

@@ -305,8 +305,9 @@ pub fn describe(e: &std::io::Error) -> String {
     }
 }
 
-/// What kind of thing a path that is not a regular file is.
-fn not_regular(meta: &fs::Metadata) -> &'static str {
+/// What kind of thing a path that is not a regular file is (`is a FIFO
+/// (named pipe)`, `is a device`, ...).
+pub fn not_regular(meta: &fs::Metadata) -> &'static str {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;

@@ -140,6 +140,19 @@ pub fn half_plane_fraction(pixel: &Pixel, h: HalfPlane) -> f64 {
     inside / (inside + outside)
 }
 
+/// The fraction of `pixel` inside every half-plane of `planes`: the square
+/// clipped by each in turn, its area over the pixel's.
+pub fn convex_fraction(pixel: &Pixel, planes: &[HalfPlane]) -> f64 {
+    let mut piece = square(pixel);
+    for h in planes {
+        piece = clip(&piece, h.shifted(pixel.corner()));
+        if piece.len() < 3 {
+            return 0.0;
+        }
+    }
+    area(&piece) / pixel.measure()
+}
+
 /// The fraction of `pixel` inside the convex polygon `poly` (vertices in
 /// either order): the square clipped by each edge's half-plane.
 pub fn polygon_fraction(pixel: &Pixel, poly: &[[f64; 2]]) -> f64 {
@@ -156,6 +169,11 @@ pub fn polygon_fraction(pixel: &Pixel, poly: &[[f64; 2]]) -> f64 {
                 - (q[0] - local[0][0]) * (p[1] - local[0][1])
         })
         .sum();
+    // A polygon of no area (its vertices rounded onto one point or line)
+    // covers nothing; its edges bound no side.
+    if signed == 0.0 {
+        return 0.0;
+    }
     let mut piece = square(pixel);
     for i in 0..local.len() {
         let (p, q) = (local[i], local[(i + 1) % local.len()]);

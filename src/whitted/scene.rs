@@ -346,6 +346,43 @@ impl Camera {
         }
     }
 
+    /// The film half-planes whose common part is the film region whose
+    /// primary rays meet the triangle `v`, or none when the eye is in the
+    /// triangle's plane (its image has no area).
+    ///
+    /// The ray `eye + t d`, `t > 0`, meets the triangle where `d` is a
+    /// positive combination of the `v_k - eye`: for each edge `(p, q)` with
+    /// third vertex `r`, `d . n` has the sign of `(r - p) . n`, `n = (q - p)
+    /// x (eye - p)` the normal of the plane through the edge and the eye
+    /// (`(r - eye) . n = (r - p) . n` as `n` is normal to `eye - p`). These
+    /// are homogeneous tests: no vertex is divided by its depth, so one
+    /// behind the eye, or 1e20 beyond it, bounds the region as it should.
+    pub fn triangle_half_planes(&self, v: &[Vec3; 3]) -> Option<[HalfPlane; 3]> {
+        let mut planes = [HalfPlane {
+            a: 0.0,
+            b: 0.0,
+            c: 0.0,
+        }; 3];
+        for (k, plane) in planes.iter_mut().enumerate() {
+            let (p, q, r) = (v[k], v[(k + 1) % 3], v[(k + 2) % 3]);
+            let n = (q - p).cross(&(self.eye - p));
+            // Scaled to a largest component of 1: the side tests are
+            // unchanged, and no product of them underflows or overflows.
+            let n = n / n.amax();
+            let side = (r - p).dot(&n);
+            if !side.is_finite() || side == 0.0 {
+                return None;
+            }
+            let toward = self.film_half_plane(n);
+            *plane = if side < 0.0 {
+                toward
+            } else {
+                toward.complement()
+            };
+        }
+        Some(planes)
+    }
+
     /// The film lines `x = x_0`, `x = x_1`, `y = y_0`, `y = y_1` bounding
     /// the outline of the sphere (`centre`, `radius`) where they exist: the
     /// outline's extreme `s_x = (d . right) / (d . forward)` are the tangents

@@ -50,6 +50,7 @@ mod volume;
 mod volume_emission;
 mod volume_estimators;
 mod volume_media;
+mod whitted_extreme;
 mod whitted_family;
 mod whitted_outputs;
 mod whitted_pixel;

@@ -21,6 +21,11 @@ pub const SMALLEST_RESOLVED: f64 = 1e-12;
 /// numbers (1e-150 squared is 1e-300).
 pub const SMALLEST_SIZE: f64 = 1e-150;
 
+/// The most rays below one primary ray before `check` warns at
+/// `scene.max_depth`: 1023, a tree of both mirror and glass rays to depth 9
+/// (the bundled scenes go to depth 4, 31 rays).
+pub const BUSHY_TREE: f64 = 1023.0;
+
 /// What a scene must be for its rays to be defined: said when a pixel comes
 /// out not a number (`render`) or a pixel's integrand does (a job).
 pub const RESOLVED_SCENE: &str = "a scene whose coordinates and sizes f64 resolves along its \
@@ -228,6 +233,23 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         spec.max_depth,
     )
     .map_err(|e| SpecError::from_quad("scene", e))?;
+    // A bushy ray tree multiplies every job's and the reference's rays.
+    let tree = super::tree_rays(&scene);
+    if tree > BUSHY_TREE {
+        warnings.push(SpecError::at(
+            "scene.max_depth",
+            format!(
+                "max_depth {} with mirrors and glass: up to {tree:.0} rays below each primary ray, each \
+                 tested against {} object(s); jobs are refused past 1e11 ray-object tests by \
+                 this count, and so is the converged reference when it runs (each doubling of \
+                 its n doubles it); expected a max_depth of {} or less unless the scene's rays \
+                 escape early",
+                spec.max_depth,
+                scene.objects.len(),
+                (BUSHY_TREE + 1.0).log2() as usize - 1
+            ),
+        ));
+    }
     if let Some([i, j]) = spec.pixel
         && (i >= c.width || j >= c.height)
     {

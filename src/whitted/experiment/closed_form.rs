@@ -4,26 +4,26 @@
 use super::{Built, WhittedQuantity};
 use crate::domain::Pixel;
 use crate::value::Rgb;
-use crate::whitted::coverage::{HalfPlane, half_plane_fraction, polygon_fraction};
+use crate::whitted::coverage::{HalfPlane, convex_fraction, half_plane_fraction};
 use crate::whitted::intersect::Shape;
 use crate::whitted::scene::{Camera, Object, Scene};
 
 /// The film region whose primary rays meet a shape, when it is a convex
-/// polygon or a half-plane of the film.
+/// region of the film: a triangle's is the common part of three
+/// half-planes ([`Camera::triangle_half_planes`]; no area when the eye is
+/// in its plane), a plane's one half-plane.
 enum Footprint {
-    Polygon(Vec<[f64; 2]>),
+    Cone([HalfPlane; 3]),
     HalfPlane(HalfPlane),
+    Empty,
 }
 
 fn footprint(cam: &Camera, shape: &Shape) -> Option<Footprint> {
     match *shape {
-        Shape::Triangle { vertices, .. } => {
-            let mut poly = Vec::with_capacity(3);
-            for v in vertices {
-                poly.push(cam.project(v)?);
-            }
-            Some(Footprint::Polygon(poly))
-        }
+        Shape::Triangle { vertices, .. } => Some(match cam.triangle_half_planes(&vertices) {
+            Some(planes) => Footprint::Cone(planes),
+            None => Footprint::Empty,
+        }),
         Shape::Plane { point, normal } => {
             // The ray meets the plane where d . n has the sign opposite to
             // the eye's side.
@@ -53,7 +53,8 @@ pub(super) fn closed_form(built: &Built, q: WhittedQuantity) -> Option<Vec<f64>>
     let fraction = |i: usize, j: usize| -> Option<f64> {
         let p = Pixel::new(i as f64, j as f64, 1.0, 1.0).ok()?;
         Some(match &print {
-            Footprint::Polygon(poly) => polygon_fraction(&p, poly),
+            Footprint::Cone(planes) => convex_fraction(&p, planes),
+            Footprint::Empty => 0.0,
             Footprint::HalfPlane(h) => half_plane_fraction(&p, *h),
         })
     };

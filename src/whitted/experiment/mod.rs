@@ -28,8 +28,10 @@
 //! them by kind.
 //!
 //! **Closed forms.** `coverage` when the scene's only object is a triangle
-//! in front of the eye (its projection, clipped to the pixel:
-//! [`super::coverage::polygon_fraction`]) or a plane the eye is not on
+//! (the film points whose rays meet it: the common part of three film
+//! half-planes, one per plane through the eye and an edge, clipped to the
+//! pixel: [`super::coverage::convex_fraction`]; a vertex behind the eye or
+//! far beyond it is never divided by its depth) or a plane the eye is not on
 //! (the film points whose rays meet it form a half-plane of the film:
 //! [`super::coverage::half_plane_fraction`]); `pixel` and `image` when, in
 //! addition, the object's intensity is the same everywhere (no light
@@ -83,8 +85,11 @@ mod spec;
 use build::build;
 use closed_form::closed_form;
 
-pub use build::{RESOLVED_SCENE, SMALLEST_RESOLVED, SMALLEST_SIZE};
-pub use render_spec::{MAX_RENDER_RAYS, RENDER_BYTES_PER_PIXEL, render_spec, scene_of};
+pub use build::{BUSHY_TREE, RESOLVED_SCENE, SMALLEST_RESOLVED, SMALLEST_SIZE};
+pub use render_spec::{
+    MAX_RENDER_PIXELS, MAX_RENDER_RAYS, RENDER_BYTES_PER_PIXEL, RENDER_RESERVE, render_spec,
+    scene_of,
+};
 pub use spec::{
     CameraSpec, DirectionalLightSpec, LightSpec, MAX_COORDINATE, MaterialSpec, ObjectSpec,
     PlaneSpec, PointLightSpec, SceneSpec, SphereSpec, TriangleSpec,
@@ -556,7 +561,7 @@ impl Family for Whitted {
     }
 
     fn closed_forms_available() -> &'static str {
-        "coverage when the scene's one object is a triangle in front of the eye or a plane the \
+        "coverage when the scene's one object is a triangle or a plane the \
          eye is not on; pixel and image when, besides, the object's intensity is the same \
          everywhere (ambient only: no light reaches its k_d or k_s terms, no mirror or \
          transmitted ray)"
@@ -575,15 +580,19 @@ impl Family for Whitted {
             rel_tol: 0.0,
         }));
         let per_pixel = CONVERGED_PER_N.saturating_mul(n);
+        let budget = |q: WhittedQuantity| {
+            if q == WhittedQuantity::Image {
+                (per_pixel / 16).max(rule.min_budget(2))
+            } else {
+                per_pixel
+            }
+        };
+        converged_affordable(built, n, quantities.iter().map(|&q| (q, budget(q))))?;
         let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
         quantities
             .iter()
             .map(|&q| {
-                let budget = if q == WhittedQuantity::Image {
-                    (per_pixel / 16).max(rule.min_budget(2))
-                } else {
-                    per_pixel
-                };
+                let budget = budget(q);
                 let scheme = Render::Pieces {
                     rule: rule.clone(),
                     n: budget,
@@ -606,6 +615,46 @@ impl Family for Whitted {
     }
 }
 
+/// Refuses a converged evaluation at `n` whose ray tree makes it cost more
+/// than [`MAX_JOB_EVALUATIONS`](crate::experiment::validate::MAX_JOB_EVALUATIONS)
+/// ray-object tests (unless `--no-cost-limit`): Genz–Malik's `budget`
+/// points per pixel of each quantity (`(q, budget)`), each a primary ray
+/// with up to `sum_(d <= max_depth) b^d` rays below it ([`per_primary`]; `b
+/// = 2` with mirrors and glass). Four glass spheres at depth 16 ran for
+/// more than 300 s before any report; each doubling of `n` doubles it.
+fn converged_affordable(
+    built: &Built,
+    n: usize,
+    budgets: impl Iterator<Item = (WhittedQuantity, usize)>,
+) -> Result<(), QuadError> {
+    use crate::experiment::validate::{MAX_JOB_EVALUATIONS, cost_limit_lifted};
+    let rule = Method::Rule(AnyRule::Base(BaseRule::GenzMalik(GenzMalik {
+        abs_tol: 0.0,
+        rel_tol: 0.0,
+    })));
+    let cost: f64 = budgets
+        .map(|(q, budget)| Whitted::cost(built, &rule, budget, q))
+        .sum();
+    if cost_limit_lifted() || cost <= MAX_JOB_EVALUATIONS {
+        return Ok(());
+    }
+    let scene = &built.scene;
+    Err(QuadError::invalid(
+        "reference.n",
+        n,
+        format!(
+            "a converged evaluation of at most {MAX_JOB_EVALUATIONS:.0e} ray-object tests; at \
+             n = {n} it costs about {cost:.1e}, the scene's ray tree counted (scene.max_depth \
+             {}: up to {:.0} rays below each primary ray, {} light(s), {} object(s)): lower \
+             scene.max_depth or reference.n, or pass --no-cost-limit",
+            scene.max_depth,
+            tree_rays(scene),
+            scene.lights.len(),
+            scene.objects.len()
+        ),
+    ))
+}
+
 impl WhittedQuantity {
     /// Every quantity (for the estimators, which estimate them all).
     fn all_quantities() -> &'static [WhittedQuantity] {
@@ -618,11 +667,17 @@ impl WhittedQuantity {
 /// rays per level, each tested against every object.
 fn per_primary(scene: &Scene) -> f64 {
     let lights = scene.lights.len() as f64;
-    let branches = f64::from(u8::from(scene.has_mirrors()) + u8::from(scene.has_transparency()));
-    let hits: f64 = (0..=scene.max_depth).map(|d| branches.powi(d as i32)).sum();
     // Every ray tests every object (50 000 spheres made a ray 0.3 ms).
     let objects = scene.objects.len().max(1) as f64;
-    hits * (1.0 + lights) * objects
+    tree_rays(scene) * (1.0 + lights) * objects
+}
+
+/// The most rays of one primary ray's tree, itself included: `sum_(d = 0)^
+/// max_depth b^d`, `b` the secondary rays a hit spawns (one for mirrors,
+/// one for glass, two with both; 131071 at depth 16 with both).
+fn tree_rays(scene: &Scene) -> f64 {
+    let branches = f64::from(u8::from(scene.has_mirrors()) + u8::from(scene.has_transparency()));
+    (0..=scene.max_depth).map(|d| branches.powi(d as i32)).sum()
 }
 
 /// The ray kinds the scene traces, in words.

@@ -35,6 +35,8 @@ pub fn render_spec(
             "0 rays a pixel: expected at least 1 (rounded down to a square: 1, 4, 9, ...)",
         ));
     }
+    // The size first, named by its flags, and what the memory allows.
+    fits(spec_width, spec_height)?;
     let side = ((samples as f64).sqrt().floor() as usize).max(1);
     // Refuse what would run for hours: the primary rays, each of which may
     // spawn up to `max_depth` generations more.
@@ -67,21 +69,6 @@ pub fn render_spec(
             ),
         ));
     }
-    // And what would not fit: the values, their errors, the image and its
-    // files hold about RENDER_BYTES_PER_PIXEL a pixel (8192 x 8192 peaked at
-    // 3.2 GB; 16384 x 16384 ran out of memory).
-    let bytes = (spec_width as f64) * (spec_height as f64) * RENDER_BYTES_PER_PIXEL;
-    let limit = crate::experiment::validate::MAX_JOB_BYTES;
-    if bytes > limit {
-        return Err(SpecError::at(
-            "width",
-            format!(
-                "{spec_width} x {spec_height} pixels hold about {:.1} GB while rendering: expected at most {:.1} GB (a smaller --width, --height)",
-                bytes / 1e9,
-                limit / 1e9
-            ),
-        ));
-    }
     let out = render::render_parallel(&built.scene, &Render::Grid { n: side }, 0)
         .map_err(|e| SpecError::from_quad("scene", e))?;
     // A pixel that is not a number is a fault of the scene's numbers, never
@@ -99,6 +86,64 @@ pub fn render_spec(
     let image = crate::whitted::image::Image::new(spec_width, spec_height, out.image.values)
         .map_err(|e| SpecError::from_quad("scene.camera", e))?;
     Ok((image, out.rays, built.warnings))
+}
+
+/// The most pixels `lightquad render` renders (`width x height`):
+/// [`MAX_JOB_BYTES`](crate::experiment::validate::MAX_JOB_BYTES) at
+/// [`RENDER_BYTES_PER_PIXEL`], 67 108 864 (8192 x 8192).
+pub const MAX_RENDER_PIXELS: f64 =
+    crate::experiment::validate::MAX_JOB_BYTES / RENDER_BYTES_PER_PIXEL;
+
+/// The address space a render holds beside its pixels and its threads:
+/// the program, its libraries and the scene (`VmSize` at the start, about
+/// 10 MB, is already out of the room under a cap; this is the rest, with
+/// a margin).
+pub const RENDER_RESERVE: f64 = 32e6;
+
+/// Refuses a `width x height` render of more than [`MAX_RENDER_PIXELS`],
+/// or one whose memory, `width x height x` [`RENDER_BYTES_PER_PIXEL`] plus
+/// its worker threads' stacks and allocator arenas
+/// ([`thread_reserve`](crate::experiment::memory::thread_reserve)) plus
+/// [`RENDER_RESERVE`], exceeds the room under a hard cap on this process
+/// (`prlimit --as`, a cgroup): past it an allocation fails and aborts the
+/// process (2048 x 2048 under `prlimit --as=300000000`).
+fn fits(width: usize, height: usize) -> Result<(), SpecError> {
+    use crate::experiment::memory;
+    let pixels = (width as f64) * (height as f64);
+    let bytes = pixels * RENDER_BYTES_PER_PIXEL;
+    if pixels > MAX_RENDER_PIXELS {
+        return Err(SpecError::at(
+            "width",
+            format!(
+                "--width x --height = {width} x {height} pixels ({pixels:.0}) hold about {} \
+                 while rendering: expected at most {MAX_RENDER_PIXELS:.0} pixels (8192 x 8192; \
+                 a smaller --width, --height)",
+                memory::bytes(bytes)
+            ),
+        ));
+    }
+    let Some(cap) = memory::hard_cap() else {
+        return Ok(());
+    };
+    let threads = rayon::current_num_threads();
+    let workers = memory::thread_reserve(threads);
+    if bytes + workers + RENDER_RESERVE > cap.room {
+        return Err(SpecError::at(
+            "width",
+            format!(
+                "--width x --height = {width} x {height} pixels hold about {} while rendering, \
+                 its {threads} worker thread(s) reserve about {} (stacks and allocator arenas) \
+                 and the rest about {}, and {} leaves {}: expected a smaller --width, --height \
+                 (or a larger limit)",
+                memory::bytes(bytes),
+                memory::bytes(workers),
+                memory::bytes(RENDER_RESERVE),
+                cap.what,
+                memory::bytes(cap.room)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The memory a render holds per pixel, in bytes (values and errors, the

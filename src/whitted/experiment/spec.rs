@@ -28,7 +28,11 @@ pub struct SceneSpec {
     /// The objects.
     pub objects: Vec<ObjectSpec>,
     /// The deepest recursion of reflected and transmitted rays, `0..=16`
-    /// (default 5; the primary ray is depth 0).
+    /// (default 5; the primary ray is depth 0). With both mirrors (`k_s >
+    /// 0`) and glass (`k_t > 0`) each primary ray may have `2^(max_depth +
+    /// 1) - 1` rays below it (131071 at 16): the cost guards count that
+    /// tree (jobs and the converged reference past 1e11 ray-object tests are
+    /// refused), and past depth 9 `check` warns.
     #[serde(default = "default_depth")]
     pub max_depth: usize,
     /// `[i, j]`: the pixel of the `coverage` and `pixel` quantities (column
