@@ -217,7 +217,6 @@ fn a_bushy_ray_tree_bounds_the_converged_reference() {
         .collect();
     e["scene"]["objects"] = Json::Array(spheres);
     e["scene"]["max_depth"] = json!(16);
-    e["reference"] = json!({"type": "converged", "n": 400});
     let spec: SceneSpec = serde_json::from_value(e["scene"].clone()).expect("scene");
     let built = Whitted::build(&spec).expect("built");
     let start = std::time::Instant::now();
@@ -239,13 +238,22 @@ fn a_bushy_ray_tree_bounds_the_converged_reference() {
     for (c, v) in half[&WhittedQuantity::Pixel].value.iter().enumerate() {
         assert!((v - background[c]).abs() < 1e-12, "{v}");
     }
-    // `check` of the file at n = 200, which the layer's own reference
-    // estimate passes, warns at `scene.max_depth` with the tree's size.
-    e["reference"] = json!({"type": "converged", "n": 200});
+    // `check` prices the reference's first two evaluations, at n and 2n: at
+    // n = 200 they cost 7.9e10 + 1.57e11, refused at `reference.n`; at n =
+    // 50, 2.0e10 + 3.9e10 pass, with a warning at `scene.max_depth` naming
+    // the tree's size.
     let dir = scratch("bushy");
     let file = dir.join("e.json");
-    std::fs::write(&file, e.to_string()).expect("write");
-    let o = bin().arg("check").arg(&file).output().expect("runs");
+    let mut check = |n: usize| {
+        e["reference"] = json!({"type": "converged", "n": n});
+        std::fs::write(&file, e.to_string()).expect("write");
+        bin().arg("check").arg(&file).output().expect("runs")
+    };
+    let o = check(200);
+    let msg = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{msg}");
+    assert!(msg.contains("at `reference.n`"), "{msg}");
+    let o = check(50);
     let msg = stderr(&o);
     assert!(o.status.success(), "{msg}");
     assert!(

@@ -96,10 +96,70 @@ fn too_dear<F: Family>(exp: &Experiment<F>, m: usize, spent: f64, last: f64) -> 
     ))
 }
 
+/// Each quantity's relative change from `coarse` to `fine`, or the finer
+/// evaluation's own relative error estimate where that is larger (an
+/// adaptive rule that met its tolerance twice changes by nothing).
+fn changes_between<F: Family>(
+    exp: &Experiment<F>,
+    coarse: &BTreeMap<F::Quantity, Measured>,
+    fine: &BTreeMap<F::Quantity, Measured>,
+) -> BTreeMap<String, f64> {
+    exp.spec
+        .quantities
+        .iter()
+        .filter_map(|q| {
+            let (x, y) = (coarse.get(q)?, fine.get(q)?);
+            let change = relative_distance(&x.value, &y.value);
+            let size = rms(y.value.iter().copied());
+            let own = rms(y.error.iter().copied()) / size;
+            let own = if own.is_finite() && size > 0.0 {
+                own
+            } else {
+                0.0
+            };
+            Some((q.name().to_string(), change.max(own)))
+        })
+        .collect()
+}
+
+/// Each channel's absolute change from `coarse` to `fine` or the finer
+/// evaluation's own error estimate, the larger, never below the rounding
+/// floor [`CONVERGED_FLOOR`] of its value (as the whole quantity's): a
+/// background channel of 0.1 every ray sees alike changed by 0, yet the
+/// rules' weights summed it to 0.09999999999999999, a display step below
+/// the reference's 25.5.
+fn per_channel_changes<F: Family>(
+    exp: &Experiment<F>,
+    coarse: &BTreeMap<F::Quantity, Measured>,
+    fine: &BTreeMap<F::Quantity, Measured>,
+) -> BTreeMap<String, Vec<f64>> {
+    exp.spec
+        .quantities
+        .iter()
+        .filter_map(|q| {
+            let (x, y) = (coarse.get(q)?, fine.get(q)?);
+            let each = (0..y.value.len())
+                .map(|c| {
+                    let change = match x.value.get(c) {
+                        Some(&a) => (a - y.value[c]).abs(),
+                        None => f64::NAN,
+                    };
+                    let own = y.error.get(c).copied().filter(|e| e.is_finite());
+                    own.map_or(change, |e| change.max(e.abs()))
+                        .max(CONVERGED_FLOOR * y.value[c].abs())
+                })
+                .collect();
+            Some((q.name().to_string(), each))
+        })
+        .collect()
+}
+
 /// The converged reference: the family's converged evaluation at `n`, `2n`,
 /// `4n`, ... nodes per piece until every quantity's relative change from one
 /// to the next is at most `goal` (a hundredth of the tightest target, but not
-/// below [`CONVERGED_FLOOR`]) or `n` has doubled [`MAX_DOUBLINGS`] times. Each quantity
+/// below [`CONVERGED_FLOOR`]) or `n` has doubled [`MAX_DOUBLINGS`] times, or
+/// the next doubling would pass a job's limits ([`too_dear`]) or fails (a
+/// family's own limit), said in the note. Each quantity
 /// keeps the finest value and, as its accuracy, its own last change (at
 /// least [`CONVERGED_FLOOR`], the evaluation's own rounding); one that
 /// did not get below the goal is named in the note. A quantity the family
@@ -122,87 +182,51 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
             channel_accuracy: BTreeMap::new(),
         }
     };
-    let mut coarse = match converged_measured(exp, n) {
-        Ok(a) => a,
-        Err(e) => return failed(e),
+    let (mut coarse, mut fine) = match (converged_measured(exp, n), converged_measured(exp, 2 * n))
+    {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => return failed(e),
     };
-    let mut m = n;
-    let mut spent = evaluations(&coarse);
+    let mut m = 2 * n;
+    let mut spent = evaluations(&coarse) + evaluations(&fine);
     let mut stopped = None;
-    let (fine, changes, per_channel) = loop {
-        m *= 2;
-        let fine = match converged_measured(exp, m) {
-            Ok(b) => b,
-            Err(e) => return failed(e),
-        };
-        spent += evaluations(&fine);
-        let changes: BTreeMap<String, f64> = exp
-            .spec
-            .quantities
-            .iter()
-            .filter_map(|q| {
-                let (x, y) = (coarse.get(q)?, fine.get(q)?);
-                // The change from the coarser evaluation, or the finer one's
-                // own error estimate where that is larger (an adaptive rule
-                // that met its tolerance twice changes by nothing).
-                let change = relative_distance(&x.value, &y.value);
-                let size = rms(y.value.iter().copied());
-                let own = rms(y.error.iter().copied()) / size;
-                let own = if own.is_finite() && size > 0.0 {
-                    own
-                } else {
-                    0.0
-                };
-                Some((q.name().to_string(), change.max(own)))
-            })
-            .collect();
-        let done = changes.values().all(|c| *c <= goal);
-        if !done && m < n << MAX_DOUBLINGS {
-            stopped = too_dear::<F>(exp, m, spent, evaluations(&fine));
+    let changes = loop {
+        let changes = changes_between::<F>(exp, &coarse, &fine);
+        if changes.values().all(|c| *c <= goal) || m >= n << MAX_DOUBLINGS {
+            break changes;
         }
-        if !done && m < n << MAX_DOUBLINGS && stopped.is_none() {
-            // A reference that goes on doubling says so, or a long one looks
-            // like a hang.
-            let largest = changes.values().copied().fold(0.0, f64::max);
-            crate::say!(
-                "{}: the converged reference changed by {largest:.1e} from n = {} to {m} (goal \
-                 {goal:.0e}): doubling to n = {}",
-                exp.spec.name,
-                m / 2,
-                m * 2
-            );
+        stopped = too_dear::<F>(exp, m, spent, evaluations(&fine));
+        if stopped.is_some() {
+            break changes;
         }
-        if done || m >= n << MAX_DOUBLINGS || stopped.is_some() {
-            // Each channel's change or own error estimate, the larger.
-            let per_channel: BTreeMap<String, Vec<f64>> = exp
-                .spec
-                .quantities
-                .iter()
-                .filter_map(|q| {
-                    let (x, y) = (coarse.get(q)?, fine.get(q)?);
-                    let each = (0..y.value.len())
-                        .map(|c| {
-                            let change = match x.value.get(c) {
-                                Some(&a) => (a - y.value[c]).abs(),
-                                None => f64::NAN,
-                            };
-                            let own = y.error.get(c).copied().filter(|e| e.is_finite());
-                            // Never below the rounding floor (as the whole
-                            // quantity's): a background channel of 0.1 every
-                            // ray sees alike changed by 0, yet the rules'
-                            // weights summed it to 0.09999999999999999, a
-                            // display step below the reference's 25.5.
-                            own.map_or(change, |e| change.max(e.abs()))
-                                .max(CONVERGED_FLOOR * y.value[c].abs())
-                        })
-                        .collect();
-                    Some((q.name().to_string(), each))
-                })
-                .collect();
-            break (fine, changes, per_channel);
+        // A reference that goes on doubling says so, or a long one looks
+        // like a hang.
+        let largest = changes.values().copied().fold(0.0, f64::max);
+        crate::say!(
+            "{}: the converged reference changed by {largest:.1e} from n = {} to {m} (goal \
+             {goal:.0e}): doubling to n = {}",
+            exp.spec.name,
+            m / 2,
+            m * 2
+        );
+        // An evaluation past the first two that fails (a family's own
+        // limit on its cost) ends the doubling; the last two stand.
+        match converged_measured(exp, 2 * m) {
+            Ok(next) => {
+                spent += evaluations(&next);
+                coarse = std::mem::replace(&mut fine, next);
+                m *= 2;
+            }
+            Err(e) => {
+                stopped = Some(format!(
+                    "it stopped doubling at n = {m}: the evaluation at n = {} failed: {e}",
+                    2 * m
+                ));
+                break changes;
+            }
         }
-        coarse = fine;
     };
+    let per_channel = per_channel_changes::<F>(exp, &coarse, &fine);
     let mut values = BTreeMap::new();
     let mut missing = BTreeMap::new();
     let mut accuracy = BTreeMap::new();

@@ -575,18 +575,8 @@ impl Family for Whitted {
         n: usize,
         quantities: &[WhittedQuantity],
     ) -> Result<Outcome<WhittedQuantity>, QuadError> {
-        let rule = AnyRule::Base(BaseRule::GenzMalik(GenzMalik {
-            abs_tol: 0.0,
-            rel_tol: 0.0,
-        }));
-        let per_pixel = CONVERGED_PER_N.saturating_mul(n);
-        let budget = |q: WhittedQuantity| {
-            if q == WhittedQuantity::Image {
-                (per_pixel / 16).max(rule.min_budget(2))
-            } else {
-                per_pixel
-            }
-        };
+        let rule = converged_rule();
+        let budget = |q| converged_budget(n, q);
         converged_affordable(built, n, quantities.iter().map(|&q| (q, budget(q))))?;
         let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
         quantities
@@ -606,12 +596,49 @@ impl Family for Whitted {
             .collect()
     }
 
+    /// [`Self::converged`]'s Genz–Malik over each pixel's pieces at
+    /// [`converged_budget`], priced by [`Whitted::cost`] (the ray tree
+    /// counted).
+    fn converged_cost(built: &Built, n: usize, quantities: &[WhittedQuantity]) -> [f64; 2] {
+        let rule = Method::Rule(converged_rule());
+        let evaluations = quantities
+            .iter()
+            .map(|&q| Whitted::cost(built, &rule, converged_budget(n, q), q))
+            .sum();
+        let bytes = quantities
+            .iter()
+            .map(|&q| Whitted::memory(built, &rule, converged_budget(n, q), q))
+            .fold(0.0, f64::max);
+        [evaluations, bytes]
+    }
+
     fn settings(spec: &SceneSpec) -> String {
         settings(spec)
     }
 
     fn scene_audit(built: &Built) -> Option<String> {
         Some(terms_section(built))
+    }
+}
+
+/// The converged evaluation's rule: Genz–Malik spending its whole budget
+/// (no tolerance stops it).
+fn converged_rule() -> AnyRule {
+    AnyRule::Base(BaseRule::GenzMalik(GenzMalik {
+        abs_tol: 0.0,
+        rel_tol: 0.0,
+    }))
+}
+
+/// The converged evaluation's budget for `q` at `n`: [`CONVERGED_PER_N`]
+/// `n` a pixel, a sixteenth of it for each pixel of an image (at least
+/// Genz–Malik's one region).
+fn converged_budget(n: usize, q: WhittedQuantity) -> usize {
+    let per_pixel = CONVERGED_PER_N.saturating_mul(n);
+    if q == WhittedQuantity::Image {
+        (per_pixel / 16).max(converged_rule().min_budget(2))
+    } else {
+        per_pixel
     }
 }
 
@@ -628,10 +655,7 @@ fn converged_affordable(
     budgets: impl Iterator<Item = (WhittedQuantity, usize)>,
 ) -> Result<(), QuadError> {
     use crate::experiment::validate::{MAX_JOB_EVALUATIONS, cost_limit_lifted};
-    let rule = Method::Rule(AnyRule::Base(BaseRule::GenzMalik(GenzMalik {
-        abs_tol: 0.0,
-        rel_tol: 0.0,
-    })));
+    let rule = Method::Rule(converged_rule());
     let cost: f64 = budgets
         .map(|(q, budget)| Whitted::cost(built, &rule, budget, q))
         .sum();
