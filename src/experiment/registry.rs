@@ -349,7 +349,11 @@ impl Registry {
         if !json.is_object() {
             return Err(SpecError::at(
                 ".",
-                format!("an experiment file is a JSON object, not {json}"),
+                format!(
+                    "an experiment file is a JSON object, not {} ({})",
+                    json_kind(&json),
+                    crate::error::excerpt(&json.to_string())
+                ),
             ));
         }
         let tag = match json.get("family") {
@@ -358,7 +362,10 @@ impl Registry {
             Some(other) => {
                 return Err(SpecError::at(
                     "family",
-                    format!("{other} is not a family name: {accepted}"),
+                    format!(
+                        "{} is not a family name: {accepted}",
+                        crate::error::excerpt(&other.to_string())
+                    ),
                 ));
             }
         };
@@ -463,4 +470,16 @@ fn prefix_refs(v: &mut serde_json::Value, family: &str) {
 /// Method names for a family, for messages.
 pub fn method_names<F: Family>() -> Vec<&'static str> {
     Method::<F::Estimator>::names()
+}
+
+/// What kind of JSON value `json` is, in words.
+fn json_kind(json: &serde_json::Value) -> &'static str {
+    match json {
+        serde_json::Value::Null => "null",
+        serde_json::Value::Bool(_) => "a boolean",
+        serde_json::Value::Number(_) => "a number",
+        serde_json::Value::String(_) => "a string",
+        serde_json::Value::Array(_) => "an array",
+        serde_json::Value::Object(_) => "an object",
+    }
 }
