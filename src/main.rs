@@ -49,6 +49,7 @@ enum Command {
         /// Experiment files; none runs the bundled suite.
         files: Vec<PathBuf>,
         /// Output folder: <out>/index.md, <out>/index.html, <out>/<experiment>/.
+        /// It may be a link; a link inside it where the run writes is refused.
         #[arg(long, default_value = "report")]
         out: PathBuf,
         /// Keep the jobs an interrupted run finished and run only the rest.

@@ -299,8 +299,16 @@ impl Drop for ReportFiles {
 
 /// [`write_atomic`] for a report's files, its failure in words with the
 /// file named (a full disk said only "No space left on device"); recorded
-/// for [`ReportFiles`].
+/// for [`ReportFiles`] once written (a write that failed left nothing of
+/// ours at the path, and what is there, a link refused, stays).
 pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    write_atomic(path, bytes).map_err(|e| {
+        format!(
+            "cannot write {}: {}",
+            path.display(),
+            crate::experiment::source::describe(&e)
+        )
+    })?;
     WRITTEN.with(|w| {
         if let Some(list) = w.borrow().as_ref() {
             list.lock()
@@ -308,13 +316,7 @@ pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
                 .push(path.to_path_buf());
         }
     });
-    write_atomic(path, bytes).map_err(|e| {
-        format!(
-            "cannot write {}: {}",
-            path.display(),
-            crate::experiment::source::describe(&e)
-        )
-    })
+    Ok(())
 }
 
 /// Whether `name` is one of [`write_atomic`]'s temporary files
