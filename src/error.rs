@@ -153,15 +153,21 @@ pub fn excerpt(value: &str) -> String {
 }
 
 /// A value as a person reads it in a message: a long number in scientific
-/// notation (1e200 was echoed as its 201 digits), and any other text cut to
-/// an [`excerpt`] (a 10 MB name was echoed whole).
+/// notation (1e200 was echoed as its 201 digits), and any other text cut
+/// after 200 characters (a 10 MB name was echoed whole). For a value of
+/// ours (a formatted number, a described ray); a user's text is quoted as
+/// an [`excerpt`].
 pub fn shortened(value: String) -> String {
+    const LONGEST: usize = 200;
     if value.len() > 24
         && let Ok(x) = value.parse::<f64>()
     {
         return format!("{x:e}");
     }
-    excerpt(&value)
+    match value.char_indices().nth(LONGEST) {
+        Some((cut, _)) => format!("{}... ({} bytes)", &value[..cut], value.len()),
+        None => value,
+    }
 }
 
 /// A message as it is shown: its numbers short ([`short_numbers`]) and
