@@ -130,9 +130,33 @@ impl QuadError {
     }
 }
 
+/// The most characters of a user's value (a name, a string, a key, a file's
+/// JSON) a message quotes: past it the value is cut to an excerpt, so a
+/// message never echoes a whole file back (a file holding one long string
+/// was printed whole, 100 KB on stderr).
+pub const EXCERPT_CHARS: usize = 60;
+
+/// `value` cut to its first [`EXCERPT_CHARS`] characters, elided with `…`
+/// and its length said, where it is longer.
+///
+/// ```
+/// use lightquad::error::excerpt;
+/// assert_eq!(excerpt("short"), "short");
+/// let long = "x".repeat(1000);
+/// assert_eq!(excerpt(&long), format!("{}… (1000 characters)", "x".repeat(60)));
+/// ```
+pub fn excerpt(value: &str) -> String {
+    match value.char_indices().nth(EXCERPT_CHARS) {
+        Some((cut, _)) => format!("{}… ({} characters)", &value[..cut], value.chars().count()),
+        None => value.to_string(),
+    }
+}
+
 /// A value as a person reads it in a message: a long number in scientific
 /// notation (1e200 was echoed as its 201 digits), and any other text cut
-/// after 200 characters (a 10 MB name was echoed whole).
+/// after 200 characters (a 10 MB name was echoed whole). For a value of
+/// ours (a formatted number, a described ray); a user's text is quoted as
+/// an [`excerpt`].
 pub fn shortened(value: String) -> String {
     const LONGEST: usize = 200;
     if value.len() > 24
@@ -144,6 +168,100 @@ pub fn shortened(value: String) -> String {
         Some((cut, _)) => format!("{}... ({} bytes)", &value[..cut], value.len()),
         None => value,
     }
+}
+
+/// A message as it is shown: its numbers short ([`short_numbers`]) and
+/// every quoted value in it (`"..."`, or between backticks, as serde quotes
+/// what it read: `invalid type: string "..."`, ``unknown field `...` ``)
+/// cut to an [`excerpt`]. Every error and warning lightquad prints passes
+/// here, so no message echoes more than an excerpt of a user's value.
+///
+/// ```
+/// use lightquad::error::readable;
+/// let secret = "s".repeat(500);
+/// let shown = readable(&format!("invalid type: string \"{secret}\", expected a map"));
+/// assert_eq!(
+///     shown,
+///     format!("invalid type: string \"{}…\" (500 characters), expected a map", "s".repeat(60))
+/// );
+/// assert_eq!(readable("unknown field `radius`"), "unknown field `radius`");
+/// ```
+pub fn readable(text: &str) -> String {
+    bounded_quotes(&short_numbers(text))
+}
+
+/// `text` with the inside of every `"..."` (escapes skipped) and
+/// `` `...` `` longer than [`EXCERPT_CHARS`] cut to an [`excerpt`], the
+/// count after the closing quote; what follows a quote left open is kept.
+fn bounded_quotes(text: &str) -> String {
+    let mut out = String::with_capacity(text.len().min(4096));
+    let mut rest = text;
+    while let Some(open) = rest.find(['"', '`']) {
+        let quote = rest.as_bytes()[open];
+        out.push_str(&rest[..=open]);
+        let inside = &rest[open + 1..];
+        let close = closing(inside, quote);
+        // A quote left open is text of ours (an excerpt of a JSON value cut
+        // inside a string): the rest is left as it is.
+        let Some(close) = close else {
+            out.push_str(inside);
+            return out;
+        };
+        let value = &inside[..close];
+        // An excerpt already (the message was made readable before) is kept.
+        let excerpted = value.ends_with('…') && value.chars().count() == EXCERPT_CHARS + 1;
+        match value
+            .char_indices()
+            .nth(EXCERPT_CHARS)
+            .filter(|_| !excerpted)
+        {
+            Some((cut, _)) => {
+                out.push_str(&value[..cut]);
+                out.push('…');
+                out.push(char::from(quote));
+                out.push_str(&format!(" ({} characters)", value.chars().count()));
+            }
+            None => {
+                out.push_str(value);
+                out.push(char::from(quote));
+            }
+        }
+        rest = &inside[close + 1..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The byte index in `inside` of the quote that closes a quoted value opened
+/// by `quote`; a backslash escapes the next character inside `"..."`.
+fn closing(inside: &str, quote: u8) -> Option<usize> {
+    let bytes = inside.as_bytes();
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'\\' if quote == b'"' => i += 2,
+            b if b == quote => return Some(i),
+            _ => i += 1,
+        }
+    }
+    None
+}
+
+/// The most characters of one key a JSON path in a message shows.
+const PATH_KEY_CHARS: usize = 20;
+
+/// A JSON path as a message shows it: each key of it longer than
+/// [`PATH_KEY_CHARS`] cut and elided with `…` (a key is the user's text,
+/// quoted whole in the message beside it as an excerpt).
+fn readable_path(path: &str) -> String {
+    if path.len() <= EXCERPT_CHARS {
+        return path.to_string();
+    }
+    let key = |k: &str| match k.char_indices().nth(PATH_KEY_CHARS) {
+        Some((cut, _)) => format!("{}…", &k[..cut]),
+        None => k.to_string(),
+    };
+    path.split('.').map(key).collect::<Vec<_>>().join(".")
 }
 
 /// `text` with every number written in more than 24 characters put in
@@ -236,8 +354,8 @@ impl SpecError {
     /// An error at `path`.
     pub fn at(path: impl Into<String>, message: impl Into<String>) -> Self {
         SpecError {
-            path: path.into(),
-            message: short_numbers(&message.into()),
+            path: readable_path(&path.into()),
+            message: readable(&message.into()),
         }
     }
 
@@ -253,8 +371,8 @@ impl SpecError {
             _ => path.to_string(),
         };
         SpecError {
-            path,
-            message: short_numbers(&e.to_string()),
+            path: readable_path(&path),
+            message: readable(&e.to_string()),
         }
     }
 }

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
-use lightquad::error::short_numbers;
+use lightquad::error::readable;
 use lightquad::experiment;
 use lightquad::experiment::Source;
 use lightquad::experiment::run::RunOptions;
@@ -49,6 +49,7 @@ enum Command {
         /// Experiment files; none runs the bundled suite.
         files: Vec<PathBuf>,
         /// Output folder: <out>/index.md, <out>/index.html, <out>/<experiment>/.
+        /// It may be a link; a link inside it where the run writes is refused.
         #[arg(long, default_value = "report")]
         out: PathBuf,
         /// Keep the jobs an interrupted run finished and run only the rest.
@@ -85,6 +86,11 @@ enum Command {
         /// Output folder of the merged report.
         #[arg(long, default_value = "report")]
         out: PathBuf,
+        /// Merge shards whose results were computed by different builds of
+        /// lightquad (different git commits; refused by default); the report
+        /// names every commit.
+        #[arg(long)]
+        allow_mixed_commits: bool,
     },
     /// Print the families' audits of the source documents' printed formulas
     /// (Markdown; also at the end of every report's index).
@@ -126,7 +132,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            lightquad::say!("error: {}", short_numbers(&e.to_string()));
+            lightquad::say!("error: {}", readable(&e.to_string()));
             ExitCode::FAILURE
         }
     }
@@ -236,11 +242,7 @@ fn run(command: Command) -> Result<(), Failure> {
                     .into());
                 }
                 for w in exp.warnings() {
-                    lightquad::say!(
-                        "warning: {}: {}",
-                        f.display(),
-                        short_numbers(&w.to_string())
-                    );
+                    lightquad::say!("warning: {}: {}", f.display(), readable(&w.to_string()));
                 }
                 let (rules, budgets, repeats) = exp.shape();
                 let [jobs, reference] = exp.cost();
@@ -261,11 +263,18 @@ fn run(command: Command) -> Result<(), Failure> {
             }
         }
         Command::Schema => writeln!(out, "{}", serde_json::to_string_pretty(&registry.schema())?)?,
-        Command::Merge { inputs, out: dir } => {
+        Command::Merge {
+            inputs,
+            out: dir,
+            allow_mixed_commits,
+        } => {
             // A merge runs no job: the cost guard, which shards that needed
             // --no-cost-limit passed, would refuse to join them.
             experiment::validate::lift_cost_limit();
-            let index = experiment::merge(&registry, &inputs, &dir)?;
+            let options = experiment::MergeOptions {
+                allow_mixed_commits,
+            };
+            let index = experiment::merge_with(&registry, &inputs, &dir, &options)?;
             writeln!(out, "report: {}", index.display())?;
         }
         Command::Render {
@@ -374,7 +383,7 @@ fn run(command: Command) -> Result<(), Failure> {
                 lightquad::say!(
                     "warning: {}: {}",
                     source.display(),
-                    short_numbers(&w.to_string())
+                    readable(&w.to_string())
                 );
             }
             // Both files or neither: each is encoded, then written beside

@@ -9,12 +9,33 @@ use crate::experiment::registry::{Loaded, Registry};
 use crate::experiment::run::{self, JobResult, write_atomic};
 
 use super::input::load;
-use super::output::{keep_values, lock_output, writable};
+use super::output::{experiment_folder, keep_values, lock_output, no_top_links, writable};
 use super::{RunError, io, write_reports};
 
 /// Joins the shards' results under `inputs` (written by `run --shard k/n` into
-/// the same or copied folders) into one results file and report per experiment.
+/// the same or copied folders) into one results file and report per
+/// experiment; shards computed by different builds (git commits) are
+/// refused ([`merge_with`] can allow them).
 pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<PathBuf, RunError> {
+    merge_with(registry, inputs, out, &MergeOptions::default())
+}
+
+/// Options of a merge.
+#[derive(Debug, Clone, Default)]
+pub struct MergeOptions {
+    /// Merge shards whose results were computed by different builds of
+    /// lightquad (different git commits of one version); the report then
+    /// names every commit.
+    pub allow_mixed_commits: bool,
+}
+
+/// [`merge`] with `options`.
+pub fn merge_with(
+    registry: &Registry,
+    inputs: &[PathBuf],
+    out: &Path,
+    options: &MergeOptions,
+) -> Result<PathBuf, RunError> {
     let mut by_name: BTreeMap<String, Gathered> = BTreeMap::new();
     // Shards still writing into an input would be merged half done.
     let mut reading = Vec::new();
@@ -73,10 +94,18 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
             message: "no experiment folders (with an experiment.json) found: give the --out folders of the shards".into(),
         });
     }
+    if !options.allow_mixed_commits {
+        one_build(inputs, &by_name)?;
+    }
     writable(out)?;
     // The inputs have been read; `out` may be one of them.
     drop(reading);
     let _lock = lock_output(out, None)?;
+    // No link where the merge writes (a link there was written through).
+    no_top_links(out)?;
+    for name in by_name.keys() {
+        experiment_folder(&out.join(name))?;
+    }
     run::remove_stale_temporaries(out);
     run::clear_reports(out, by_name.keys().map(String::as_str));
     let mut missing = Vec::new();
@@ -87,6 +116,7 @@ pub fn merge(registry: &Registry, inputs: &[PathBuf], out: &Path) -> Result<Path
             mut results,
             spec,
             unread,
+            ..
         } = g;
         // One result per job of this experiment, a finished one before a
         // failed one where shards disagree.
@@ -154,6 +184,64 @@ struct Gathered {
     results: Vec<JobResult>,
     spec: Vec<u8>,
     unread: run::Unread,
+    /// The files the results came from, by the build (git commit) that
+    /// computed them.
+    builds: BTreeMap<String, BTreeSet<PathBuf>>,
+}
+
+/// The build that computed a result, as reports name it.
+fn build_of(r: &JobResult) -> &str {
+    r.git_commit.as_deref().unwrap_or("unknown")
+}
+
+/// Refuses results of more than one build (git commit) among the gathered
+/// shards: each is named with the results files that hold it (a report
+/// named only the first one's commit).
+fn one_build(inputs: &[PathBuf], by_name: &BTreeMap<String, Gathered>) -> Result<(), RunError> {
+    let mut builds: BTreeMap<&str, BTreeSet<&Path>> = BTreeMap::new();
+    for g in by_name.values() {
+        for (build, files) in &g.builds {
+            builds
+                .entry(build)
+                .or_default()
+                .extend(files.iter().map(PathBuf::as_path));
+        }
+    }
+    if builds.len() < 2 {
+        return Ok(());
+    }
+    /// Files named per build; the rest are counted.
+    const NAMED: usize = 3;
+    let each: Vec<String> = builds
+        .iter()
+        .map(|(build, files)| {
+            let mut names: Vec<String> = files
+                .iter()
+                .take(NAMED)
+                .map(|f| f.display().to_string())
+                .collect();
+            if files.len() > NAMED {
+                names.push(format!("{} more", files.len() - NAMED));
+            }
+            format!("commit {build} (in {})", names.join(", "))
+        })
+        .collect();
+    Err(RunError::Io {
+        path: inputs
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        message: format!(
+            "the shards' results were computed by {} different builds of lightquad {}: {}; \
+             expected the results of one build (run the other shards again with one \
+             build), or pass --allow-mixed-commits to merge them with the report naming \
+             every commit",
+            builds.len(),
+            env!("CARGO_PKG_VERSION"),
+            each.join("; ")
+        ),
+    })
 }
 
 /// Whether two results of one job hold different values or errors (bit for
@@ -186,6 +274,7 @@ fn gather(
         results: Vec::new(),
         spec,
         unread: run::Unread::default(),
+        builds: BTreeMap::new(),
     });
     if slot.exp.hash() != hash {
         return Err(io(
@@ -210,11 +299,17 @@ fn gather(
         let (lines, unread) = run::read_results_counted(&f, Some(&hash));
         let (lines, misfits) = slot.exp.reusable(lines);
         slot.unread.unreadable += unread.unreadable + misfits;
-        slot.results.extend(
-            lines
-                .into_iter()
-                .filter(|r| r.version == env!("CARGO_PKG_VERSION")),
-        );
+        let lines: Vec<JobResult> = lines
+            .into_iter()
+            .filter(|r| r.version == env!("CARGO_PKG_VERSION"))
+            .collect();
+        for r in &lines {
+            slot.builds
+                .entry(build_of(r).to_string())
+                .or_default()
+                .insert(f.clone());
+        }
+        slot.results.extend(lines);
     }
     Ok(())
 }

@@ -65,8 +65,8 @@ pub use validate::SpecError;
 
 use input::load_all;
 pub use input::{experiment_files, load, load_source};
-pub use merge::merge;
-use output::{experiment_folder, keep_values, lock_output, writable};
+pub use merge::{MergeOptions, merge, merge_with};
+use output::{experiment_folder, keep_values, lock_output, no_top_links, writable};
 
 /// An error of a run, naming the file (and the JSON path when it is a spec fault).
 #[derive(Debug, thiserror::Error)]
@@ -152,7 +152,11 @@ pub fn run_sources(
     if opts.progress {
         for (exp, _, _) in &loaded {
             for w in exp.warnings() {
-                crate::say!("warning: {}: {w}", exp.name());
+                crate::say!(
+                    "warning: {}: {}",
+                    exp.name(),
+                    crate::error::readable(&w.to_string())
+                );
             }
         }
     }
@@ -208,10 +212,18 @@ pub fn run_sources(
     // Every experiment's folder and files, before any job runs: a file where
     // a folder goes (or a folder where a file goes) stopped the run after
     // the experiments before it had run, with "already exists".
+    // No link where the run writes, in the folder or in an experiment's
+    // (a link there was written through, to wherever it pointed).
+    no_top_links(&opts.out)?;
     for (exp, _, _) in &loaded {
         experiment_folder(&opts.out.join(exp.name()))?;
     }
-    run::clear_reports(&opts.out, loaded.iter().map(|(e, _, _)| e.name()));
+    // A shard writes its own results file and no report: the pages there
+    // (a whole run's, or a merge's) stay, still those of the results beside
+    // them. A whole run's pages go until its own are written.
+    if opts.shard.is_none() {
+        run::clear_reports(&opts.out, loaded.iter().map(|(e, _, _)| e.name()));
+    }
     let total: usize = loaded
         .iter()
         .map(|(e, _, _)| e.jobs(opts.shard).len())

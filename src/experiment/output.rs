@@ -6,7 +6,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use crate::experiment::registry::Loaded;
-use crate::experiment::run::write_atomic;
+use crate::experiment::run::{WRITTEN_AT_TOP, links, write_atomic, written_here};
 use crate::experiment::source;
 
 use super::{RunError, io};
@@ -22,13 +22,13 @@ pub(super) fn lock_output(
     out: &Path,
     shard: Option<(usize, usize)>,
 ) -> Result<Vec<fs::File>, RunError> {
+    // Never through a link: a link to nothing there had its target created.
     let open = |name: String| {
         let path = out.join(name);
-        fs::OpenOptions::new()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
+        if links::is_link(&path) {
+            return Err(io(&path, links::link_words(&path)));
+        }
+        links::open_or_create(&path)
             .map(|f| (f, path.clone()))
             .map_err(|e| io(&path, e))
     };
@@ -84,17 +84,40 @@ pub(super) fn keep_values(exp: &dyn Loaded, dir: &Path) -> Result<(), RunError> 
     Ok(())
 }
 
+/// Refuses a link where the run writes into the output folder itself (its
+/// index pages); the experiment folders are [`experiment_folder`]'s.
+pub(super) fn no_top_links(out: &Path) -> Result<(), RunError> {
+    for name in WRITTEN_AT_TOP {
+        let path = out.join(name);
+        if links::is_link(&path) {
+            return Err(io(&path, links::link_words(&path)));
+        }
+    }
+    Ok(())
+}
+
 /// Makes an experiment's folder under `--out` (or finds it there), with no
-/// folder where its files go; what is in the way is named.
+/// folder where its files go and no link where it or its files go; what is
+/// in the way is named.
 pub(super) fn experiment_folder(dir: &Path) -> Result<(), RunError> {
+    if links::is_link(dir) {
+        return Err(io(dir, links::link_words(dir)));
+    }
     if fs::symlink_metadata(dir).is_ok() && !dir.is_dir() {
         return Err(io(
             dir,
-            "is in the way: a file (or a broken link) where this experiment's results folder \
+            "is in the way: a file where this experiment's results folder \
              goes; expected a folder or nothing (remove it, or choose another --out)",
         ));
     }
     fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    let entries = fs::read_dir(dir).map_err(|e| io(dir, e))?;
+    for e in entries.flatten() {
+        let written = e.file_name().to_str().is_some_and(written_here);
+        if written && e.file_type().is_ok_and(|t| t.is_symlink()) {
+            return Err(io(&e.path(), links::link_words(&e.path())));
+        }
+    }
     for file in [
         "experiment.json",
         "results.jsonl",

@@ -364,7 +364,11 @@ impl Registry {
         if !json.is_object() {
             return Err(SpecError::at(
                 ".",
-                format!("an experiment file is a JSON object, not {json}"),
+                format!(
+                    "an experiment file is a JSON object, not {} ({})",
+                    json_kind(&json),
+                    crate::error::excerpt(&json.to_string())
+                ),
             ));
         }
         let tag = match json.get("family") {
@@ -373,7 +377,10 @@ impl Registry {
             Some(other) => {
                 return Err(SpecError::at(
                     "family",
-                    format!("{other} is not a family name: {accepted}"),
+                    format!(
+                        "{} is not a family name: {accepted}",
+                        crate::error::excerpt(&other.to_string())
+                    ),
                 ));
             }
         };
@@ -478,4 +485,16 @@ fn prefix_refs(v: &mut serde_json::Value, family: &str) {
 /// Method names for a family, for messages.
 pub fn method_names<F: Family>() -> Vec<&'static str> {
     Method::<F::Estimator>::names()
+}
+
+/// What kind of JSON value `json` is, in words.
+fn json_kind(json: &serde_json::Value) -> &'static str {
+    match json {
+        serde_json::Value::Null => "null",
+        serde_json::Value::Bool(_) => "a boolean",
+        serde_json::Value::Number(_) => "a number",
+        serde_json::Value::String(_) => "a string",
+        serde_json::Value::Array(_) => "an array",
+        serde_json::Value::Object(_) => "an object",
+    }
 }

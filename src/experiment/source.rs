@@ -183,6 +183,8 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
     if let Origin::Folder(dir) = origin {
         if let Some(file) = named {
             let path = resolve(dir, file);
+            // The name is the user's text: said as an excerpt.
+            let shown = crate::error::excerpt(&path.display().to_string());
             let json = read_text(&path).and_then(|t| values_json(&t));
             // A file that is there but is no values file is the fault, even
             // where other (stale) values are found.
@@ -190,14 +192,14 @@ pub fn find_values(origin: &Origin, name: &str, hash: &str, named: Option<&str>)
                 && path.exists()
             {
                 return Values::NotValues {
-                    location: path.display().to_string(),
+                    location: shown,
                     why: why.clone(),
                 };
             }
             if let Err(why) = &json {
-                named_missing = Some(format!("{} ({why})", path.display()));
+                named_missing = Some(format!("{shown} ({why})"));
             }
-            places.push((path.display().to_string(), json));
+            places.push((shown, json));
         }
         let copy = dir.join(VALUES_COPY);
         if copy.is_file() {
@@ -271,6 +273,17 @@ pub fn values_json(text: &str) -> Result<serde_json::Value, String> {
     .map(|(field, _)| field)
     .collect();
     if missing.is_empty() {
+        // The hash is said in messages (a stale file's): only one of the
+        // form lightquad writes, never any string a JSON file holds.
+        let hash = json["experiment_hash"].as_str().unwrap_or("");
+        if !is_file_hash(hash) {
+            return Err(format!(
+                "not a Mitsuba values file: its `experiment_hash` ({} characters) is not a hash \
+                 of an experiment file (16 lowercase hexadecimal digits, as scripts/reference.sh \
+                 writes it)",
+                hash.chars().count()
+            ));
+        }
         Ok(json)
     } else {
         Err(format!(
@@ -283,6 +296,12 @@ pub fn values_json(text: &str) -> Result<serde_json::Value, String> {
                 .join(" and ")
         ))
     }
+}
+
+/// Whether `hash` has the form of [`crate::experiment::run::file_hash`]'s:
+/// 16 lowercase hexadecimal digits.
+fn is_file_hash(hash: &str) -> bool {
+    hash.len() == 16 && hash.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'))
 }
 
 /// Why a file operation failed, in words with the operating system's own

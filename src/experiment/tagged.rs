@@ -55,7 +55,7 @@ pub fn split_tag<E: Error>(value: Value, tag: &str, names: &[&str]) -> Result<(S
             tag,
             &format!(
                 "unknown variant {}: {}",
-                crate::error::shortened(other.to_string()),
+                crate::error::excerpt(&other.to_string()),
                 accepted()
             ),
         )),
@@ -390,7 +390,7 @@ pub fn kind(value: &Value) -> String {
         Value::Array(_) => "a list",
         Value::Object(_) => "an object",
     };
-    format!("{what} {}", crate::error::shortened(value.to_string()))
+    format!("{what} {}", crate::error::excerpt(&value.to_string()))
 }
 
 /// The names a unit enum accepts, as serde lists them (`` `cumulative` or

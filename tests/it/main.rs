@@ -27,6 +27,7 @@ mod input_leftovers;
 mod line_sum_par;
 mod memory_estimate;
 mod mitsuba;
+mod output_safety;
 mod parallel;
 mod properties;
 mod reference_bounds;

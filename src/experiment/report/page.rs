@@ -164,15 +164,35 @@ fn header(page: &Page, results: &[JobResult]) -> String {
 pub const SHARED: &str = " Each quantity is evaluated and timed on its own (a job evaluates only \
 the terms that quantity needs), so its times are its own cost.";
 
-/// The version, commit, machine and experiment hash of a run, in words.
+/// The version, commit, machine and experiment hash of a run, in words;
+/// every commit with its count of jobs where the results come from several
+/// builds (a merge allowed to mix them, or a `--resume` after a rebuild).
 pub fn provenance(results: &[JobResult]) -> Option<String> {
+    let mut builds: std::collections::BTreeMap<&str, usize> = std::collections::BTreeMap::new();
+    for r in results {
+        *builds
+            .entry(r.git_commit.as_deref().unwrap_or("unknown"))
+            .or_default() += 1;
+    }
+    let commits = match builds.len() {
+        1 => format!(
+            "commit {}",
+            builds.keys().next().copied().unwrap_or("unknown")
+        ),
+        _ => format!(
+            "results of {} builds: {}",
+            builds.len(),
+            builds
+                .iter()
+                .map(|(c, n)| format!("commit {c} ({n} jobs)"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
     results.first().map(|r| {
         format!(
-            "lightquad {} (commit {}), {}, experiment hash {}.",
-            r.version,
-            r.git_commit.as_deref().unwrap_or("unknown"),
-            r.machine,
-            r.experiment_hash
+            "lightquad {} ({commits}), {}, experiment hash {}.",
+            r.version, r.machine, r.experiment_hash
         )
     })
 }

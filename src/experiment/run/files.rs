@@ -13,7 +13,7 @@ use serde::Deserialize;
 use crate::experiment::validate::Experiment;
 use crate::family::{Family, Quantity};
 
-use super::{JobKey, JobResult, job_seed, jobs};
+use super::{JobKey, JobResult, job_seed, jobs, links};
 
 /// The results read back from a file (`--resume`, `merge`) that are results
 /// of `exp`'s jobs as this version runs them: a job of its list, by the rule
@@ -117,8 +117,12 @@ pub(super) fn results_of(path: &Path, hash: &str) -> usize {
 }
 
 /// Writes `text` to `path` atomically (a temporary file, then a rename), so a
-/// reader never sees a half-written file.
+/// reader never sees a half-written file. A link at `path` is refused, not
+/// followed ([`super::links`]); the temporary file is created new (a link
+/// at its name fails it), and the rename replaces the entry at `path`, so a
+/// link put there meanwhile is replaced, never written through.
 pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
+    links::refuse_link(path)?;
     // A name no other process or thread writing beside us can pick (shards of
     // one run may share an output folder).
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
@@ -127,11 +131,18 @@ pub fn write_atomic(path: &Path, text: &[u8]) -> std::io::Result<()> {
         .file_name()
         .map_or("out".into(), |n| n.to_string_lossy().to_string());
     let tmp = path.with_file_name(format!(".{name}.{}.{unique}.tmp", std::process::id()));
-    let written = File::create(&tmp)
-        .and_then(|mut f| {
-            f.write_all(text)?;
-            f.sync_all()
-        })
+    // A name that is taken (a link planted there) fails here, and is not
+    // ours to remove.
+    let mut file = links::create_new(&tmp).map_err(|e| {
+        if links::is_link(&tmp) {
+            links::link_error(&tmp)
+        } else {
+            e
+        }
+    })?;
+    let written = file
+        .write_all(text)
+        .and_then(|()| file.sync_all())
         .and_then(|()| fs::rename(&tmp, path));
     // A write that failed (a full disk) leaves no temporary file behind.
     if written.is_err() {
@@ -288,8 +299,16 @@ impl Drop for ReportFiles {
 
 /// [`write_atomic`] for a report's files, its failure in words with the
 /// file named (a full disk said only "No space left on device"); recorded
-/// for [`ReportFiles`].
+/// for [`ReportFiles`] once written (a write that failed left nothing of
+/// ours at the path, and what is there, a link refused, stays).
 pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    write_atomic(path, bytes).map_err(|e| {
+        format!(
+            "cannot write {}: {}",
+            path.display(),
+            crate::experiment::source::describe(&e)
+        )
+    })?;
     WRITTEN.with(|w| {
         if let Some(list) = w.borrow().as_ref() {
             list.lock()
@@ -297,13 +316,7 @@ pub fn write_report_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
                 .push(path.to_path_buf());
         }
     });
-    write_atomic(path, bytes).map_err(|e| {
-        format!(
-            "cannot write {}: {}",
-            path.display(),
-            crate::experiment::source::describe(&e)
-        )
-    })
+    Ok(())
 }
 
 /// Whether `name` is one of [`write_atomic`]'s temporary files
@@ -325,17 +338,39 @@ fn is_temporary(name: &str) -> bool {
 /// the experiment file are not among them.
 const REPORT_EXTENSIONS: [&str; 6] = ["md", "html", "csv", "svg", "png", "pfm"];
 
+/// Whether a run or a merge writes a file named `name` into an experiment's
+/// folder: the experiment file, its Mitsuba values, results (a shard's
+/// too) and the report's files.
+pub fn written_here(name: &str) -> bool {
+    let report = Path::new(name)
+        .extension()
+        .and_then(|x| x.to_str())
+        .is_some_and(|x| REPORT_EXTENSIONS.contains(&x));
+    report
+        || name == "experiment.json"
+        || name == crate::experiment::source::VALUES_COPY
+        || (name.starts_with("results") && name.ends_with(".jsonl"))
+}
+
+/// The files a run or a merge writes into the output folder itself.
+pub const WRITTEN_AT_TOP: [&str; 2] = ["index.md", "index.html"];
+
 /// Removes what an earlier run's report wrote: the index of `out` and the
-/// report files of the experiment folders `names`. A run that is killed
-/// before its own report is written then leaves no report, rather than the
-/// earlier one looking complete beside the new results (and no image of a
-/// rule the experiment no longer has).
+/// report files of the experiment folders `names` (regular files only: a
+/// folder that is a link is not entered). A run that is killed before its
+/// own report is written then leaves no report, rather than the earlier one
+/// looking complete beside the new results (and no image of a rule the
+/// experiment no longer has).
 pub fn clear_reports<'a>(out: &Path, names: impl IntoIterator<Item = &'a str>) {
-    for index in ["index.md", "index.html"] {
+    for index in WRITTEN_AT_TOP {
         let _ = fs::remove_file(out.join(index));
     }
     for name in names {
-        let Ok(entries) = fs::read_dir(out.join(name)) else {
+        let dir = out.join(name);
+        if links::is_link(&dir) {
+            continue;
+        }
+        let Ok(entries) = fs::read_dir(&dir) else {
             continue;
         };
         for e in entries.flatten() {
@@ -344,7 +379,7 @@ pub fn clear_reports<'a>(out: &Path, names: impl IntoIterator<Item = &'a str>) {
                 .extension()
                 .and_then(|x| x.to_str())
                 .is_some_and(|x| REPORT_EXTENSIONS.contains(&x));
-            if report && path.is_file() {
+            if report && e.file_type().is_ok_and(|t| t.is_file()) {
                 let _ = fs::remove_file(&path);
             }
         }
@@ -358,14 +393,22 @@ pub fn remove_stale_temporaries(out: &Path) {
     let Ok(top) = fs::read_dir(out) else {
         return;
     };
+    // Folders and files as they are, links not followed: a link to a folder
+    // elsewhere is not entered.
     let mut dirs = vec![out.to_path_buf()];
-    dirs.extend(top.flatten().map(|e| e.path()).filter(|p| p.is_dir()));
+    dirs.extend(
+        top.flatten()
+            .filter(|e| e.file_type().is_ok_and(|t| t.is_dir()))
+            .map(|e| e.path()),
+    );
     for dir in dirs {
         let Ok(entries) = fs::read_dir(&dir) else {
             continue;
         };
         for e in entries.flatten() {
-            if e.file_name().to_str().is_some_and(is_temporary) && e.path().is_file() {
+            if e.file_name().to_str().is_some_and(is_temporary)
+                && e.file_type().is_ok_and(|t| t.is_file())
+            {
                 let _ = fs::remove_file(e.path());
             }
         }

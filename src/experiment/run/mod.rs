@@ -50,12 +50,13 @@ use super::validate::{Experiment, min_budget};
 use crate::family::{Family, Measured, Quantity};
 
 mod files;
+pub mod links;
 
 use files::results_of;
 pub use files::{
-    ReportFiles, Unread, clear_reports, read_results, read_results_counted,
+    ReportFiles, Unread, WRITTEN_AT_TOP, clear_reports, read_results, read_results_counted,
     remove_stale_temporaries, results_path, reusable, write_all_or_none, write_atomic,
-    write_report_file,
+    write_report_file, written_here,
 };
 
 /// A job's identity within its experiment: (rule index, budget, repeat).
@@ -219,7 +220,7 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
                 }
             }
             Err(e) => {
-                out.failure = Some(crate::error::short_numbers(&format!("{}: {e}", q.name())));
+                out.failure = Some(crate::error::readable(&format!("{}: {e}", q.name())));
                 return out;
             }
         }
@@ -400,6 +401,7 @@ pub fn run_experiment_in_lanes(
     lanes: usize,
 ) -> std::io::Result<Vec<JobResult>> {
     let dir = opts.out.join(exp.name());
+    links::refuse_link(&dir)?;
     fs::create_dir_all(&dir)?;
     let path = results_path(&opts.out, exp.name(), opts.shard);
     // Keep finished jobs on --resume (rewriting the file without a torn last
@@ -461,7 +463,10 @@ pub fn run_experiment_in_lanes(
         all_jobs - pending.len(),
         opts.progress && progress.is_hidden(),
     );
-    let file = Mutex::new(OpenOptions::new().append(true).open(&path)?);
+    let file = Mutex::new(links::open_unlinked(
+        &path,
+        OpenOptions::new().append(true),
+    )?);
     let run = |&key: &JobKey| {
         let result = exp.run_job(key);
         let line = serde_json::to_string(&result).map_err(std::io::Error::other)? + "\n";
