@@ -247,14 +247,16 @@ fn run(command: Command) -> Result<(), Failure> {
                 let (rules, budgets, repeats) = exp.shape();
                 let [jobs, reference] = exp.cost();
                 let reference = if reference > 0.0 {
-                    format!(", its reference stage up to {reference:.1e} at the rules' caps")
+                    format!(", its reference stage up to {reference:.1e}")
                 } else {
                     String::new()
                 };
                 writeln!(
                     out,
                     "{}: ok ({}, family {}, {rules} rule(s) x {budgets} budget(s) x {repeats} repeat(s), hash {}; \
-                     its jobs about {jobs:.1e} integrand evaluations{reference})",
+                     priced for the cost limits at about {jobs:.1e} integrand evaluations in its \
+                     jobs{reference}: estimates that count the rules' caps and every ray a \
+                     branching ray tree may spawn, so the work done is often less)",
                     f.display(),
                     exp.name(),
                     exp.family(),

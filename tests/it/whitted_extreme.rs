@@ -35,6 +35,33 @@ fn distant_eye_sees_a_dot() {
     assert!((0.0..1e-30).contains(&coverage), "coverage {coverage}");
 }
 
+/// Film coordinates near the 6-pixel image are rounded to about 6 x 2.2e-16
+/// = 1.3e-15 pixels: the triangle 1e10 from the eye (its size over its
+/// distance 2.8e-10) has an image 2.8e-10 x 6.4 pixels a radian = 1.8e-9
+/// pixels across, and its closed-form
+/// coverage is exact only to about 1.3e-15 / 1.8e-9 = 7e-7 relative (an
+/// independent 120-digit projection put its error at 6.9e-6): `check`
+/// warns at the object with that bound, and not at the bundled eye.
+#[test]
+fn a_closed_form_below_the_films_rounding_is_warned() {
+    let mut e = bundled("w-ss-edge-coverage");
+    let check = |e: &Json| {
+        let dir = scratch("film");
+        let file = dir.join("e.json");
+        std::fs::write(&file, e.to_string()).expect("write");
+        let o = bin().arg("check").arg(&file).output().expect("runs");
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    assert!(!check(&e).contains("film coordinates"), "{}", check(&e));
+    e["scene"]["camera"]["eye"] = json!([0.0, 1e10, 0.0]);
+    let msg = check(&e);
+    assert!(
+        msg.contains("at `scene.objects[0]`") && msg.contains("exact only to about 1e-6 relative"),
+        "{msg}"
+    );
+}
+
 /// A vertex 1e20 up, 2.2 in front of the eye: the triangle's image is, to
 /// 1e-19, the part of the film beyond the image of edge a-b between the
 /// lines through the images of a and b toward the vanishing point of +y,

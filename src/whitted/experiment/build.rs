@@ -17,6 +17,11 @@ use crate::whitted::scene::{Camera, Light, Material, Object, Scene};
 /// 1e-4 of the object.
 pub const SMALLEST_RESOLVED: f64 = 1e-12;
 
+/// The relative accuracy a closed-form coverage must keep: its film lines'
+/// rounding over the size of the object's image (both in pixels) above this
+/// is warned at the object.
+pub const FILM_RESOLVED: f64 = 1e-13;
+
 /// The least size of an object whose squared sizes stay normal f64
 /// numbers (1e-150 squared is 1e-300).
 pub const SMALLEST_SIZE: f64 = 1e-150;
@@ -182,6 +187,28 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
                     SMALLEST_RESOLVED
                 ),
             ));
+        }
+        // Film coordinates, up to the image's size in pixels, are rounded
+        // to about 2.2e-16 of it: an object whose image is a small part of
+        // a pixel has a closed-form coverage (a region bounded by film
+        // lines) exact only to that rounding over its size (an eye 1e15
+        // from a unit triangle: 2.4e-30 for 8.9e-31).
+        if let Some(ratio) = object.shape.size_over_distance(camera.eye()) {
+            let tan_half = (0.5 * c.fov_y.to_radians()).tan();
+            let across = ratio * c.height as f64 / (2.0 * tan_half);
+            let film = f64::EPSILON * c.width.max(c.height) as f64;
+            if across > 0.0 && film / across > FILM_RESOLVED {
+                warnings.push(SpecError::at(
+                    at.clone(),
+                    format!(
+                        "its image is about {across:.1e} pixels across, and film coordinates \
+                         are rounded to about {film:.0e} of a pixel: its closed-form coverage \
+                         is exact only to about {:.0e} relative (above the {FILM_RESOLVED:.0e} a \
+                         reference claims); expected the eye nearer the object",
+                        film / across
+                    ),
+                ));
+            }
         }
         // Hit points are rounded to about 1e-16 of their coordinates: an
         // object small beside the coordinates it sits at (or the eye's) is
