@@ -85,6 +85,13 @@ pub trait Loaded: Send + Sync {
     fn reusable(&self, results: Vec<JobResult>) -> (Vec<JobResult>, usize);
 }
 
+/// The bytes a job's result holds per channel while it is written: value
+/// and error in memory (16) and as JSON text in a growing string (about 50,
+/// up to twice that as it grows). An image of 1024 x 1024 pixels wrote a
+/// line of tens of MB, and under an address-space cap of 300 MB the run
+/// aborted allocating it.
+pub const RESULT_BYTES_PER_CHANNEL: f64 = 128.0;
+
 impl<F: Family> Loaded for Experiment<F> {
     fn name(&self) -> &str {
         &self.spec.name
@@ -135,6 +142,13 @@ impl<F: Family> Loaded for Experiment<F> {
                     .map(move |&q| F::memory(&self.scene, rule, n, q))
             })
             .fold(0.0, f64::max)
+            + RESULT_BYTES_PER_CHANNEL
+                * self
+                    .spec
+                    .quantities
+                    .iter()
+                    .map(|&q| F::channels(&self.scene, q) as f64)
+                    .sum::<f64>()
     }
     fn reusable(&self, results: Vec<JobResult>) -> (Vec<JobResult>, usize) {
         super::run::reusable(self, results)

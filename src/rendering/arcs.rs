@@ -128,20 +128,22 @@ impl Spoke {
         }
     }
 
-    /// True when `x` lies in the plane through `p` with unit normal `n`
-    /// (to rounding): the shape is seen edge on and covers no solid angle.
-    fn edge_on(&self, p: Vec3, n: Vec3, size: f64) -> bool {
-        n.dot(&(p - self.x)).abs() <= 1e-14 * ((p - self.x).norm() + size)
+    /// True when `x` lies in the plane through `p` with unit normal `n` to
+    /// the rounding of their distance (`gamma_8 |n| . |p - x|`, as the
+    /// occluders' intersections bound it): the shape is seen edge on and
+    /// covers no solid angle. (A fixed 1e-14 of the shape's size took a
+    /// disk 1e-15 above the receiver for edge on, and the reference let
+    /// the light through it.)
+    fn edge_on(&self, p: Vec3, n: Vec3) -> bool {
+        let to = p - self.x;
+        n.dot(&to).abs() <= crate::whitted::intersect::gamma(8) * n.abs().dot(&to.abs())
     }
 
     /// The directions to a convex planar polygon (vertices in order, unit
     /// normal `n`): the segment where the spoke's plane cuts it, through the
     /// points where its edges change side.
     fn polygon(&self, vertices: &[Vec3], n: Vec3) -> Pieces {
-        let size = vertices
-            .iter()
-            .fold(0.0_f64, |m, v| m.max((v - vertices[0]).norm()));
-        if self.edge_on(vertices[0], n, size) {
+        if self.edge_on(vertices[0], n) {
             return Vec::new();
         }
         let m = self.normal();
@@ -165,7 +167,7 @@ impl Spoke {
     /// k cos(t - tau) = 0`.
     fn disk(&self, d: &Disk) -> Pieces {
         let (c, f, r) = (d.centre(), d.frame(), d.radius());
-        if self.edge_on(c, f.n, r) {
+        if self.edge_on(c, f.n) {
             return Vec::new();
         }
         let m = self.normal();

@@ -451,3 +451,55 @@ fn a_stale_hash_is_said_only_from_a_values_file() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A FIFO planted as a lock file (the run's, a shard's) is refused as not a
+/// regular file: opening it for writing blocked the run forever. The run
+/// is killed after 20 s if it blocks, and that fails the test.
+#[test]
+fn a_fifo_as_a_lock_file_is_refused_not_waited_on() {
+    for (lock, extra) in [
+        (".lightquad.lock", &[][..]),
+        (".lightquad.shard-2-of-8.lock", &["--shard", "2/8"][..]),
+    ] {
+        let (dir, file) = with_small("fifo-lock");
+        let out = dir.join("out");
+        fs::create_dir_all(&out).expect("out");
+        let fifo = out.join(lock);
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo");
+        assert!(made.success());
+        let mut child = bin()
+            .arg("run")
+            .arg(&file)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("runs");
+        let start = std::time::Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().expect("waits") {
+                break Some(s);
+            }
+            if start.elapsed() > std::time::Duration::from_secs(20) {
+                let _ = child.kill();
+                let _ = child.wait();
+                break None;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        };
+        let status = status.unwrap_or_else(|| panic!("{lock}: the run blocked on the FIFO"));
+        let mut err = String::new();
+        use std::io::Read as _;
+        let _ = child
+            .stderr
+            .take()
+            .expect("stderr")
+            .read_to_string(&mut err);
+        assert_eq!(status.code(), Some(1), "{lock}: {err}");
+        assert!(err.contains("is a FIFO"), "{lock}: {err}");
+    }
+}

@@ -348,3 +348,33 @@ fn many_small_blockers_leave_the_reference_exact() {
         square_light()
     );
 }
+
+/// A disk occluder of radius 0.5 at height h = 1e-15 .. 1e-300 over the
+/// receiver, under a coaxial disk light of radius 1 at height 1: every ray
+/// to the light leaves within 45 degrees and crosses the occluder's plane
+/// at a radius of at most h, inside it: E = 0 exactly. The reference took a
+/// blocker within 1e-14 of its size of the receiver for edge on and gave
+/// pi/2, the light unoccluded, while every rule gave 0.
+#[test]
+fn a_disk_occluder_just_above_the_receiver_hides_the_light_in_the_reference() {
+    for h in [1e-15, 1e-100, 1e-300] {
+        let e = json!({
+            "name": "oc", "family": "rendering",
+            "scene": {
+                "receiver": {"point": [0, 0, 0], "normal": [0, 0, 1]},
+                "emitters": [{"type": "disk", "centre": [0, 0, 1], "normal": [0, 0, -1],
+                              "radius": 1.0, "radiance": 1.0}],
+                "occluders": [{"type": "disk", "centre": [0, 0, h], "normal": [0, 0, 1],
+                               "radius": 0.5}]
+            },
+            "quantities": ["E_area", "E_cosine"], "rules": [{"rule": "gauss-legendre"}],
+            "budgets": [64], "repeats": 1, "reference": {"type": "converged"}
+        });
+        let exp = load(e);
+        for q in [Q::EArea, Q::ECosine] {
+            let (value, _) = converged(&exp, q);
+            assert_eq!(value, 0.0, "h = {h:e}, {q:?}");
+            assert_eq!(by(&exp, "gauss-legendre", 64, q), 0.0, "h = {h:e}, {q:?}");
+        }
+    }
+}

@@ -289,3 +289,36 @@ fn a_bushy_ray_tree_bounds_the_converged_reference() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A run of a 1024 x 1024 image under a 300 000 KiB address-space cap: its
+/// result line holds 3 x 1024^2 channels of value and error, about 128
+/// bytes each while written (3.1e6 x 128 = 403 MB), and the run aborted
+/// allocating it (exit 134, in serde_json's writer). It is refused before
+/// any job with the cap named, exit 1.
+#[test]
+fn an_image_run_past_a_memory_cap_is_refused_not_aborted() {
+    let dir = scratch("image-cap");
+    let file = dir.join("wbig.json");
+    let e = json!({"name": "wbig", "family": "whitted",
+        "scene": {"camera": {"eye": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0],
+                             "fov_y": 50.0, "width": 1024, "height": 1024},
+                  "ambient": [1, 1, 1],
+                  "objects": [{"type": "sphere", "centre": [0, 0, -3], "radius": 1.0,
+                               "material": {"k_a": 0.5, "k_s": 0.5}}],
+                  "lights": [{"type": "point", "position": [0, 5, 0], "intensity": [1, 1, 1]}]},
+        "quantities": ["image"], "rules": [{"rule": "grid"}], "budgets": [1, 4], "repeats": 1,
+        "reference": {"type": "converged"}});
+    std::fs::write(&file, e.to_string()).expect("write");
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 300000 && exec \"$0\" run \"$1\" --out \"$2\"")
+        .arg(env!("CARGO_BIN_EXE_lightquad"))
+        .arg(&file)
+        .arg(dir.join("out"))
+        .output()
+        .expect("runs");
+    let msg = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{msg}");
+    assert!(msg.contains("address-space limit"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -55,11 +55,24 @@ pub fn create_new(path: &Path) -> io::Result<File> {
 /// the file opened must be the one the path's own entry names.
 pub fn open_unlinked(path: &Path, options: &OpenOptions) -> io::Result<File> {
     refuse_link(path)?;
+    refuse_special(path)?;
     let file = options.open(path)?;
     if !same_entry(&file, path)? {
         return Err(link_error(path));
     }
     Ok(file)
+}
+
+/// Refuses an existing `path` that is not a regular file (a FIFO planted as
+/// the lock file blocked the run forever at its opening).
+pub fn refuse_special(path: &Path) -> io::Result<()> {
+    match fs::symlink_metadata(path) {
+        Ok(meta) if !meta.is_file() => Err(io::Error::other(format!(
+            "{}: lightquad writes only regular files in its output folder (--out); remove it",
+            crate::experiment::source::not_regular(&meta)
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// Opens `path` for writing without truncating it: created new when absent,

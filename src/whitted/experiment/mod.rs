@@ -597,7 +597,7 @@ impl Family for Whitted {
     }
 
     /// [`Self::converged`]'s Genz–Malik over each pixel's pieces at
-    /// [`converged_budget`], priced by [`Whitted::cost`] (the ray tree
+    /// the converged budget, priced by [`Whitted::cost`] (the ray tree
     /// counted).
     fn converged_cost(built: &Built, n: usize, quantities: &[WhittedQuantity]) -> [f64; 2] {
         let rule = Method::Rule(converged_rule());
