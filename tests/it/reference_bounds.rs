@@ -118,3 +118,32 @@ fn the_mitsuba_comparison_evaluates_lightquad_only_beside_a_mitsuba_value() {
         );
     }
 }
+
+#[test]
+fn a_rendering_reference_is_priced_by_its_blockers() {
+    // The converged rendering reference integrates, for each light, the
+    // light and what each blocker hides, every evaluation testing every
+    // blocker: 100 n (1 + B)^2 a light. 1000 sphere blockers under a sky at
+    // n = 400 and 800: 100 x 1200 x 1001^2 = 1.2e11 > 1e11, refused at
+    // `reference.n` (priced as one integral, 3.6e7, it ran for more than
+    // 400 s); 100 blockers: 1.2e9, accepted.
+    let spec = |count: usize| {
+        let occluders: Vec<Json> = (0..count)
+            .map(|k| json!({"type": "sphere", "centre": [0.001 * k as f64, 5, 1], "radius": 0.01}))
+            .collect();
+        json!({"name": "mo", "family": "rendering",
+            "scene": {"receiver": {"point": [0, 0, 0], "normal": [0, 0, 1]},
+                      "emitters": [{"type": "environment", "radiance": 1.0}],
+                      "occluders": occluders},
+            "quantities": ["E_cosine"], "rules": [{"rule": "gauss-legendre"}], "budgets": [16],
+            "repeats": 1, "reference": {"type": "converged"}})
+    };
+    let (code, err) = check("spheres-1000", &spec(1000));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("at `reference.n`") && err.contains("1.2e11"),
+        "{err}"
+    );
+    let (code, err) = check("spheres-100", &spec(100));
+    assert_eq!(code, Some(0), "{err}");
+}

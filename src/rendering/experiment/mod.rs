@@ -486,6 +486,61 @@ impl Family for Rendering {
          environment alone at normal incidence or of exponent 1"
     }
 
+    /// [`Self::converged`] at its cap: for each emitter, the light's own
+    /// integral and one per blocker (what it hides), each of
+    /// [`CONVERGED_PER_N`]` n` evaluations testing every blocker:
+    /// `kinds x emitters x 100 n x (1 + B)^2` for `B` occluders and finite
+    /// emitters (`(1 + B)` where all are polygons, cut into lit pieces once),
+    /// `kinds` 2 where irradiance and reflected radiance are both asked
+    /// for. (1000 sphere blockers under a sky were priced as one
+    /// integral and ran for more than 400 s.)
+    fn converged_cost(built: &Built, n: usize, quantities: &[RenderingQuantity]) -> [f64; 2] {
+        let budget = CONVERGED_PER_N.saturating_mul(n);
+        let finite = built
+            .scene
+            .emitters()
+            .iter()
+            .filter(|e| !super::emitter::Emitter::at_infinity(*e))
+            .count();
+        let blockers = (built.scene.occluders().len() + finite) as f64;
+        let kinds = [false, true]
+            .iter()
+            .filter(|&&r| quantities.iter().any(|q| q.reflected() == r))
+            .count() as f64;
+        let emitters = built.scene.emitters().len() as f64;
+        // Polygons behind polygons are cut into lit pieces once and summed
+        // by their contours: each blocker is met once, not per evaluation.
+        use super::emitter::AnyEmitter;
+        use super::occluder::Occluder;
+        let polygons = built
+            .scene
+            .occluders()
+            .iter()
+            .all(|o| matches!(o, Occluder::Rectangle(_) | Occluder::Triangle(_)))
+            && built
+                .scene
+                .emitters()
+                .iter()
+                .all(|e| matches!(e, AnyEmitter::Rectangle(_) | AnyEmitter::Triangle(_)));
+        let per_light = if polygons {
+            1.0 + blockers
+        } else {
+            (1.0 + blockers).powi(2)
+        };
+        let evaluations = kinds * emitters * budget as f64 * per_light;
+        let rule = Method::Rule(crate::quadrature::AnyRule::Base(
+            crate::quadrature::BaseRule::GenzMalik(crate::quadrature::GenzMalik {
+                abs_tol: 0.0,
+                rel_tol: 1e-14,
+            }),
+        ));
+        let bytes = quantities
+            .iter()
+            .map(|&q| Self::memory(built, &rule, budget, q))
+            .fold(0.0, f64::max);
+        [evaluations, bytes]
+    }
+
     /// Adaptive Genz–Malik (relative tolerance 1e-14) with up to
     /// [`CONVERGED_PER_N`]` n` evaluations per emitter, on the smoothest
     /// form each emitter has (module documentation); every `E_` quantity
