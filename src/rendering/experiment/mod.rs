@@ -446,13 +446,7 @@ impl Family for Rendering {
         // emitter (100 000 triangles made a sample about 1 ms; 100 000
         // sphere lights ran without a bound, each of their cone forms' rays
         // testing the other lights).
-        let finite = built
-            .scene
-            .emitters()
-            .iter()
-            .filter(|e| !super::emitter::Emitter::at_infinity(*e))
-            .count();
-        let visibility = 1.0 + (built.scene.occluders().len() + finite) as f64;
+        let visibility = 1.0 + blockers(built);
         visibility
             * match (method, q.form()) {
                 (Method::Estimator(_), _) => 2.0 * n,
@@ -496,13 +490,7 @@ impl Family for Rendering {
     /// integral and ran for more than 400 s.)
     fn converged_cost(built: &Built, n: usize, quantities: &[RenderingQuantity]) -> [f64; 2] {
         let budget = CONVERGED_PER_N.saturating_mul(n);
-        let finite = built
-            .scene
-            .emitters()
-            .iter()
-            .filter(|e| !super::emitter::Emitter::at_infinity(*e))
-            .count();
-        let blockers = (built.scene.occluders().len() + finite) as f64;
+        let blockers = blockers(built);
         let kinds = [false, true]
             .iter()
             .filter(|&&r| quantities.iter().any(|q| q.reflected() == r))
@@ -529,10 +517,7 @@ impl Family for Rendering {
         };
         let evaluations = kinds * emitters * budget as f64 * per_light;
         let rule = Method::Rule(crate::quadrature::AnyRule::Base(
-            crate::quadrature::BaseRule::GenzMalik(crate::quadrature::GenzMalik {
-                abs_tol: 0.0,
-                rel_tol: 1e-14,
-            }),
+            crate::quadrature::BaseRule::GenzMalik(reference::CONVERGED_RULE),
         ));
         let bytes = quantities
             .iter()
@@ -588,3 +573,15 @@ impl Family for Rendering {
 /// `{"type": "converged", "n": n}`: 400 (the default) gives 40000, about
 /// 2350 Genz–Malik boxes.
 pub const CONVERGED_PER_N: usize = 100;
+
+/// What a ray toward a light may meet: the occluders and every finite
+/// emitter.
+fn blockers(built: &Built) -> f64 {
+    let finite = built
+        .scene
+        .emitters()
+        .iter()
+        .filter(|e| !super::emitter::Emitter::at_infinity(*e))
+        .count();
+    (built.scene.occluders().len() + finite) as f64
+}

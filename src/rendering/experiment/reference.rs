@@ -55,6 +55,13 @@ fn coaxial(d: &DiskLight<f64>, x: Vec3) -> Option<f64> {
     (h != 0.0 && lateral <= 1e-14 * (h.abs() + shape.radius())).then_some(h)
 }
 
+/// The converged method's rule: adaptive Genz–Malik to a relative
+/// tolerance of 1e-14.
+pub(super) const CONVERGED_RULE: GenzMalik = GenzMalik {
+    abs_tol: 0.0,
+    rel_tol: 1e-14,
+};
+
 /// The value of irradiance (or reflected radiance) by the converged method:
 /// adaptive Genz–Malik on each emitter's smoothest form.
 pub(super) fn converged_value(
@@ -80,10 +87,7 @@ fn converged_by_emitter<K: Kernel>(
     lobe: Option<&Reflected<'_, AnyBrdf>>,
     budget: usize,
 ) -> Result<Estimate<f64>, QuadError> {
-    let rule = GenzMalik {
-        abs_tol: 0.0,
-        rel_tol: 1e-14,
-    };
+    let rule = CONVERGED_RULE;
     let mut rng = <rand_pcg::Pcg64 as rand::SeedableRng>::seed_from_u64(0);
     let (scene, receiver) = (&built.scene, &built.receiver);
     let mut total = Estimate::zero();
