@@ -4,7 +4,7 @@
 //! ```
 //! let registry = lightquad::families::builtin();
 //! let names: Vec<&str> = registry.entries().iter().map(|f| f.name).collect();
-//! assert_eq!(names, ["calibration", "volume", "rendering", "whitted", "furnace"]);
+//! assert_eq!(names, ["calibration", "volume", "rendering", "whitted", "furnace", "integral"]);
 //! assert!(registry.get("volume").expect("registered").quantities().contains(&"tau"));
 //! ```
 
@@ -19,6 +19,7 @@ pub fn builtin() -> Registry {
         .with::<crate::rendering::experiment::Rendering>()
         .with::<crate::whitted::experiment::Whitted>()
         .with::<crate::rendering::closed::Furnace>()
+        .with::<crate::integral::Integral>()
 }
 
 #[cfg(test)]
@@ -47,6 +48,7 @@ mod tests {
         names_agree::<crate::rendering::experiment::Rendering>()?;
         names_agree::<crate::whitted::experiment::Whitted>()?;
         names_agree::<crate::rendering::closed::Furnace>()?;
+        names_agree::<crate::integral::Integral>()?;
         // Every family listed above is the registry's.
         assert_eq!(
             super::builtin()
@@ -54,7 +56,14 @@ mod tests {
                 .iter()
                 .map(|e| e.name)
                 .collect::<Vec<_>>(),
-            ["calibration", "volume", "rendering", "whitted", "furnace"]
+            [
+                "calibration",
+                "volume",
+                "rendering",
+                "whitted",
+                "furnace",
+                "integral"
+            ]
         );
         Ok(())
     }

@@ -80,6 +80,7 @@ pub mod experiment;
 pub mod families;
 pub mod family;
 pub mod geometry;
+pub mod integral;
 pub mod parallel;
 pub mod quadrature;
 pub mod rendering;
