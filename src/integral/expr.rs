@@ -375,7 +375,7 @@ pub fn check(text: &str, variables: &[&str]) -> Result<(), ExprError> {
                             ));
                         }
                         open.push(Open {
-                            at,
+                            at: toks[i + 1].1,
                             lead,
                             call: Some(arity),
                             commas: 0,

@@ -84,11 +84,27 @@ impl Built {
         let Some(jacobian) = self.region.point(u, &mut values, self.angles) else {
             return Ok(V::zero());
         };
-        let f = V::from_fn(|c| self.integrand[c].eval(&values));
+        Ok(self.integrand_at::<V>(&values)?.map(|v| v * jacobian))
+    }
+
+    /// The integrand at the variables' `values`; a non-finite value is an
+    /// error naming the point.
+    #[inline]
+    fn integrand_at<V: Value>(&self, values: &[f64; MAX_VARIABLES]) -> Result<V, QuadError> {
+        let f = V::from_fn(|c| self.integrand[c].eval(values));
         if !f.all_finite() {
-            return Err(self.not_finite(&values, f));
+            return Err(self.not_finite(values, f));
         }
-        Ok(f.map(|v| v * jacobian))
+        Ok(f)
+    }
+
+    /// The integrand at the ray parameter `t` of a segment (whose own
+    /// integration applies its Jacobian).
+    #[inline]
+    fn at_parameter<V: Value>(&self, t: f64) -> Result<V, QuadError> {
+        let mut values = [0.0; MAX_VARIABLES];
+        values[0] = t;
+        self.integrand_at::<V>(&values)
     }
 
     /// The error for a non-finite integrand value `f` at `values`.
@@ -99,7 +115,7 @@ impl Built {
             .iter()
             .zip(values)
             .take(self.region.coordinates())
-            .map(|(name, v)| format!("{name} = {v:e}"))
+            .map(|(name, v)| format!("{name} = {}", readable_number(*v)))
             .collect();
         let channels: Vec<String> = (0..V::CHANNELS).map(|c| f.channel(c).to_string()).collect();
         QuadError::invalid(
@@ -118,7 +134,9 @@ impl Built {
         rng: &mut rand_pcg::Pcg64,
     ) -> Result<Measured, QuadError> {
         let est = match (&self.region, self.region.dim()) {
-            (Region::Segment(s), _) => s.try_integrate(rule, n, rng, |t| self.at::<V>(&[t]))?,
+            (Region::Segment(s), _) => {
+                s.try_integrate(rule, n, rng, |t| self.at_parameter::<V>(t))?
+            }
             (_, 1) => rule.try_integrate(n, rng, |u: [f64; 1]| self.at::<V>(&u))?,
             (_, 2) => rule.try_integrate(n, rng, |u: [f64; 2]| self.at::<V>(&u))?,
             (_, 3) => rule.try_integrate(n, rng, |u: [f64; 3]| self.at::<V>(&u))?,
@@ -135,6 +153,15 @@ impl Built {
             Region::Segment(s) => s.pieces().count(),
             _ => 1,
         }
+    }
+}
+
+/// `v` as a person reads it: plain digits from 1e-4 to 1e15, else with an exponent.
+fn readable_number(v: f64) -> String {
+    if v == 0.0 || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
     }
 }
 

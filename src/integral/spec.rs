@@ -305,7 +305,14 @@ impl Serialize for Formulas {
 
 impl<'de> Deserialize<'de> for Formulas {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let terms = terms(Json::deserialize(d)?, "an expression in quotes (\"x*y\")")?;
+        let value = Json::deserialize(d)?;
+        if value.is_number() {
+            return Err(D::Error::custom(format!(
+                "{}: expected an expression in quotes (\"x*y\"), or a list of 3 (R, G, B)",
+                tagged::kind(&value)
+            )));
+        }
+        let terms = terms(value, "an expression in quotes (\"x*y\")")?;
         terms
             .into_iter()
             .enumerate()
