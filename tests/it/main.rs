@@ -43,6 +43,7 @@ mod rendering_furnace;
 mod rendering_mis;
 mod rules;
 mod runner;
+mod sobol_dims;
 mod spec_fuzz;
 mod sum_lanes;
 mod tracking_cost;
