@@ -181,7 +181,10 @@ fn coverage<const D: usize>() -> f64 {
 fn sobol_intervals_cover_at_the_nominal_rate_in_4d_and_6d() {
     // The error is the Student-t scaled standard error of 8 scramble means,
     // so value +- 1.96 error is a 95% interval; with 400 runs the binomial
-    // standard deviation is 1.1%.
+    // standard deviation is 1.1%. Over 4000 runs (seeds 100000..) the
+    // coverage was 0.948-0.954 in 4-D and 0.942-0.949 in 6-D at 1024, 4096
+    // and 16384 points: the 6-D figure here (0.965 with these seeds) is a
+    // +1.5 sigma draw, not a wide interval.
     for (d, rate) in [(4, coverage::<4>()), (6, coverage::<6>())] {
         assert!((0.93..=0.97).contains(&rate), "{d}-D coverage {rate}");
     }
