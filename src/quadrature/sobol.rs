@@ -290,17 +290,7 @@ impl Rule for Sobol {
     }
 
     fn check(&self) -> Result<(), QuadError> {
-        if !(2..=MAX_REPLICATES).contains(&self.replicates) {
-            return Err(QuadError::invalid(
-                "replicates",
-                self.replicates,
-                format!(
-                    "an integer in 2..={MAX_REPLICATES} (the standard error needs two scrambles, \
-                     and each scramble at least one point of the budget)"
-                ),
-            ));
-        }
-        Ok(())
+        check_replicates(self.replicates)
     }
 
     fn integrate_unguarded<
@@ -360,27 +350,54 @@ impl Rule for Sobol {
             }
             means.add(sum.total().map(|s| s / per as f64));
         }
-        let t = t95_factor(reps as f64 - 1.0);
-        let estimate = Estimate::random(
-            means.mean(),
-            means.standard_error().map(|e| e * t),
-            (reps * per) as u64,
-        );
-        // Scrambles that all gave the same mean (SE 0), or points whose
-        // spread is carried by a few values: over all the points, or, from
-        // PER_SCRAMBLE_CHECK points a scramble, within one scramble (the
-        // tail check at a scramble's count: sqrt((b2 - 1) / per) from the
-        // kurtosis b2 of all the points; module documentation).
-        let alike = (0..V::CHANNELS).any(|c| means.standard_error().channel(c) == 0.0);
-        let per_scramble = points.worst_variance_relative_error() * (reps as f64).sqrt();
-        let few = points.doubtful()
-            || (per >= PER_SCRAMBLE_CHECK
-                && per_scramble > variance_doubt_threshold(per as u64));
-        Ok(if alike || few {
-            estimate.doubted()
-        } else {
-            estimate
-        })
+        Ok(over_scrambles(&means, &points, reps, per))
+    }
+}
+
+/// The replicate count in `2..=MAX_REPLICATES`, or why not.
+pub(super) fn check_replicates(replicates: usize) -> Result<(), QuadError> {
+    if !(2..=MAX_REPLICATES).contains(&replicates) {
+        return Err(QuadError::invalid(
+            "replicates",
+            replicates,
+            format!(
+                "an integer in 2..={MAX_REPLICATES} (the standard error needs two scrambles, \
+                 and each scramble at least one point of the budget)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The estimate from `reps` scrambles of `per` points: the mean of the
+/// scramble `means`, the standard error of the mean times
+/// `t_(reps-1)(0.975) / 1.96`, doubted when the scrambles agree or the
+/// values at all the `points` fail the tail check (module documentation).
+pub(super) fn over_scrambles<V: Value>(
+    means: &Welford<V>,
+    points: &Welford<V>,
+    reps: usize,
+    per: usize,
+) -> Estimate<V> {
+    let t = t95_factor(reps as f64 - 1.0);
+    let estimate = Estimate::random(
+        means.mean(),
+        means.standard_error().map(|e| e * t),
+        (reps * per) as u64,
+    );
+    // Scrambles that all gave the same mean (SE 0), or points whose
+    // spread is carried by a few values: over all the points, or, from
+    // PER_SCRAMBLE_CHECK points a scramble, within one scramble (the
+    // tail check at a scramble's count: sqrt((b2 - 1) / per) from the
+    // kurtosis b2 of all the points; module documentation).
+    let alike = (0..V::CHANNELS).any(|c| means.standard_error().channel(c) == 0.0);
+    let per_scramble = points.worst_variance_relative_error() * (reps as f64).sqrt();
+    let few = points.doubtful()
+        || (per >= PER_SCRAMBLE_CHECK && per_scramble > variance_doubt_threshold(per as u64));
+    if alike || few {
+        estimate.doubted()
+    } else {
+        estimate
     }
 }
 
