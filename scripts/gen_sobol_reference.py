@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Write scipy's unscrambled Sobol' points, the independent reference for
-lightquad's Joe-Kuo direction numbers (src/quadrature/sobol.rs).
+"""Write scipy's unscrambled Sobol' and Halton points, the independent
+references for lightquad's Joe-Kuo direction numbers (src/quadrature/sobol.rs)
+and radical inverses (src/quadrature/halton.rs).
 
 Run from the repository root:
 
@@ -22,6 +23,12 @@ Those points use only the first 10 direction numbers of each dimension. The
 the k-th direction number itself) and three others with many bits set, each
 drawn at its Gray-code row (the inverse Gray code of its index) after
 fast_forward; about a minute, most of it stepping to row 2^32 - 1.
+
+Writes tests/data/halton_scipy.json: the first 512 points of
+scipy.stats.qmc.Halton(DIMS, scramble=False) (row i is point i, row 0 the
+origin; coordinate j the radical inverse of i in the j-th prime), as floats
+(shortest round-trip form). scipy sums the digits in floating point, so they
+may differ from the correctly rounded radical inverse in the last bits.
 """
 
 import json
@@ -33,6 +40,7 @@ from scipy.stats import qmc
 
 DIMS = 21
 POINTS = 1024
+HALTON_POINTS = 512
 HIGH = [1 << k for k in range(32)] + [0xFFFF_FFFF, 0xDEAD_BEEF, 0x1234_5678]
 
 
@@ -90,6 +98,27 @@ def main() -> None:
     text = text.replace("],[", "],\n[").replace("},{", "},\n{")
     path.write_text(text + "\n")
     print(f"wrote {path}: {POINTS} points x {DIMS} dimensions")
+    halton()
+
+
+def halton() -> None:
+    """tests/data/halton_scipy.json: scipy's unscrambled Halton points."""
+    x = qmc.Halton(DIMS, scramble=False).random(HALTON_POINTS)
+    out = {
+        "source": (
+            f"scripts/gen_sobol_reference.py (scipy {scipy.__version__}, numpy {np.__version__}): "
+            f"scipy.stats.qmc.Halton({DIMS}, scramble=False).random({HALTON_POINTS}); "
+            "row i is point i, coordinate j the radical inverse of i in the j-th prime"
+        ),
+        "scipy_version": scipy.__version__,
+        "dimensions": DIMS,
+        "points": HALTON_POINTS,
+        "rows": [[float(v) for v in row] for row in x],
+    }
+    path = Path("tests/data/halton_scipy.json")
+    text = json.dumps(out, indent=None, separators=(",", ":")).replace("],[", "],\n[")
+    path.write_text(text + "\n")
+    print(f"wrote {path}: {HALTON_POINTS} points x {DIMS} dimensions")
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@ mod furnace_family;
 mod gauss_legendre;
 mod gauss_legendre_peers;
 mod genz_malik;
+mod halton_dims;
 mod html_report;
 mod input_leftovers;
 mod line_sum_par;
