@@ -27,7 +27,8 @@
 //! | `genz-malik` | adaptive Genz–Malik degree-7 cubature (2 <= D <= 6), bisecting the worst box (as HCubature) | embedded degree-5 rule |
 //! | `monte-carlo` | plain Monte Carlo | standard error; doubted when all samples agree or the sample variance is carried by a few samples (kurtosis) |
 //! | `stratified` | jittered Monte Carlo, one sample per cell | second differences of every three neighbouring cells; doubted when none varies, or when a few cells carry the variance and one sample inside the cube most of the sum (a peak between samples) |
-//! | `sobol` | Owen-scrambled Sobol' points (D <= 2), 8 scrambles | standard error over scrambles, times t_{R-1}(0.975)/1.96; doubted when the scrambles agree or the points fail the Monte Carlo tail check |
+//! | `sobol` | Owen-scrambled Sobol' points (D <= 21, Joe–Kuo direction numbers), 8 scrambles | standard error over scrambles, times t_{R-1}(0.975)/1.96; doubted when the scrambles agree or the points fail the Monte Carlo tail check |
+//! | `halton` | Halton points (D <= 21, prime bases 2 to 73) scrambled by random digit permutations, 8 scrambles | as `sobol` |
 //! | `product` | iterated 2-D rule from any two 1-D rules (`AnyRule::by_name("product(A,B)")` in the library) | outer estimate + integrated inner estimates |
 //!
 //! ```
@@ -398,6 +399,7 @@ registry! {
     monte_carlo::MonteCarlo = "monte-carlo",
     stratified::Stratified = "stratified",
     sobol::Sobol = "sobol",
+    halton::Halton = "halton",
 }
 
 /// A rule's parameters (the object without its `"rule"`), with the path of a

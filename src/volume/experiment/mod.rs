@@ -354,7 +354,7 @@ impl Family for Volume {
     /// walks from the nearest visited node with 6-point panels, about
     /// 12 density lookups (two panels) for rules that visit their nodes in
     /// order (trapezoid, Simpson, Gauss–Legendre, stratified), `6 (2 + log2
-    /// n)` for those that do not (Gauss–Kronrod, Monte Carlo, Sobol': they
+    /// n)` for those that do not (Gauss–Kronrod, Monte Carlo, Sobol', Halton: they
     /// walk the gaps again at every level); it was counted as 1, and the
     /// bundled scenes cost 12 to 80 times the estimate (Gauss–Legendre's
     /// error estimate's rules, 2.5 n more, were not counted either); `n` more where an integral
@@ -434,7 +434,7 @@ impl Family for Volume {
         // every level of their refinement; the others about twice.
         let in_order = !matches!(
             crate::quadrature::Rule::name(rule),
-            "gauss-kronrod" | "monte-carlo" | "sobol"
+            "gauss-kronrod" | "monte-carlo" | "sobol" | "halton"
         );
         // Each piece's integral costs its evaluations and the call around
         // them (the rule's setup and bookkeeping, about PIECE_OVERHEAD
