@@ -112,7 +112,7 @@ impl MakeOperators<f64> for Operators {
             Operator::make_constant("pi", std::f64::consts::PI),
             Operator::make_constant("e", std::f64::consts::E),
         ];
-        let unary: [(&str, fn(f64) -> f64); 18] = [
+        let unary: [(&str, Unary); 18] = [
             ("sin", f64::sin),
             ("cos", f64::cos),
             ("tan", f64::tan),
@@ -136,6 +136,9 @@ impl MakeOperators<f64> for Operators {
         ops
     }
 }
+
+/// A function of one argument, as exmex applies it.
+type Unary = fn(f64) -> f64;
 
 /// Heaviside's step: 1 for `a >= 0`, 0 below (and for NaN, which the
 /// integrand's check then meets elsewhere).
