@@ -24,6 +24,7 @@ mod gauss_legendre_peers;
 mod genz_malik;
 mod html_report;
 mod input_leftovers;
+mod integral_bundled;
 mod line_sum_par;
 mod memory_estimate;
 mod mitsuba;
