@@ -25,6 +25,7 @@ mod genz_malik;
 mod halton_dims;
 mod html_report;
 mod input_leftovers;
+mod integral_bundled;
 mod integral_family;
 mod line_sum_par;
 mod memory_estimate;

@@ -587,7 +587,14 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
         .collect();
     assert_eq!(
         families,
-        ["calibration", "volume", "rendering", "whitted", "furnace"]
+        [
+            "calibration",
+            "volume",
+            "rendering",
+            "whitted",
+            "furnace",
+            "integral"
+        ]
     );
     // Every object the schema describes is closed, as `check` refuses
     // unknown fields: `{"rule": "trapezoid", "foo": 1}` passed the schema;
