@@ -26,6 +26,7 @@ mod halton_dims;
 mod html_report;
 mod input_leftovers;
 mod integral_bundled;
+mod integral_expr;
 mod integral_family;
 mod line_sum_par;
 mod memory_estimate;
