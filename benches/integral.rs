@@ -72,7 +72,8 @@ fn point(c: &mut Criterion) {
     let pts = points();
     let mut g = c.benchmark_group("expression/point");
     g.throughput(Throughput::Elements(pts.len() as u64));
-    let cases: [(&str, &str, fn(&[f64]) -> f64); 2] = [
+    type Closure = fn(&[f64]) -> f64;
+    let cases: [(&str, &str, Closure); 2] = [
         ("functions", FUNCTIONS, functions),
         ("arithmetic", ARITHMETIC, arithmetic),
     ];

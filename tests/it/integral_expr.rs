@@ -21,7 +21,10 @@ enum T {
     Call2(&'static str, Box<T>, Box<T>),
 }
 
-const UNARY: [(&str, fn(f64) -> f64); 9] = [
+type Unary = fn(f64) -> f64;
+type Binary = fn(f64, f64) -> f64;
+
+const UNARY: [(&str, Unary); 9] = [
     ("sin", f64::sin),
     ("cos", f64::cos),
     ("exp", f64::exp),
@@ -33,8 +36,7 @@ const UNARY: [(&str, fn(f64) -> f64); 9] = [
     ("ln", f64::ln),
 ];
 
-const BINARY: [(&str, fn(f64, f64) -> f64); 3] =
-    [("min", f64::min), ("max", f64::max), ("atan2", f64::atan2)];
+const BINARY: [(&str, Binary); 3] = [("min", f64::min), ("max", f64::max), ("atan2", f64::atan2)];
 
 fn tree() -> impl Strategy<Value = T> {
     let leaf = prop_oneof![

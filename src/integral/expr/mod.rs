@@ -1,7 +1,7 @@
 //! Integrand expressions: a formula in a string, compiled once into a tree
 //! of closures (`program`) and evaluated at every point without allocating.
 //!
-//! [`check`] reads the text token by token first, so every fault is named
+//! The grammar check (`check`) reads the text token by token first, so every fault is named
 //! with its column. It refuses what tools read differently, rather than
 //! pick one reading silently:
 //!

@@ -2,11 +2,17 @@
 
 use std::f64::consts::{E, PI};
 
+/// A function of one argument.
+pub(super) type Unary = fn(f64) -> f64;
+
+/// A function of two arguments.
+pub(super) type Binary = fn(f64, f64) -> f64;
+
 /// The constants, by name.
 pub(super) const CONSTANTS: [(&str, f64); 2] = [("pi", PI), ("e", E)];
 
 /// The functions of one argument, by name (`log` is the natural logarithm).
-pub(super) const UNARY: [(&str, fn(f64) -> f64); 18] = [
+pub(super) const UNARY: [(&str, Unary); 18] = [
     ("sin", f64::sin),
     ("cos", f64::cos),
     ("tan", f64::tan),
@@ -28,7 +34,7 @@ pub(super) const UNARY: [(&str, fn(f64) -> f64); 18] = [
 ];
 
 /// The functions of two arguments, by name.
-pub(super) const BINARY: [(&str, fn(f64, f64) -> f64); 3] =
+pub(super) const BINARY: [(&str, Binary); 3] =
     [("atan2", f64::atan2), ("min", f64::min), ("max", f64::max)];
 
 /// Heaviside's step: 1 for `a >= 0`, else 0 (NaN included).
@@ -42,11 +48,11 @@ pub(super) fn constant(name: &str) -> Option<f64> {
 }
 
 /// The function of one argument named `name`, if it is one.
-pub(super) fn unary(name: &str) -> Option<fn(f64) -> f64> {
+pub(super) fn unary(name: &str) -> Option<Unary> {
     UNARY.iter().find(|f| f.0 == name).map(|f| f.1)
 }
 
 /// The function of two arguments named `name`, if it is one.
-pub(super) fn binary(name: &str) -> Option<fn(f64, f64) -> f64> {
+pub(super) fn binary(name: &str) -> Option<Binary> {
     BINARY.iter().find(|f| f.0 == name).map(|f| f.1)
 }

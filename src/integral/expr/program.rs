@@ -6,13 +6,16 @@
 
 use super::tree::{BinOp, Node};
 
-/// A compiled (sub)expression: its value at the variables' values.
-type Compiled = Box<dyn Fn(&[f64]) -> f64 + Send + Sync>;
+/// A (sub)expression's value at the variables' values.
+type Function = dyn Fn(&[f64]) -> f64 + Send + Sync;
+
+/// A compiled (sub)expression.
+type Compiled = Box<Function>;
 
 /// A compiled expression (shared, not copied, by clones of the scene).
 #[derive(Clone)]
 pub(super) struct Program {
-    root: std::sync::Arc<dyn Fn(&[f64]) -> f64 + Send + Sync>,
+    root: std::sync::Arc<Function>,
 }
 
 impl std::fmt::Debug for Program {
