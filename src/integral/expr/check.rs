@@ -31,6 +31,7 @@ struct Open {
 /// names the first fault with its column ([`super`]'s documentation).
 pub(super) fn check(text: &str, variables: &[&str]) -> Result<(), ExprError> {
     let toks = tokens(text)?;
+    bounded(text, &toks)?;
     let mut open: Vec<Open> = Vec::new();
     let mut want_operand = true;
     let mut lead = Lead::default();
@@ -150,6 +151,50 @@ pub(super) fn check(text: &str, variables: &[&str]) -> Result<(), ExprError> {
     }
     if let Some(group) = open.last() {
         return Err(fault(text, group.at, "this `(` is never closed"));
+    }
+    Ok(())
+}
+
+/// The most tokens an expression may have: its tree, built and evaluated
+/// by recursion, then stays a few hundred levels deep.
+pub(super) const MAX_TOKENS: usize = 1000;
+
+/// The deepest nesting of parentheses and signs (`-(-(-x))`).
+pub(super) const MAX_NESTING: usize = 64;
+
+/// Refuses an expression longer than [`MAX_TOKENS`] or nested deeper than
+/// [`MAX_NESTING`], at the token that passes the limit.
+fn bounded(text: &str, toks: &[(Token<'_>, usize)]) -> Result<(), ExprError> {
+    if let Some(&(_, at)) = toks.get(MAX_TOKENS) {
+        return Err(fault(
+            text,
+            at,
+            format!("longer than {MAX_TOKENS} tokens (numbers, names, operators, parentheses)"),
+        ));
+    }
+    let (mut parens, mut signs) = (0usize, 0usize);
+    for (k, &(tok, at)) in toks.iter().enumerate() {
+        match tok {
+            Token::Open => parens += 1,
+            Token::Close => parens = parens.saturating_sub(1),
+            _ => {}
+        }
+        let sign = matches!(tok, Token::Op(b'+' | b'-'));
+        let after_op = k == 0 || matches!(toks[k - 1].0, Token::Op(_) | Token::Open | Token::Comma);
+        signs = if sign && after_op {
+            signs + 1
+        } else if sign {
+            signs
+        } else {
+            0
+        };
+        if parens + signs > MAX_NESTING {
+            return Err(fault(
+                text,
+                at,
+                format!("nested deeper than {MAX_NESTING} parentheses and signs"),
+            ));
+        }
     }
     Ok(())
 }

@@ -195,6 +195,13 @@ mod tests {
             ("sin(x, y)", 6, "comma"),
             ("", 1, "ends"),
             ("x * é", 5, "unexpected character"),
+            (
+                &format!("{}x{}", "(".repeat(70), ")".repeat(70)),
+                65,
+                "nested deeper",
+            ),
+            (&format!("{}x", "-".repeat(70)), 65, "nested deeper"),
+            (&"x+".repeat(600), 1001, "longer than 1000"),
         ];
         for (text, column, says) in cases {
             match Expr::compile(text, &["x", "y"]) {
