@@ -150,6 +150,7 @@ fn compile(node: &Node) -> Compiled {
             }
         },
         Node::Bin(BinOp::Pow, a, b) if small_integer(b).is_some() => power(a, b),
+        Node::Bin(BinOp::Add | BinOp::Sub, a, _) if is_sum(a) => sum(node),
         Node::Bin(BinOp::Add, a, b) => binary!(a.as_ref(), b.as_ref(), |x, y| x + y),
         Node::Bin(BinOp::Sub, a, b) => binary!(a.as_ref(), b.as_ref(), |x, y| x - y),
         Node::Bin(BinOp::Mul, a, b) => binary!(a.as_ref(), b.as_ref(), |x, y| x * y),
@@ -173,6 +174,34 @@ fn compile(node: &Node) -> Compiled {
             binary!(a.as_ref(), b.as_ref(), |x, y| f(x, y))
         }
     }
+}
+
+/// True when `node` is itself a sum or difference (so the node above it
+/// starts a chain of three or more terms).
+fn is_sum(node: &Node) -> bool {
+    matches!(node, Node::Bin(BinOp::Add | BinOp::Sub, ..))
+}
+
+/// A chain `t0 ± t1 ± ... ± tk` as one closure over its terms, added left
+/// to right as the tree says (one call a term instead of one a term and
+/// one an addition).
+fn sum(node: &Node) -> Compiled {
+    let mut terms: Vec<(bool, Compiled)> = Vec::new();
+    let mut spine = node;
+    while let Node::Bin(op @ (BinOp::Add | BinOp::Sub), a, b) = spine {
+        terms.push((*op == BinOp::Sub, compile(b)));
+        spine = a;
+    }
+    let first = compile(spine);
+    terms.reverse();
+    Box::new(move |v: &[f64]| {
+        let mut acc = first(v);
+        for (minus, term) in &terms {
+            let x = term(v);
+            acc = if *minus { acc - x } else { acc + x };
+        }
+        acc
+    })
 }
 
 /// `a^k` for a small integer `k` (`b` is the number `k`): `x*x` for 2.
