@@ -84,6 +84,16 @@ impl Built {
         let Some(jacobian) = self.region.point(u, &mut values, self.angles) else {
             return Ok(V::zero());
         };
+        if jacobian == f64::INFINITY {
+            return Err(QuadError::invalid(
+                "integrand",
+                format!("evaluated on the rim of the hemisphere (u = {u:?})"),
+                "points where the cosine map's Jacobian pi / cos(theta) is finite: rules with \
+                 nodes on the domain's edge (trapezoid, Simpson) reach the rim, where it is \
+                 infinite; use \"map\": \"projected\" with the integrand divided by \
+                 cos(theta), or \"uniform\"",
+            ));
+        }
         Ok(self.integrand_at::<V>(&values)?.map(|v| v * jacobian))
     }
 
@@ -137,6 +147,7 @@ impl Built {
             (Region::Segment(s), _) => {
                 s.try_integrate(rule, n, rng, |t| self.at_parameter::<V>(t))?
             }
+            (Region::Interval(pieces), _) => self.interval::<R, V>(pieces, rule, n, rng)?,
             (_, 1) => rule.try_integrate(n, rng, |u: [f64; 1]| self.at::<V>(&u))?,
             (_, 2) => rule.try_integrate(n, rng, |u: [f64; 2]| self.at::<V>(&u))?,
             (_, 3) => rule.try_integrate(n, rng, |u: [f64; 3]| self.at::<V>(&u))?,
@@ -147,10 +158,33 @@ impl Built {
         Ok(est.into())
     }
 
+    /// `int f dx` over an interval's pieces, each with the whole budget.
+    fn interval<R: Rule, V: Value>(
+        &self,
+        pieces: &[region::Interval],
+        rule: &R,
+        n: usize,
+        rng: &mut rand_pcg::Pcg64,
+    ) -> Result<crate::estimate::Estimate<V>, QuadError> {
+        let mut total = crate::estimate::Estimate::<V>::zero();
+        for &piece in pieces {
+            let est = rule.try_integrate(n, rng, |u: [f64; 1]| {
+                let mut values = [0.0; MAX_VARIABLES];
+                match region::interval_point(piece, u[0], &mut values) {
+                    Some(jacobian) => Ok(self.integrand_at::<V>(&values)?.map(|v| v * jacobian)),
+                    None => Ok(V::zero()),
+                }
+            })?;
+            total = total.combine(est);
+        }
+        Ok(total)
+    }
+
     /// The pieces a rule runs on (a segment's between its breaks; else 1).
     fn pieces(&self) -> usize {
         match &self.region {
             Region::Segment(s) => s.pieces().count(),
+            Region::Interval(pieces) => pieces.len(),
             _ => 1,
         }
     }
@@ -214,9 +248,10 @@ impl Family for Integral {
     const ABOUT: &'static str = "your own integral: an integrand expression over an interval, a box of up to 6 \
          dimensions, a surface, the hemisphere or a pixel";
     const EQUATIONS: &'static [&'static str] = &[];
-    const BUDGET_UNIT: &'static str = "the points a rule is given (per piece of a segment with \
-                                       breaks; the evaluations column counts what it spent, its \
-                                       error estimate included)";
+    const BUDGET_UNIT: &'static str = "the points a rule is given (per piece: a segment's between \
+                                       its breaks, an infinite interval's middle and tails; the \
+                                       evaluations column counts what it spent, its error \
+                                       estimate included)";
 
     type SceneSpec = IntegralSpec;
     type Scene = Built;

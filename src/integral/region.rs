@@ -18,13 +18,20 @@
 //!
 //! `phi` is in `[0, 2 pi)`, measured from the frame's first axis.
 //!
-//! An infinite interval is mapped onto `[0, 1]` (as QuadGK and HCubature do):
-//! `[a, inf)` by `x = a + u / (1 - u)`, `|J| = 1 / (1 - u)^2`; `(-inf, b]` by
-//! `x = b - (1 - u) / u`, `|J| = 1 / u^2`; `(-inf, inf)` by
-//! `x = (2u - 1) / (4 u (1 - u))`, `|J| = (1 + (2u - 1)^2) / (8 u^2 (1 - u)^2)`.
-//! At an infinite end the integrand times `|J|` is taken as 0, its limit for
-//! any integrand falling faster than `1/x^2`; rules with a node there
-//! (trapezoid, Simpson) lose accuracy on integrands that fall slower.
+//! An infinite interval is cut into pieces, each integrated with the whole
+//! budget: a finite piece of length 1 at each finite end, mapped from that
+//! end, and a tail for each infinite end, `[c, inf)` by `x = c + (1 - u)/u`
+//! and `(-inf, c]` by `x = c - (1 - u)/u`, `|J| = 1/u^2` (`(-inf, inf)`:
+//! `(-inf, -1]`, `[-1, 1]`, `[1, inf)`). The infinite end sits at `u = 0`,
+//! where f64 resolves `u` down to 1e-308 (`x` up to 1e308), and so does the
+//! interval's finite end (where an integrand may be singular); a single map
+//! of `[a, inf)` onto `[0, 1]` resolves one of its ends only to 1e-16 (an
+//! integrand falling as `x^-1.5` lost 1e-8 of its mass past `x = 1e16`, a
+//! `1/sqrt` at the finite end 1e-8 before it). At `u = 0` the integrand
+//! times `|J|` is taken as 0, its limit for any integrand falling faster
+//! than `1/x^2`; rules with a node there (trapezoid, Simpson) lose
+//! accuracy on integrands that fall slower. A divergent integral is not
+//! detected: its converged reference says it did not converge.
 
 use std::f64::consts::PI;
 
@@ -40,24 +47,23 @@ pub const MAX_BOX_DIM: usize = 6;
 /// The names of a box's coordinates.
 const BOX_NAMES: [&str; MAX_BOX_DIM] = ["x1", "x2", "x3", "x4", "x5", "x6"];
 
-/// Where the ends of an `interval` lie.
+/// One piece of an `interval`: finite, or a tail reaching to infinity.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Interval {
-    /// `[a, b]`, both finite.
+    /// Between two finite ends, the first at `u = 0` (where f64 resolves
+    /// `u` best): `x = a + (b - a) u`, `|J| = |b - a|`.
     Finite(f64, f64),
-    /// `[a, inf)`.
+    /// `[c, inf)` by `x = c + (1 - u)/u`.
     Above(f64),
-    /// `(-inf, b]`.
+    /// `(-inf, c]` by `x = c - (1 - u)/u`.
     Below(f64),
-    /// The whole line.
-    Line,
 }
 
 /// A built domain of the `integral` family ([module documentation](self)).
 #[derive(Debug, Clone)]
 pub enum Region {
-    /// An interval, possibly infinite.
-    Interval(Interval),
+    /// An interval, possibly infinite: its pieces ([module documentation](self)).
+    Interval(Vec<Interval>),
     /// A finite segment cut at break points.
     Segment(Segment),
     /// A box (the unit cube included): its lower and upper corners.
@@ -119,6 +125,28 @@ impl Region {
         }
     }
 
+    /// The domain's size in its measure (length, area, volume, solid
+    /// angle); infinite for an infinite interval.
+    pub fn size(&self) -> f64 {
+        match self {
+            Region::Interval(pieces) => pieces
+                .iter()
+                .map(|p| match p {
+                    Interval::Finite(a, b) => (b - a).abs(),
+                    _ => f64::INFINITY,
+                })
+                .sum(),
+            Region::Segment(s) => s.measure(),
+            Region::Box { lo, hi, dim } => (0..*dim).map(|k| hi[k] - lo[k]).product(),
+            Region::Rectangle(r) => r.measure(),
+            Region::Disk(d) => d.measure(),
+            Region::Triangle(t) => t.measure(),
+            Region::Cap(c) => c.measure(),
+            Region::Hemisphere(h) => h.measure(),
+            Region::Pixel(p) => p.measure(),
+        }
+    }
+
     /// The measure the integral is taken in, in words.
     pub fn measure(&self) -> &'static str {
         match self {
@@ -139,7 +167,7 @@ impl Region {
     #[inline]
     pub fn point(&self, u: &[f64], values: &mut [f64; MAX_VARIABLES], angles: bool) -> Option<f64> {
         match self {
-            Region::Interval(i) => interval_point(*i, u[0], values),
+            Region::Interval(pieces) => interval_point(pieces[0], u[0], values),
             Region::Segment(s) => {
                 let (t, jacobian) = s.map([u[0]]);
                 values[0] = t;
@@ -174,26 +202,19 @@ impl Region {
     }
 }
 
-/// `x` and `|J|` of an interval's map ([module documentation](self)).
+/// `x` and `|J|` of an interval piece's map ([module documentation](self));
+/// `None` at a tail's infinite end.
 #[inline]
-fn interval_point(i: Interval, u: f64, values: &mut [f64; MAX_VARIABLES]) -> Option<f64> {
+pub fn interval_point(i: Interval, u: f64, values: &mut [f64; MAX_VARIABLES]) -> Option<f64> {
     let (x, jacobian) = match i {
-        Interval::Finite(a, b) => (along(a, b, u), b - a),
-        Interval::Above(a) => {
-            let rest = 1.0 - u;
-            (rest > 0.0).then_some(())?;
-            (a + u / rest, 1.0 / (rest * rest))
-        }
-        Interval::Below(b) => {
+        Interval::Finite(a, b) => (along(a, b, u), (b - a).abs()),
+        Interval::Above(c) => {
             (u > 0.0).then_some(())?;
-            (b - (1.0 - u) / u, 1.0 / (u * u))
+            (c + (1.0 - u) / u, 1.0 / (u * u))
         }
-        Interval::Line => {
-            let (v, rest) = (u, 1.0 - u);
-            (v > 0.0 && rest > 0.0).then_some(())?;
-            let t = 2.0 * u - 1.0;
-            let q = v * rest;
-            (t / (4.0 * q), (1.0 + t * t) / (8.0 * q * q))
+        Interval::Below(c) => {
+            (u > 0.0).then_some(())?;
+            (c - (1.0 - u) / u, 1.0 / (u * u))
         }
     };
     values[0] = x;

@@ -19,12 +19,11 @@ use super::region::{Interval, MAX_BOX_DIM, Region};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct IntegralSpec {
-    /// Where the integral is taken, and in which measure
-    /// ([`region`](super::region)).
+    /// Where the integral is taken, and in which measure.
     #[serde(deserialize_with = "tagged::object")]
     pub domain: DomainSpec,
     /// The integrand: an expression (`"x*exp(-x*y)"`), or a list of three
-    /// (R, G, B) ([`expr`](super::expr)).
+    /// (R, G, B).
     pub integrand: Formulas,
     /// The exact value, for `"reference": {"type": "closed-form"}`: a number
     /// or an expression without variables (`"(1 + exp(-2))/2"`), a list of
@@ -413,6 +412,17 @@ pub struct Built {
 /// Checks every field of `spec` and builds it; errors at `scene.<field>`.
 pub fn build(spec: &IntegralSpec) -> Result<Built, SpecError> {
     let region = region(&spec.domain).map_err(|e| SpecError::from_quad("scene.domain", e))?;
+    let size = region.size();
+    if !(size.is_normal() || size == f64::INFINITY && matches!(region, Region::Interval(_))) {
+        return Err(SpecError::at(
+            "scene.domain",
+            format!(
+                "its {} is {size:e}: expected a finite size above 2.2e-308 in f64 (the \
+                 integrand is multiplied by it; rescale the domain's coordinates)",
+                region.measure()
+            ),
+        ));
+    }
     let variables = region.variables();
     let integrand = spec
         .integrand
@@ -522,8 +532,9 @@ fn region(spec: &DomainSpec) -> Result<Region, QuadError> {
     })
 }
 
-/// `[a, b]` with `a < b`; infinite ends as [`Interval`] says.
-fn interval(a: f64, b: f64) -> Result<Interval, QuadError> {
+/// The pieces of `[a, b]`, `a < b`, infinite ends cut off as
+/// [`Interval`] says.
+fn interval(a: f64, b: f64) -> Result<Vec<Interval>, QuadError> {
     if a.is_nan() || a == f64::INFINITY {
         return Err(QuadError::invalid("a", a, "a number or \"-inf\""));
     }
@@ -534,7 +545,7 @@ fn interval(a: f64, b: f64) -> Result<Interval, QuadError> {
         return Err(QuadError::invalid("b", b, format!("b > a = {a}")));
     }
     Ok(match (a.is_finite(), b.is_finite()) {
-        (true, true) if (b - a).is_finite() => Interval::Finite(a, b),
+        (true, true) if (b - a).is_finite() => vec![Interval::Finite(a, b)],
         (true, true) => {
             return Err(QuadError::invalid(
                 "b",
@@ -542,9 +553,13 @@ fn interval(a: f64, b: f64) -> Result<Interval, QuadError> {
                 format!("an end whose distance b - a from a = {a} is finite in f64"),
             ));
         }
-        (true, false) => Interval::Above(a),
-        (false, true) => Interval::Below(b),
-        (false, false) => Interval::Line,
+        (true, false) => vec![Interval::Finite(a, a + 1.0), Interval::Above(a + 1.0)],
+        (false, true) => vec![Interval::Below(b - 1.0), Interval::Finite(b, b - 1.0)],
+        (false, false) => vec![
+            Interval::Below(-1.0),
+            Interval::Finite(-1.0, 1.0),
+            Interval::Above(1.0),
+        ],
     })
 }
 

@@ -213,6 +213,23 @@ fn infinite_intervals_and_breaks() {
         0.5,
         1e-13,
     );
+    // Slow decay and a singular finite end: each infinite end and each
+    // finite one is at u = 0 of its piece, where f64 resolves u to 1e-308
+    // (one map of [1, inf) lost 1.1e-8 of 2 past x = 1e16, while its
+    // reference claimed 6e-11; the mirrored map met the 1/sqrt at x = 0).
+    let slow = json!({"type": "interval", "a": 1, "b": "inf"});
+    close(
+        "x^-1.5 on [1, inf)",
+        converged(slow, "1/x^1.5", 400).value[0],
+        2.0,
+        1e-12,
+    );
+    let singular = json!({"type": "interval", "a": "-inf", "b": 0});
+    let m = converged(singular, "exp(x)/sqrt(-x)", 400);
+    close("e^x / sqrt(-x) on (-inf, 0]", m.value[0], PI.sqrt(), 1e-10);
+    let mirrored = json!({"type": "interval", "a": 0, "b": "inf"});
+    let m = converged(mirrored, "exp(-x)/sqrt(x)", 400);
+    close("e^-x / sqrt(x) on [0, inf)", m.value[0], PI.sqrt(), 1e-10);
     // A rule with a node at the infinite end (trapezoid) takes it as 0.
     let m = integrate(tail, "x^(-3)", "trapezoid", 4097);
     close("trapezoid x^-3", m.value[0], 0.5, 1e-6);
@@ -354,6 +371,21 @@ fn faults_are_refused_at_their_path_and_column() {
             json!({"domain": {"type": "hemisphere", "normal": [0, 0, 0]}, "integrand": "1"}),
             "scene.domain.normal",
             &["non-zero"],
+        ),
+        (
+            json!({"domain": {"type": "box", "min": [0, 0], "max": [1e-200, 1e-200]}, "integrand": "1e300"}),
+            "scene.domain",
+            &["volume is 0e0", "rescale"],
+        ),
+        (
+            json!({"domain": {"type": "sphere", "centre": [0, 0, 0], "radius": 1e200}, "integrand": "1"}),
+            "scene.domain",
+            &["area is inf"],
+        ),
+        (
+            json!({"domain": cube2, "integrand": "x*1e309"}),
+            "scene.integrand",
+            &["column 3", "beyond the f64 range"],
         ),
         (
             json!({"domain": {"type": "torus"}, "integrand": "1"}),

@@ -42,7 +42,8 @@ pub(super) fn check(text: &str, variables: &[&str]) -> Result<(), ExprError> {
         if want_operand {
             match tok {
                 Token::Op(b'+' | b'-') => lead.signed = true,
-                Token::Number(_) => {
+                Token::Number(digits) => {
+                    in_range(text, at, digits)?;
                     (last, lead, want_operand) = (lead, Lead::default(), false);
                 }
                 Token::Name(name) => {
@@ -197,6 +198,26 @@ fn bounded(text: &str, toks: &[(Token<'_>, usize)]) -> Result<(), ExprError> {
         }
     }
     Ok(())
+}
+
+/// Refuses a number beyond the f64 range, or one that is not 0 but rounds
+/// to it.
+fn in_range(text: &str, at: usize, digits: &str) -> Result<(), ExprError> {
+    let x: f64 = digits.parse().unwrap_or(f64::NAN);
+    let nonzero = digits
+        .split(['e', 'E'])
+        .next()
+        .is_some_and(|m| m.bytes().any(|c| (b'1'..=b'9').contains(&c)));
+    if x.is_finite() && (x != 0.0 || !nonzero) {
+        return Ok(());
+    }
+    Err(fault(
+        text,
+        at,
+        format!(
+            "{digits} is beyond the f64 range: expected a number from 2.2e-308 to 1.8e308 in magnitude, or 0"
+        ),
+    ))
 }
 
 /// A `^` after an operand read with a sign before it, or as an exponent
