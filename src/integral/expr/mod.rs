@@ -25,12 +25,12 @@
 //! | functions of two arguments | `atan2(y, x)`, `min(a, b)`, `max(a, b)` |
 //!
 //! Why not an expression crate: exmex (maintained, MIT/Apache) and fasteval
-//! (last released 2020) both read `-x^2` as `(-x)^2`, and exmex's evaluator
-//! cost 4.8 times a Rust closure per point on a 10-term integrand with
-//! elementary functions and 16 times on a 10-term polynomial
-//! (benches/README.md), against this program's figures there; evalexpr is
-//! AGPL. exmex stays a test dependency: the tests check this parser's
-//! values against it on random expressions that both read alike.
+//! (last released 2020) both read `-x^2` as `(-x)^2`; exmex also misreads
+//! some sums inside calls (`sin(-(x + 0.5 + 0.5))` at x = -2.3624 is -3.20
+//! to it) and its evaluator cost 4.8 times a Rust closure per point on a
+//! 10-term integrand with elementary functions and 16 times on a 10-term
+//! polynomial (benches/README.md), against this compiler's figures there;
+//! evalexpr is AGPL.
 //!
 //! ```
 //! use lightquad::integral::expr::Expr;
