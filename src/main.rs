@@ -76,8 +76,13 @@ enum Command {
         #[arg(long)]
         no_cost_limit: bool,
     },
-    /// Print the JSON Schema of experiment files.
-    Schema,
+    /// Print the JSON Schema of experiment files (with --summary: of the
+    /// summary.json files a report writes).
+    Schema {
+        /// The schema of summary.json instead.
+        #[arg(long)]
+        summary: bool,
+    },
     /// Join the results of `run --shard` folders into one report.
     Merge {
         /// Output folders of the shards.
@@ -91,6 +96,33 @@ enum Command {
         /// names every commit.
         #[arg(long)]
         allow_mixed_commits: bool,
+    },
+    /// Compare a run (NEW, a report folder) with a baseline (OLD): every
+    /// job's values bit for bit (or within --tolerance), every row's time
+    /// (faster or slower where the medians' confidence intervals do not
+    /// overlap), every rule's rank. Prints a Markdown summary; exits
+    /// non-zero where a value changed, unless --allow-value-changes.
+    Compare {
+        /// The baseline report folder.
+        old: PathBuf,
+        /// The report folder to judge.
+        new: PathBuf,
+        /// Only these experiments (default: every one both folders have).
+        #[arg(long = "experiment")]
+        experiments: Vec<String>,
+        /// Values agree within this relative difference (default: bit for bit).
+        #[arg(long)]
+        tolerance: Option<f64>,
+        /// A time changed only beyond this relative change either way (and
+        /// outside both intervals): 0.5 means 1.5x faster or slower.
+        #[arg(long, default_value_t = experiment::compare::NOISE)]
+        noise: f64,
+        /// Exit 0 even where values changed (they are still reported).
+        #[arg(long)]
+        allow_value_changes: bool,
+        /// Also write compare.md and compare.html into this folder.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Print the families' audits of the source documents' printed formulas
     /// (Markdown; also at the end of every report's index).
@@ -264,7 +296,14 @@ fn run(command: Command) -> Result<(), Failure> {
                 )?;
             }
         }
-        Command::Schema => writeln!(out, "{}", serde_json::to_string_pretty(&registry.schema())?)?,
+        Command::Schema { summary: false } => {
+            writeln!(out, "{}", serde_json::to_string_pretty(&registry.schema())?)?
+        }
+        Command::Schema { summary: true } => writeln!(
+            out,
+            "{}",
+            serde_json::to_string_pretty(&experiment::report::summary_schema())?
+        )?,
         Command::Merge {
             inputs,
             out: dir,
@@ -278,6 +317,35 @@ fn run(command: Command) -> Result<(), Failure> {
             };
             let index = experiment::merge_with(&registry, &inputs, &dir, &options)?;
             writeln!(out, "report: {}", index.display())?;
+        }
+        Command::Compare {
+            old,
+            new,
+            experiments,
+            tolerance,
+            noise,
+            allow_value_changes,
+            out: dir,
+        } => {
+            let opts = experiment::compare::CompareOptions {
+                tolerance,
+                experiments,
+                noise,
+            };
+            let c = experiment::compare::compare(&old, &new, &opts)?;
+            let md = c.markdown();
+            write!(out, "{md}")?;
+            out.flush()?;
+            if let Some(dir) = dir {
+                experiment::compare::write(&dir, &c)?;
+            }
+            if c.values_changed() > 0 && !allow_value_changes {
+                return Err(format!(
+                    "{} value change(s) against the baseline (listed above;                      --allow-value-changes to accept them)",
+                    c.values_changed()
+                )
+                .into());
+            }
         }
         Command::Render {
             file,

@@ -32,6 +32,39 @@ pub fn fitted_order(points: &[(f64, f64)]) -> Option<f64> {
 /// errors follow a power law, large where they oscillate (a kink between
 /// nodes that moves with n), so the slope is not an order.
 pub fn fitted_line(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    line(points).map(|l| (l.slope, l.off))
+}
+
+/// A least-squares line through `(ln cost, ln error)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Line {
+    /// The slope: the observed order.
+    pub slope: f64,
+    /// `ln error` where `ln cost` is 0.
+    pub intercept: f64,
+    /// The largest factor by which a point lies off the line.
+    pub off: f64,
+    /// Half the width of the slope's 95% confidence interval: `t(0.975,
+    /// m - 2) s / sqrt(Sxx)` with `s^2` the residuals' mean square over
+    /// `m - 2`; infinite through two points (no residual to judge by).
+    pub half_width: f64,
+    /// Points fitted.
+    pub points: usize,
+}
+
+impl Line {
+    /// The cost at which the line reaches `error`: `exp((ln error - intercept) / slope)`;
+    /// None unless the slope is negative.
+    pub fn cost_at(&self, error: f64) -> Option<f64> {
+        (self.slope < 0.0).then(|| ((error.ln() - self.intercept) / self.slope).exp())
+    }
+}
+
+/// The least-squares line of `ln(error)` against `ln(cost)` with its
+/// slope's confidence interval (the regression's t interval: exact for
+/// errors scattered normally about a power law in log space); points with
+/// a zero or non-finite error or cost left out; None below two points.
+pub fn line(points: &[(f64, f64)]) -> Option<Line> {
     let pts: Vec<(f64, f64)> = points
         .iter()
         .filter(|(c, e)| *c > 0.0 && *e > 0.0 && c.is_finite() && e.is_finite())
@@ -50,11 +83,29 @@ pub fn fitted_line(points: &[(f64, f64)]) -> Option<(f64, f64)> {
         return None;
     }
     let slope = num / den;
-    let worst = pts
-        .iter()
-        .map(|(x, y)| (y - my - slope * (x - mx)).abs())
-        .fold(0.0f64, f64::max);
-    Some((slope, worst.exp()))
+    let residuals: Vec<f64> = pts.iter().map(|(x, y)| y - my - slope * (x - mx)).collect();
+    let worst = residuals.iter().map(|r| r.abs()).fold(0.0f64, f64::max);
+    let half_width = if pts.len() > 2 {
+        let dof = m - 2.0;
+        let s2 = residuals.iter().map(|r| r * r).sum::<f64>() / dof;
+        t_975(dof) * (s2 / den).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    Some(Line {
+        slope,
+        intercept: my - slope * mx,
+        off: worst.exp(),
+        half_width,
+        points: pts.len(),
+    })
+}
+
+/// The 0.975 quantile of Student's t with `dof` degrees of freedom (12.71
+/// for one, 4.30 for two).
+fn t_975(dof: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    StudentsT::new(0.0, 1.0, dof).map_or(f64::INFINITY, |t| t.inverse_cdf(0.975))
 }
 
 #[cfg(test)]
@@ -83,5 +134,41 @@ mod tests {
             panic!("no fit")
         };
         assert!(off > 10.0, "{off}");
+    }
+
+    /// The slope's interval against a hand computation: through (1, e^0),
+    /// (2, e^-1.1), (4, e^-1.9) in log-log, x = 0, ln 2, ln 4; the t
+    /// quantile for one degree of freedom is tan(0.475 pi) = 12.7062.
+    #[test]
+    fn the_slope_interval_is_the_regression_t_interval() {
+        let pts = [(1.0, 1.0), (2.0, (-1.1f64).exp()), (4.0, (-1.9f64).exp())];
+        let Some(l) = line(&pts) else {
+            panic!("no fit")
+        };
+        let (x, y) = ([0.0, 2f64.ln(), 4f64.ln()], [0.0, -1.1, -1.9]);
+        let (mx, my) = (x.iter().sum::<f64>() / 3.0, y.iter().sum::<f64>() / 3.0);
+        let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
+        let b = x
+            .iter()
+            .zip(&y)
+            .map(|(a, c)| (a - mx) * (c - my))
+            .sum::<f64>()
+            / sxx;
+        let rss: f64 = x
+            .iter()
+            .zip(&y)
+            .map(|(a, c)| (c - my - b * (a - mx)).powi(2))
+            .sum();
+        let t = (0.475 * std::f64::consts::PI).tan();
+        assert!((l.slope - b).abs() < 1e-14);
+        assert!((l.half_width - t * (rss / sxx).sqrt()).abs() < 1e-9 * l.half_width);
+        // On a power law the interval closes; through two points it is open.
+        let Some(law) = line(&[(1.0, 1.0), (2.0, 0.25), (4.0, 0.0625)]) else {
+            panic!("no fit")
+        };
+        assert!(law.half_width < 1e-12, "{}", law.half_width);
+        assert_eq!(line(&pts[..2]).map(|l| l.half_width), Some(f64::INFINITY));
+        // The cost where the law reaches 1e-4: n^-2 = 1e-4 at n = 100.
+        assert!(law.cost_at(1e-4).is_some_and(|n| (n - 100.0).abs() < 1e-9));
     }
 }

@@ -35,6 +35,7 @@
 //! locks and checks the output folder, and `merge` gathers shards' results;
 //! running and reporting are here.
 
+pub mod compare;
 pub mod expected;
 pub mod fit;
 pub mod html;
@@ -52,6 +53,7 @@ pub mod run;
 pub mod source;
 pub mod spec;
 pub mod tagged;
+pub mod timing;
 pub mod validate;
 
 use std::collections::BTreeSet;
@@ -348,6 +350,7 @@ fn write_reports(
             .map_err(|e| io(&dir, unfinished(e)))
     });
     let mut entries = Vec::new();
+    let mut numbers = Vec::new();
     let mut checks = Vec::new();
     let mut problems = missing;
     for ((exp, _), written) in done.iter().zip(pages?) {
@@ -356,6 +359,7 @@ fn write_reports(
             exp.description().to_string(),
             written.summary,
         ));
+        numbers.push(written.numbers);
         checks.extend(written.crosscheck);
         problems.extend(written.problems);
     }
@@ -382,6 +386,9 @@ fn write_reports(
     earlier.sort();
     report_files
         .record(|| report::write_index(out, &entries, &checks, &audits, &problems, &earlier))
+        .map_err(|e| io(out, unfinished(e)))?;
+    report_files
+        .record(|| report::write_summary(out, &numbers))
         .map_err(|e| io(out, unfinished(e)))?;
     report_files.finish();
     let index = out.join("index.md");

@@ -123,6 +123,7 @@ pub(super) fn experiment_folder(dir: &Path) -> Result<(), RunError> {
         "results.jsonl",
         "report.md",
         "index.html",
+        crate::experiment::run::SUMMARY_FILE,
     ] {
         let path = dir.join(file);
         if path.is_dir() {

@@ -173,7 +173,7 @@ impl<F: Family> Loaded for Experiment<F> {
         let reference = reference(self);
         let crosscheck = crosscheck(self);
         let page = page(self, &reference, &crosscheck);
-        let summary = write_experiment(dir, &page, results)?;
+        let (summary, numbers) = write_experiment(dir, &page, results)?;
         let problems = reference
             .missing
             .iter()
@@ -181,6 +181,7 @@ impl<F: Family> Loaded for Experiment<F> {
             .collect();
         Ok(Written {
             summary,
+            numbers,
             crosscheck,
             problems,
         })
@@ -192,6 +193,8 @@ impl<F: Family> Loaded for Experiment<F> {
 pub struct Written {
     /// Per quantity, each rule's time to the middle target.
     pub summary: Summary,
+    /// What the page shows, for `summary.json`.
+    pub numbers: super::report::ExperimentSummary,
     /// The Mitsuba comparison rows.
     pub crosscheck: Vec<Crosscheck>,
     /// What the page could not show (a quantity without a reference).
@@ -237,6 +240,7 @@ fn page<'a, F: Family>(
         .collect();
     Page {
         name: &spec.name,
+        hash: &exp.hash,
         description: &spec.description,
         family: F::NAME,
         equations: &spec.equations,

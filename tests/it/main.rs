@@ -50,6 +50,7 @@ mod runner;
 mod sobol_dims;
 mod spec_fuzz;
 mod sum_lanes;
+mod summary_compare;
 mod tracking_cost;
 mod tracking_diagnostic;
 mod volume;

@@ -102,9 +102,11 @@ fn the_bundled_whitted_experiments_validate_run_and_cover_every_equation() {
                     .lines()
                     .find(|l| l.starts_with(&format!("| {rule} | -")))
                     .unwrap_or_else(|| panic!("no slope row for {rule}"));
+                // The cell is "-2.00 ± 0.01": the slope, then its interval.
                 row.split('|')
                     .nth(2)
-                    .and_then(|c| c.trim().parse().ok())
+                    .and_then(|c| c.split_whitespace().next())
+                    .and_then(|c| c.parse().ok())
                     .expect("slope")
             };
             for rule in ["grid", "trapezoid"] {

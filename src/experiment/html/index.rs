@@ -56,7 +56,7 @@ pub fn write_index(
         let fastest: Vec<String> = summary
             .iter()
             .map(|(q, ranking)| {
-                // The first, and any tied with it within timing noise.
+                // The first, and any tied with it (overlapping time intervals).
                 let ranking = ranked(ranking);
                 let best: Vec<String> = ranking
                     .iter()
@@ -74,7 +74,7 @@ pub fn write_index(
                     0 => format!("{}: none reached", escape(q)),
                     1 => format!("{}: {}", escape(q), best[0]),
                     _ => format!(
-                        "{}: {} (tied within timing noise)",
+                        "{}: {} (tied: their time intervals overlap)",
                         escape(q),
                         best.join(" = ")
                     ),

@@ -22,7 +22,7 @@
 //! // holds markup: it is shown as text, and the page loads nothing from elsewhere.
 //! let out = std::env::temp_dir().join(format!("lightquad-doc-html-{}", std::process::id()));
 //! std::fs::create_dir_all(&out)?;
-//! let ranked = Ranked { label: "gauss-legendre".into(), seconds: Some(2e-6), exact_from_start: false };
+//! let ranked = Ranked { label: "gauss-legendre".into(), seconds: Some(2e-6), time: None, exact_from_start: false };
 //! let entries = [("exp".to_string(), "e^u <b>& friends</b>".to_string(), vec![("exp", vec![ranked])])];
 //! write_index(&out, &entries, &[], &[], &[], &[])?;
 //! let page = std::fs::read_to_string(out.join("index.html"))?;
@@ -150,6 +150,11 @@ fn document(title: &str, body: &str) -> String {
          <title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n{body}\n<script>{JS}</script>\n</body>\n</html>\n",
         escape(title)
     )
+}
+
+/// A page of Markdown `md` as HTML, in the report's style.
+pub fn markdown_page(title: &str, md: &str) -> String {
+    document(title, &super::markdown::to_html(md, 0))
 }
 
 /// A rule's name with its colour swatch on the page of `palette`.

@@ -127,8 +127,9 @@ pub(super) fn section(page: &Page, s: &Section) -> String {
     }
     let _ = writeln!(
         b,
-        "</tbody></table></div>\n<p class=\"note\">Slope vs n: {}. An order-p rule shows as -p.</p>",
-        escape(&s.slope_heading)
+        "</tbody></table></div>\n<p class=\"note\">Slope vs n: {}. An order-p rule shows as -p. {}</p>",
+        escape(&s.slope_heading),
+        escape(crate::experiment::report::FIT_NOTE)
     );
     // Every row.
     let display = page
@@ -154,7 +155,7 @@ pub(super) fn section(page: &Page, s: &Section) -> String {
     }
     let _ = write!(
         b,
-        "<h3>Every rule and budget</h3>\n<div class=\"scroll\"><table class=\"sortable\"><thead><tr>{}{}{}{}{extra}{}{}{}{}</tr></thead><tbody>",
+        "<h3>Every rule and budget</h3>\n<div class=\"scroll\"><table class=\"sortable\"><thead><tr>{}{}{}{}{extra}{}{}{}{}{}</tr></thead><tbody>",
         th("rule", "rule or estimator", false),
         th("n", "budget", true),
         th("value", "value, mean over repeats", true),
@@ -171,8 +172,13 @@ pub(super) fn section(page: &Page, s: &Section) -> String {
         th("evaluations", "mean evaluations", true),
         th(
             "median time (s)",
-            "lower median wall time over repeats",
+            "lower median wall time per call, over the per-call times of every repeat",
             true
+        ),
+        th(
+            "time interval",
+            "confidence interval of the median time (order statistics, distribution-free), with its confidence",
+            false
         ),
         th("flags", "see Flags below", false),
     );
@@ -227,7 +233,7 @@ fn row(page: &Page, r: &Row, multi: bool, display: bool) -> String {
         ));
     }
     format!(
-        "<tr{class}>{}{}{}{}{extra}{}{}{}<td class=\"flags\">{}</td></tr>",
+        "<tr{class}>{}{}{}{}{extra}{}{}{}<td>{}</td><td class=\"flags\">{}</td></tr>",
         rule_cell(&page.palette(), &label(page, r.rule_index)),
         num_cell(&r.budget.to_string(), r.budget as f64),
         num_cell(&show_value(&r.value), value),
@@ -235,6 +241,7 @@ fn row(page: &Page, r: &Row, multi: bool, display: bool) -> String {
         num_cell(&cell(r.rel_estimate), r.rel_estimate),
         num_cell(&format!("{:.0}", r.evaluations), r.evaluations),
         num_cell(&format!("{:.2e}", r.seconds), r.seconds),
+        escape(&crate::experiment::report::interval_cell(r.time.as_ref())),
         escape(&flags.join("; "))
     )
 }

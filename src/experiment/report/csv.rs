@@ -1,14 +1,22 @@
 //! `results.csv`: a line per job and quantity, timed by the quantity's own
-//! evaluation (the job's time where the job failed before any quantity).
+//! evaluation (the job's time where the job failed before any quantity),
+//! with the quantity's reference and the job's true error against it.
 
 use std::fmt::Write as _;
 
+use super::Page;
+use super::rows::scale_of;
+use crate::experiment::reference::rms;
 use crate::experiment::run::JobResult;
 
-/// A CSV line per job and quantity (a channel vector as `;`-separated numbers).
-pub(super) fn csv(results: &[JobResult]) -> String {
+/// A CSV line per job and quantity (a channel vector as `;`-separated
+/// numbers): `reference` is the quantity's reference per channel and
+/// `rel_error` the job's root-mean-square error over channels against it,
+/// relative to the reference's root mean square as in the report (both
+/// empty where the quantity has no reference).
+pub(super) fn csv(page: &Page, results: &[JobResult]) -> String {
     let mut csv = String::from(
-        "experiment,rule_index,rule,budget,repeat,seed,quantity,value,estimated_error,evaluations,seconds,failure\n",
+        "experiment,rule_index,rule,budget,repeat,seed,quantity,value,estimated_error,evaluations,seconds,reference,rel_error,failure\n",
     );
     let join = |v: &[f64]| {
         v.iter()
@@ -33,12 +41,16 @@ pub(super) fn csv(results: &[JobResult]) -> String {
             } else {
                 &failure
             };
-            let _ = writeln!(csv, "{lead},,,,,{:e},{why}", r.seconds);
+            let _ = writeln!(csv, "{lead},,,,,{:e},,,{why}", r.seconds);
         }
         for (q, m) in &r.quantities {
+            let (reference, error) = match page.reference.values.get(q) {
+                Some(v) => (join(v), format!("{:e}", true_error(&m.value, v))),
+                None => (String::new(), String::new()),
+            };
             let _ = writeln!(
                 csv,
-                "{lead},{},{},{},{},{:e},{failure}",
+                "{lead},{},{},{},{},{:e},{reference},{error},{failure}",
                 field(q),
                 join(&m.value),
                 join(&m.error),
@@ -48,6 +60,22 @@ pub(super) fn csv(results: &[JobResult]) -> String {
         }
     }
     csv
+}
+
+/// The root-mean-square error of `value` against `reference` over
+/// channels, relative to the reference's root mean square (absolute where
+/// that is 0); a missing channel is NaN. Near the top of the range the
+/// halves are subtracted and the result doubled, as the report's rows do.
+fn true_error(value: &[f64], reference: &[f64]) -> f64 {
+    let n = value.len().max(reference.len());
+    let at = |v: &[f64], c: usize| v.get(c).copied().unwrap_or(f64::NAN);
+    let huge = value
+        .iter()
+        .chain(reference)
+        .any(|x| x.abs() > f64::MAX / 2.0);
+    let (halve, double) = if huge { (0.5, 2.0) } else { (1.0, 1.0) };
+    rms((0..n).map(|c| at(value, c) * halve - at(reference, c) * halve)) / scale_of(reference)
+        * double
 }
 
 /// A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break.

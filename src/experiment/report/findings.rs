@@ -5,8 +5,8 @@
 
 use std::collections::BTreeMap;
 
-use super::ranking::TIE_FACTOR;
 use super::{Page, RowFlag, Section, label};
+use crate::experiment::timing::TimeInterval;
 use crate::family::Flag;
 
 /// The findings paragraph of `s` (Markdown, one paragraph), or none where
@@ -28,10 +28,13 @@ fn targets(page: &Page, s: &Section) -> String {
         .map(|r| r.label.as_str())
         .collect();
     for (k, t) in page.targets.iter().enumerate() {
-        let mut reached: Vec<(&str, f64)> = s
+        let mut reached: Vec<(&str, f64, TimeInterval)> = s
             .fits
             .iter()
-            .filter_map(|f| Some((f.label.as_str(), (*f.seconds.get(k)?)?)))
+            .filter_map(|f| {
+                let time = f.reach.get(k)?.interval()?;
+                Some((f.label.as_str(), time.median, time))
+            })
             .collect();
         reached.sort_by(|a, b| a.1.total_cmp(&b.1));
         let below = s.fits.iter().all(|f| {
@@ -44,14 +47,14 @@ fn targets(page: &Page, s: &Section) -> String {
                 format!("{t:.0e} is below the reference's accuracy: no rule is judged against it.")
             }
             [] => format!("No rule reaches {t:.0e}."),
-            [(a, x)] => format!("Only {a} reaches {t:.0e}, in {x:.2e} s."),
-            [(a, x), (b, y), ..] if *y <= x * TIE_FACTOR => format!(
-                "{a} and {b} reach {t:.0e} in {x:.2e} and {y:.2e} s, within timing noise \
-                 ({} of {} rules reach it).",
+            [(a, x, _)] => format!("Only {a} reaches {t:.0e}, in {x:.2e} s."),
+            [(a, x, i), (b, y, j), ..] if i.overlaps(j) => format!(
+                "{a} and {b} reach {t:.0e} in {x:.2e} and {y:.2e} s, not told apart (their \
+                 times' confidence intervals overlap; {} of {} rules reach it).",
                 reached.len(),
                 s.fits.len()
             ),
-            [(a, x), (b, y), ..] => format!(
+            [(a, x, _), (b, y, _), ..] => format!(
                 "{a} reaches {t:.0e} first, in {x:.2e} s, {:.1} times faster than the next, \
                  {b} ({} of {} rules reach it).",
                 y / x,

@@ -45,6 +45,7 @@
 
 mod csv;
 mod findings;
+mod fitted;
 mod index;
 mod order;
 mod page;
@@ -52,19 +53,25 @@ mod pictures;
 mod ranking;
 mod rows;
 mod section;
+mod summary;
 
 use std::collections::BTreeMap;
 
 pub use findings::findings;
+pub use fitted::{Extrapolated, Reach, Slope};
 pub use index::write_index;
-pub use order::{Against, ERRATIC, FIT_ROWS, fit_floor, order, order_and_scatter, time_to};
-pub use page::{SHARED, provenance, write_experiment};
+pub use order::{Against, ERRATIC, FIT_ROWS, Order, fit_floor, fitted, order, time_to};
+pub use page::{FIT_NOTE, SHARED, interval_cell, provenance, write_experiment, write_summary};
 pub use pictures::Picture;
-pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIE_FACTOR, TIED, ranked, ranks};
+pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIED, ranked, ranks, tied};
 pub use rows::{FLAG_LEGEND, Row, RowFlag, rows};
 pub use section::{
     Fit, Section, cell, display_line, extra_columns, label, off_cell, over_budget, sections,
     show_value, skipped,
+};
+pub use summary::{
+    ExperimentSummary, FlagSummary, QuantitySummary, ReferenceSummary, ReportSummary, RowSummary,
+    RuleSummary, SUMMARY_VERSION, TargetSummary, experiment_summary, schema as summary_schema,
 };
 
 use super::reference::{Crosscheck, Reference};
@@ -75,6 +82,8 @@ use crate::family::Display;
 pub struct Page<'a> {
     /// Experiment name.
     pub name: &'a str,
+    /// FNV-1a hash of the experiment file.
+    pub hash: &'a str,
     /// What it shows.
     pub description: &'a str,
     /// Its family.
@@ -115,6 +124,15 @@ pub struct Page<'a> {
 }
 
 impl Page<'_> {
+    /// The target the rules are ranked by: the middle one (1e-6 where the
+    /// file gives none).
+    pub fn middle_target(&self) -> f64 {
+        self.targets
+            .get(self.targets.len() / 2)
+            .copied()
+            .unwrap_or(1e-6)
+    }
+
     /// The colours of this page's rules, no two alike.
     pub fn palette(&self) -> super::plot::Palette {
         super::plot::Palette::new(self.rules.iter().map(|r| r.label.as_str()))

@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use super::rows::{FLOOR, Row, RowFlag};
-use crate::experiment::fit::fitted_line;
+use crate::experiment::fit::{Line, line};
 use crate::family::Flag;
 
 /// What a fitted slope is measured against.
@@ -35,7 +35,7 @@ pub const FIT_ROWS: usize = 4;
 /// floor and ten times the reference's own accuracy (`floor`); None below
 /// three such rows.
 pub fn order(rows: &[&Row], against: Against, floor: f64) -> Option<f64> {
-    order_and_scatter(rows, against, floor).map(|(o, _, _)| o)
+    fitted(rows, against, floor).map(|o| o.line.slope)
 }
 
 /// The error an order is fitted above: ten times the reference's accuracy
@@ -49,10 +49,19 @@ pub fn fit_floor(accuracy: f64) -> f64 {
 /// mean square over a few repeats scatters more and gets twice the room).
 pub const ERRATIC: f64 = 2.0;
 
-/// [`order`] with the largest factor by which a fitted point lies off the
-/// line ([`fitted_line`]), and whether the error grew by more
-/// than 1.5x from one fitted point to the next.
-pub fn order_and_scatter(rows: &[&Row], against: Against, floor: f64) -> Option<(f64, f64, bool)> {
+/// A fitted order: the line through a rule's last rows and whether the
+/// error grew by more than 1.5x from one fitted point to the next.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Order {
+    /// The line, with its slope's confidence interval and scatter.
+    pub line: Line,
+    /// The error grew by more than 1.5x between consecutive fitted points.
+    pub grew: bool,
+}
+
+/// [`order`] with its line ([`Line`]: the slope's interval, how far a point
+/// lies off it) and whether the error grew inside the fitted rows.
+pub fn fitted(rows: &[&Row], against: Against, floor: f64) -> Option<Order> {
     let mut pts: Vec<(f64, f64)> = rows
         .iter()
         .filter(|r| r.rel_error > fit_floor(floor))
@@ -75,12 +84,13 @@ pub fn order_and_scatter(rows: &[&Row], against: Against, floor: f64) -> Option<
     pts.sort_by(|a, b| a.0.total_cmp(&b.0));
     let tail = &pts[pts.len().saturating_sub(FIT_ROWS)..];
     let grew = tail.windows(2).any(|w| w[1].1 > 1.5 * w[0].1);
-    fitted_line(tail).map(|(slope, off)| (slope, off, grew))
+    line(tail).map(|line| Order { line, grew })
 }
 
-/// The time a rule needs to reach `target` and stay there: the least median
-/// time among the rows from the smallest budget on whose every larger
-/// budget meets the target too; None where the largest budget misses it.
+/// The row that gives the time a rule needs to reach `target` and stay
+/// there: the least median time among the rows from the smallest budget on
+/// whose every larger budget meets the target too; None where the largest
+/// budget misses it.
 ///
 /// An error that dips below the target at one budget by a lucky
 /// cancellation and rises above it again does not count (Gauss–Legendre on
@@ -89,7 +99,7 @@ pub fn order_and_scatter(rows: &[&Row], against: Against, floor: f64) -> Option<
 /// nothing, nor does one whose value underflowed: 0 against a reference
 /// that also reads 0 in f64 is an error of 0 on paper and of 100% against
 /// the true value (`e^-100000` on the stiff sphere).
-pub fn time_to(rows: &[&Row], target: f64) -> Option<f64> {
+pub fn time_to<'a>(rows: &[&'a Row], target: f64) -> Option<&'a Row> {
     let meets = |r: &Row| {
         r.rel_error <= target
             && !r
@@ -97,7 +107,7 @@ pub fn time_to(rows: &[&Row], target: f64) -> Option<f64> {
                 .iter()
                 .any(|f| matches!(f, RowFlag::Failed(_) | RowFlag::Job(Flag::Underflow)))
     };
-    let mut by_budget: Vec<&Row> = rows.to_vec();
+    let mut by_budget: Vec<&'a Row> = rows.to_vec();
     by_budget.sort_by_key(|r| r.budget);
     // The rows past the last budget that misses the target.
     let from = by_budget
@@ -106,8 +116,8 @@ pub fn time_to(rows: &[&Row], target: f64) -> Option<f64> {
         .map_or(0, |i| i + 1);
     by_budget[from..]
         .iter()
-        .map(|r| r.seconds)
-        .min_by(f64::total_cmp)
+        .copied()
+        .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
 }
 
 #[cfg(test)]
@@ -125,6 +135,7 @@ mod tests {
             display_off: None,
             evaluations: budget as f64,
             seconds,
+            time: None,
             flags: Vec::new(),
         }
     }
@@ -144,13 +155,14 @@ mod tests {
             row(262144, 5e-8, 8e-2),
         ];
         let refs: Vec<&Row> = rows.iter().collect();
-        assert_eq!(time_to(&refs, 1e-6), Some(2e-2));
-        assert_eq!(time_to(&refs, 1e-4), Some(1e-5));
-        assert_eq!(time_to(&refs, 1e-8), None);
+        let seconds = |t| time_to(&refs, t).map(|r| r.seconds);
+        assert_eq!(seconds(1e-6), Some(2e-2));
+        assert_eq!(seconds(1e-4), Some(1e-5));
+        assert_eq!(seconds(1e-8), None);
         // The largest budget missing the target: not reached, whatever
         // came before.
         let dip = [row(16, 1e-9, 1e-6), row(64, 1e-3, 4e-6)];
         let refs: Vec<&Row> = dip.iter().collect();
-        assert_eq!(time_to(&refs, 1e-6), None);
+        assert!(time_to(&refs, 1e-6).is_none());
     }
 }

@@ -12,13 +12,19 @@ use super::rows::{FLAG_LEGEND, Row, RowFlag};
 use super::section::{
     cell, display_line, extra_columns, label, off_cell, over_budget, sections, show_value, skipped,
 };
+use super::summary::{ExperimentSummary, ReportSummary, experiment_summary};
 use crate::experiment::reference::crosscheck_markdown;
 use crate::experiment::run::{JobResult, write_report_file};
+use crate::experiment::timing::TimeInterval;
 use crate::family::Display;
 
-/// Writes `report.md`, the SVG plots, `results.csv` and `index.html` of one
-/// experiment.
-pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Result<Summary, String> {
+/// Writes `report.md`, the SVG plots, `results.csv`, `summary.json` and
+/// `index.html` of one experiment; gives the index its ranking and summary.
+pub fn write_experiment(
+    dir: &Path,
+    page: &Page,
+    results: &[JobResult],
+) -> Result<(Summary, ExperimentSummary), String> {
     let sections = sections(page, results)?;
     let mut md = header(page, results);
     if let Some(audit) = &page.scene_audit {
@@ -79,7 +85,7 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
             "\nTime to a target: the least median time among the rows from the budget on which \
              the error stays at or below the target at every larger budget (an error that dips \
              below it at one budget and rises again does not count; a row whose value underflows \
-             has no error and reaches nothing)."
+             has no error and reaches nothing). {FIT_NOTE}"
         );
         md.push('\n');
         for (what, file, text) in &s.plots {
@@ -111,9 +117,42 @@ pub fn write_experiment(dir: &Path, page: &Page, results: &[JobResult]) -> Resul
     }
     let _ = writeln!(md, "{FLAG_LEGEND}");
     write_report_file(&dir.join("report.md"), md.as_bytes())?;
-    write_report_file(&dir.join("results.csv"), csv(results).as_bytes())?;
+    write_report_file(&dir.join("results.csv"), csv(page, results).as_bytes())?;
+    let numbers = experiment_summary(page, &sections);
+    write_summary(dir, std::slice::from_ref(&numbers))?;
     crate::experiment::html::write_experiment(dir, page, results, &sections)?;
-    Ok(summary)
+    Ok((summary, numbers))
+}
+
+/// What the fitted-slope and time-to-target columns' extra figures mean.
+pub const FIT_NOTE: &str = "A slope's ± is half its 95% confidence interval (Student's t on the \
+fitted rows, from their scatter about the line: 3 rows leave 1 degree of freedom and a wide \
+interval). Where a target is not reached and the slope against evaluations is an order known to within \
+a quarter of itself (its 95% interval), the extrapolation is where that line reaches the target, its time scaled from the largest budget's \
+in proportion to the evaluations: an estimate, not a measurement.";
+
+/// A time's interval as a cell: `1.1e-6 to 1.3e-6 (96%)`.
+pub fn interval_cell(t: Option<&TimeInterval>) -> String {
+    match t {
+        Some(t) if t.samples > 1 => format!(
+            "{:.1e} to {:.1e} ({:.0}%)",
+            t.low,
+            t.high,
+            100.0 * t.confidence
+        ),
+        _ => "— (one reading)".into(),
+    }
+}
+
+/// Writes `summary.json` into `dir`: the summary of `experiments`.
+pub fn write_summary(dir: &Path, experiments: &[ExperimentSummary]) -> Result<(), String> {
+    let summary = ReportSummary::of(experiments.to_vec());
+    let text = serde_json::to_string_pretty(&summary)
+        .map_err(|e| format!("summary.json could not be written: {e}"))?;
+    write_report_file(
+        &dir.join(crate::experiment::run::SUMMARY_FILE),
+        text.as_bytes(),
+    )
 }
 
 /// The page's title, settings, reference and provenance.
@@ -216,10 +255,10 @@ fn table(page: &Page, rows: &[Row], display: Option<&Display>) -> String {
         );
     }
     md.push_str(
-        " estimated error (mean over repeats, same scale; a standard error for random rules) | evaluations (mean) | median time (s) | flags |\n|---|---:|---:|---:|",
+        " estimated error (mean over repeats, same scale; a standard error for random rules) | evaluations (mean) | median time (s) | its interval (s, confidence) | flags |\n|---|---:|---:|---:|",
     );
     md.push_str(&"---:|".repeat(usize::from(multi) + usize::from(display.is_some())));
-    md.push_str("---:|---:|---:|---|\n");
+    md.push_str("---:|---:|---:|---:|---|\n");
     for r in rows {
         // A job's failure text may carry a user's strings (a results line
         // edited by hand): escaped, so that it cannot break the table.
@@ -249,10 +288,11 @@ fn table(page: &Page, rows: &[Row], display: Option<&Display>) -> String {
         }
         let _ = writeln!(
             md,
-            " {} | {:.0} | {:.2e} | {} |",
+            " {} | {:.0} | {:.2e} | {} | {} |",
             cell(r.rel_estimate),
             r.evaluations,
             r.seconds,
+            interval_cell(r.time.as_ref()),
             flags.join("; ")
         );
     }

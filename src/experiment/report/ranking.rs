@@ -1,5 +1,7 @@
 //! The index's ranking of the rules by time to the middle target error, with
-//! ties within timing noise.
+//! ties where the times' confidence intervals overlap.
+
+use crate::experiment::timing::TimeInterval;
 
 /// Per-experiment summary for the index: per quantity, in the file's order,
 /// each rule's time to the middle target (None: not reached).
@@ -12,6 +14,8 @@ pub struct Ranked {
     pub label: String,
     /// Its time to the middle target (None: not reached).
     pub seconds: Option<f64>,
+    /// That time's confidence interval (None: not reached, or no time read).
+    pub time: Option<TimeInterval>,
     /// A deterministic rule whose error is unresolved (exact, at rounding, or
     /// at the reference's accuracy) already at its smallest budget: its rank
     /// then says nothing about its speed on integrands in general.
@@ -30,30 +34,31 @@ pub fn ranked(ranking: &[Ranked]) -> Vec<Ranked> {
     ranked
 }
 
-/// Times closer than this factor are ranked as a tie: two runs of the
-/// bundled suite on one machine swapped rules whose times differed by 2%
-/// (5.6e-7 s and 5.7e-7 s), and timings on a shared machine move by 10-20%.
-pub const TIE_FACTOR: f64 = 1.25;
-
 /// The rank of each rule in `ranked` (sorted by [`ranked`]): 1, 2, ...,
-/// with a rule whose time is within [`TIE_FACTOR`] of the one before it
-/// sharing that one's rank (a tie within timing noise). Rules that did not
-/// reach the target rank after all that did.
+/// with a rule whose time's interval overlaps that of the rule before it
+/// sharing that one's rank (their times are not told apart). Rules that did
+/// not reach the target rank after all that did.
 pub fn ranks(ranked: &[Ranked]) -> Vec<usize> {
     let mut out: Vec<usize> = Vec::with_capacity(ranked.len());
     for (i, r) in ranked.iter().enumerate() {
-        let tied = i > 0
-            && matches!(
-                (ranked[i - 1].seconds, r.seconds),
-                (Some(a), Some(b)) if b <= a * TIE_FACTOR
-            );
+        let tied = i > 0 && tied(&ranked[i - 1], r);
         out.push(if tied { out[i - 1] } else { i + 1 });
     }
     out
 }
 
+/// Whether two reached times are not told apart: their intervals overlap
+/// (equal times where either has none).
+pub fn tied(a: &Ranked, b: &Ranked) -> bool {
+    match (a.time, b.time, a.seconds, b.seconds) {
+        (Some(x), Some(y), _, _) => x.overlaps(&y),
+        (_, _, Some(x), Some(y)) => x == y,
+        _ => false,
+    }
+}
+
 /// Said of a rule whose rank it shares with the one before.
-pub const TIED: &str = "tied: within 25% of the time of the rule before, timing noise";
+pub const TIED: &str = "tied: its time's confidence interval overlaps that of the rule before";
 
 /// Said of a rule ranked while exact from its first budget.
 pub const EXACT_FROM_START: &str = "at the error floor from its first budget: this integrand is \
@@ -67,15 +72,22 @@ mod tests {
         Ranked {
             label: label.into(),
             seconds,
+            time: seconds.map(|s| TimeInterval {
+                median: s,
+                low: 0.9 * s,
+                high: 1.1 * s,
+                confidence: 0.95,
+                samples: 15,
+            }),
             exact_from_start: false,
         }
     }
 
-    /// Times within 25% of the one before share its rank; a gap of more
+    /// Times whose intervals overlap the one before share its rank; a gap
     /// starts a new rank at the position; rules that did not reach the
     /// target are never tied.
     #[test]
-    fn times_within_timing_noise_share_a_rank() {
+    fn times_whose_intervals_overlap_share_a_rank() {
         let r = ranked(&[
             rule("d", None),
             rule("c", Some(2.0e-6)),

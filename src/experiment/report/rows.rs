@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use super::RuleInfo;
 use crate::experiment::reference::rms;
 use crate::experiment::run::JobResult;
+use crate::experiment::timing::TimeInterval;
 use crate::family::{Display, Flag, Measured};
 
 /// A fact about a row of a report table.
@@ -106,8 +107,11 @@ pub struct Row {
     pub display_off: Option<f64>,
     /// Mean evaluations.
     pub evaluations: f64,
-    /// Lower median wall time, seconds.
+    /// Lower median wall time per call, seconds: `time`'s median.
     pub seconds: f64,
+    /// The median's confidence interval over the repeats' times (None: no
+    /// time was read).
+    pub time: Option<TimeInterval>,
     /// Stability flags.
     pub flags: Vec<RowFlag>,
 }
@@ -115,16 +119,6 @@ pub struct Row {
 /// Relative errors below this are at the f64 rounding floor: no order is
 /// fitted through them and no estimate is judged against them.
 pub(super) const FLOOR: f64 = 1e-14;
-
-/// The lower median (of two repeats, the faster: the first pays for cold caches).
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[(v.len() - 1) / 2]
-    }
-}
 
 /// Aggregates the jobs of quantity `q` into rows, with their flags; with
 /// the quantity's display, each row counts the displayed values that differ
@@ -189,18 +183,24 @@ fn row(
     if let Some(f) = jobs.iter().find_map(|j| j.failure.clone()) {
         flags.push(RowFlag::Failed(f));
     }
-    // The quantity's own time where the job timed it alone (older results
-    // files: the job's).
-    let seconds = median(
-        jobs.iter()
-            .map(|j| {
-                j.quantities
-                    .get(q)
-                    .and_then(|m| m.seconds)
-                    .unwrap_or(j.seconds)
-            })
-            .collect(),
-    );
+    // A sample per repeat: the quantity's own time where the job timed it
+    // alone, the job's otherwise (a failed job; older results files). The
+    // repeats ran at different moments of the run, so their spread holds
+    // the machine's changing load; a job's batches, run back to back, do
+    // not (GL at n = 16 on calibration-exp: batches within 3% of each other
+    // in each repeat, 0.92 and 1.43 us between two repeats). The lower
+    // median: of two samples the faster, as the first pays for cold caches.
+    let samples: Vec<f64> = jobs
+        .iter()
+        .map(|j| {
+            j.quantities
+                .get(q)
+                .and_then(|m| m.seconds)
+                .unwrap_or(j.seconds)
+        })
+        .collect();
+    let time = TimeInterval::of(&samples);
+    let seconds = time.map_or(f64::NAN, |t| t.median);
     let measured: Vec<_> = jobs.iter().filter_map(|j| j.quantities.get(q)).collect();
     if measured.is_empty() {
         // Every job of this row failed: keep the row, so the failure shows.
@@ -214,6 +214,7 @@ fn row(
             display_off: None,
             evaluations: 0.0,
             seconds,
+            time,
             flags,
         };
     }
@@ -316,6 +317,7 @@ fn row(
         display_off: None,
         evaluations,
         seconds,
+        time,
         flags,
     }
 }

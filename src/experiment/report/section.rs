@@ -3,7 +3,8 @@
 //! plots and images, and the cells and lines both pages print.
 
 use super::Page;
-use super::order::{Against, ERRATIC, FIT_ROWS, fit_floor, order_and_scatter, time_to};
+use super::fitted::{Reach, Slope};
+use super::order::{Against, FIT_ROWS, fit_floor, fitted};
 use super::pictures::{Picture, pictures};
 use super::ranking::Ranked;
 use super::rows::{FLOOR, Row, RowFlag, rows, scale_of};
@@ -54,16 +55,26 @@ pub struct Section {
     pub pictures: Vec<Picture>,
 }
 
-/// A rule's fitted slopes and times to the targets, as shown.
+/// A rule's fitted slopes and times to the targets, as numbers and as shown.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fit {
+    /// The rule's index in the file.
+    pub rule_index: usize,
     /// The rule's label.
     pub label: String,
+    /// The slope against the resolution per axis, with its interval.
+    pub resolution_slope: Option<Slope>,
+    /// The slope against evaluations, with its interval.
+    pub evaluations_slope: Option<Slope>,
+    /// Per target: reached (with the row's time), not reached (with an
+    /// extrapolation where the order allows), or below the reference's accuracy.
+    pub reach: Vec<Reach>,
     /// The slope of log error against log budget per axis ("—": too few rows).
     pub slope_budget: String,
     /// The slope of log error against log evaluations.
     pub slope_evaluations: String,
-    /// Per target: the time in seconds, "not reached" or "below reference accuracy".
+    /// Per target as shown: the time in seconds, "not reached" (with its
+    /// extrapolation) or "below reference accuracy".
     pub times: Vec<String>,
     /// Per target: the time in seconds where the rule reached it.
     pub seconds: Vec<Option<f64>>,
@@ -262,6 +273,41 @@ pub fn label(page: &Page, i: usize) -> String {
         .map_or_else(|| format!("rule #{i}"), |r| r.label.clone())
 }
 
+/// Rule `i`'s fitted slopes (a deterministic rule whose error grows with
+/// the budget inside the fitted rows, a kink that moves between nodes, has
+/// no order either) and where it stands against each target.
+fn fit(page: &Page, i: usize, mine: &[&Row], dimension: usize, accuracy: f64) -> Fit {
+    let random = page.rules.get(i).is_some_and(|r| r.is_random);
+    let resolution = Against::Resolution {
+        dimension,
+        by_budget: page.rules.get(i).and_then(|r| r.resolution.get(&dimension)),
+    };
+    let resolution_slope = Slope::of(mine, resolution, accuracy, random);
+    let cost = fitted(mine, Against::Evaluations, accuracy);
+    let evaluations_slope = cost.map(|o| Slope::from_order(o, random));
+    // Only an order known to within a quarter extrapolates: the error's
+    // distance to a target grows as a power of the slope's error.
+    let order = cost.filter(|_| evaluations_slope.is_some_and(|s| s.extrapolates()));
+    let reach: Vec<Reach> = page
+        .targets
+        .iter()
+        .map(|&t| Reach::of(mine, t, accuracy, order.as_ref()))
+        .collect();
+    let shown = |s: Option<Slope>| s.map_or_else(|| "—".into(), |s| s.shown(random));
+    Fit {
+        rule_index: i,
+        label: label(page, i),
+        resolution_slope,
+        evaluations_slope,
+        slope_budget: shown(resolution_slope),
+        slope_evaluations: shown(evaluations_slope),
+        times: reach.iter().map(Reach::shown).collect(),
+        seconds: reach.iter().map(Reach::seconds).collect(),
+        reach,
+        order: evaluations_slope.map(|s| (s.slope, s.erratic)),
+    }
+}
+
 /// Fitted orders, times to the targets and the two plots of one quantity,
 /// with each rule's time to the middle target.
 fn orders_and_plots(
@@ -292,11 +338,7 @@ fn orders_and_plots(
         },
         fit_floor(floor),
     );
-    let middle = page
-        .targets
-        .get(page.targets.len() / 2)
-        .copied()
-        .unwrap_or(1e-6);
+    let middle = page.middle_target();
     let (mut ranking, mut fits, mut by_time, mut by_n) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for i in 0..page.rules.len() {
@@ -305,61 +347,17 @@ fn orders_and_plots(
             continue;
         }
         let label = label(page, i);
-        let reach = |t: f64| (t >= accuracy).then(|| time_to(&mine, t)).flatten();
-        let seconds: Vec<Option<f64>> = page.targets.iter().map(|&t| reach(t)).collect();
-        let times: Vec<String> = page
-            .targets
-            .iter()
-            .map(|&t| match (t < accuracy, reach(t)) {
-                (true, _) => "below reference accuracy".into(),
-                (false, None) => "not reached".into(),
-                (false, Some(s)) => format!("{s:.2e}"),
-            })
-            .collect();
-        // A deterministic rule whose error grows with the budget inside the
-        // fitted rows (a kink that moves between nodes) has no order either.
-        let deterministic = !page.rules.get(i).is_some_and(|r| r.is_random);
-        let limit = if deterministic {
-            ERRATIC
-        } else {
-            2.0 * ERRATIC
-        };
-        let slope = |against| match order_and_scatter(&mine, against, accuracy) {
-            None => "—".into(),
-            Some((o, off, grew)) if off > limit || (deterministic && grew) => format!(
-                "{o:.2} (erratic: errors up to {}x off the line{}, not an order)",
-                if off < 1e4 {
-                    format!("{off:.1}")
-                } else {
-                    format!("{off:.1e}")
-                },
-                if deterministic && grew {
-                    ", growing with n"
-                } else {
-                    ""
-                }
-            ),
-            Some((o, _, _)) => format!("{o:.2}"),
-        };
-        fits.push(Fit {
-            label: label.clone(),
-            slope_budget: slope(Against::Resolution {
-                dimension,
-                by_budget: page.rules.get(i).and_then(|r| r.resolution.get(&dimension)),
-            }),
-            slope_evaluations: slope(Against::Evaluations),
-            times,
-            seconds,
-            order: order_and_scatter(&mine, Against::Evaluations, accuracy)
-                .map(|(o, off, grew)| (o, off > limit || (deterministic && grew))),
-        });
+        let fit = fit(page, i, &mine, dimension, accuracy);
+        let at_middle = Reach::of(&mine, middle, accuracy, None);
+        fits.push(fit);
         let first = mine
             .iter()
             .filter(|r| !r.rel_error.is_nan())
             .min_by_key(|r| r.budget);
         ranking.push(Ranked {
             label: label.clone(),
-            seconds: reach(middle),
+            seconds: at_middle.seconds(),
+            time: at_middle.interval(),
             // At the floor from the first budget, deterministic or random
             // (a random rule whose every sample agrees sees a constant
             // integrand), unless the value underflowed: 0 against 0 is not

@@ -347,13 +347,18 @@ pub fn written_here(name: &str) -> bool {
         .and_then(|x| x.to_str())
         .is_some_and(|x| REPORT_EXTENSIONS.contains(&x));
     report
+        || name == SUMMARY_FILE
         || name == "experiment.json"
         || name == crate::experiment::source::VALUES_COPY
         || (name.starts_with("results") && name.ends_with(".jsonl"))
 }
 
+/// The summary a report writes beside its index and in each experiment's
+/// folder ([`crate::experiment::report::ReportSummary`]).
+pub const SUMMARY_FILE: &str = "summary.json";
+
 /// The files a run or a merge writes into the output folder itself.
-pub const WRITTEN_AT_TOP: [&str; 2] = ["index.md", "index.html"];
+pub const WRITTEN_AT_TOP: [&str; 3] = ["index.md", "index.html", SUMMARY_FILE];
 
 /// Removes what an earlier run's report wrote: the index of `out` and the
 /// report files of the experiment folders `names` (regular files only: a
@@ -378,7 +383,8 @@ pub fn clear_reports<'a>(out: &Path, names: impl IntoIterator<Item = &'a str>) {
             let report = path
                 .extension()
                 .and_then(|x| x.to_str())
-                .is_some_and(|x| REPORT_EXTENSIONS.contains(&x));
+                .is_some_and(|x| REPORT_EXTENSIONS.contains(&x))
+                || e.file_name() == SUMMARY_FILE;
             if report && e.file_type().is_ok_and(|t| t.is_file()) {
                 let _ = fs::remove_file(&path);
             }

@@ -46,6 +46,7 @@ use rand::SeedableRng;
 use serde::{Deserialize, Serialize};
 
 use super::Loaded;
+use super::timing::{Timed, timed};
 use super::validate::{Experiment, min_budget};
 use crate::family::{Family, Measured, Quantity};
 
@@ -54,9 +55,9 @@ pub mod links;
 
 use files::results_of;
 pub use files::{
-    ReportFiles, Unread, WRITTEN_AT_TOP, clear_reports, read_results, read_results_counted,
-    remove_stale_temporaries, results_path, reusable, write_all_or_none, write_atomic,
-    write_report_file, written_here,
+    ReportFiles, SUMMARY_FILE, Unread, WRITTEN_AT_TOP, clear_reports, read_results,
+    read_results_counted, remove_stale_temporaries, results_path, reusable, write_all_or_none,
+    write_atomic, write_report_file, written_here,
 };
 
 /// A job's identity within its experiment: (rule index, budget, repeat).
@@ -204,18 +205,22 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         let start = Instant::now();
         let result = evaluate();
         let once = start.elapsed().as_secs_f64();
-        let seconds = if result.is_ok() {
-            retimed(once, || {
+        // Timing repeats only time: the values and counts are the first call's.
+        let time = if result.is_ok() {
+            timed(once, || {
                 let _ = std::hint::black_box(evaluate());
             })
         } else {
-            once
+            Timed {
+                seconds: once,
+                samples: vec![once],
+            }
         };
-        out.seconds += seconds;
+        out.seconds += time.seconds;
         match result {
             Ok(values) => {
                 for (k, mut m) in values {
-                    m.seconds = Some(seconds);
+                    m.seconds = Some(time.seconds);
                     outcome.insert(k, m);
                 }
             }
@@ -230,37 +235,6 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         Err(e) => out.failure = Some(e),
     }
     out
-}
-
-/// Below this, one evaluation's wall time is mostly clock resolution and
-/// scheduling noise (sub-microsecond jobs ranked by a single reading swapped
-/// places from run to run): such a job is timed again, in batches.
-pub const MIN_TIMED_SECONDS: f64 = 2e-4;
-
-/// Batches a fast job is timed in: the median batch gives its time.
-const TIMING_BATCHES: usize = 5;
-
-/// The time of one evaluation that took `once` seconds at its first run:
-/// `once` itself when that is at least [`MIN_TIMED_SECONDS`]; otherwise the
-/// median over [`TIMING_BATCHES`] batches of the mean time of `again` (the
-/// same evaluation, from the same seed) in a batch long enough to read the
-/// clock reliably.
-fn retimed(once: f64, mut again: impl FnMut()) -> f64 {
-    if once >= MIN_TIMED_SECONDS {
-        return once;
-    }
-    let per_batch = (MIN_TIMED_SECONDS / once.max(1e-9)).ceil().min(10_000.0) as usize;
-    let mut means: Vec<f64> = (0..TIMING_BATCHES)
-        .map(|_| {
-            let start = Instant::now();
-            for _ in 0..per_batch {
-                again();
-            }
-            start.elapsed().as_secs_f64() / per_batch as f64
-        })
-        .collect();
-    means.sort_by(f64::total_cmp);
-    means[TIMING_BATCHES / 2]
 }
 
 /// The family's outcome by quantity name, checked to hold exactly the
