@@ -65,12 +65,21 @@ pub fn plain(s: &str) -> String {
     out
 }
 
-/// One line of Markdown text as HTML: code spans and bold, the rest escaped.
+/// One line of Markdown text as HTML: code spans, bold and backslash
+/// escapes (a backslash before ASCII punctuation stands for that
+/// character, as [`plain`] writes it), the rest escaped.
 pub fn inline(s: &str) -> String {
     let mut out = String::new();
     let mut bold = false;
     let mut rest = s;
     while !rest.is_empty() {
+        if let Some(after) = rest.strip_prefix('\\')
+            && let Some(c) = after.chars().next().filter(char::is_ascii_punctuation)
+        {
+            out.push_str(&escape(&after[..1]));
+            rest = &after[c.len_utf8()..];
+            continue;
+        }
         if let Some(after) = rest.strip_prefix('`')
             && let Some(end) = after.find('`')
         {
@@ -215,6 +224,14 @@ mod tests {
         assert!(html.contains("<code>x&lt;y</code>"), "{html}");
         assert!(html.contains("<strong>bold</strong>"), "{html}");
         assert!(!html.contains("<script>"), "{html}");
+    }
+
+    /// What `plain` escapes reads as the text again in HTML.
+    #[test]
+    fn escaped_text_renders_as_itself() {
+        let text = "E_cone *x* [a](b) <i> \\int # | ~";
+        let html = to_html(&plain(text), 0);
+        assert_eq!(html, format!("<p>{}</p>\n", escape(text)));
     }
 
     #[test]
