@@ -51,7 +51,7 @@ pub struct CompareOptions {
 
 /// The default noise threshold: see [`CompareOptions::noise`] and the
 /// README's measurement of two runs of one build.
-pub const NOISE: f64 = 0.5;
+pub const NOISE: f64 = super::timing::RUN_NOISE;
 
 impl Default for CompareOptions {
     fn default() -> Self {
@@ -96,10 +96,17 @@ pub struct ExperimentComparison {
     pub hash_changed: Option<(String, String)>,
     /// Jobs in both folders.
     pub jobs: usize,
-    /// What changed in a job's values, one line each.
+    /// What changed in a job's values, one line each, and the baseline's
+    /// jobs the new run lacks.
     pub values: Vec<String>,
-    /// Rows compared by time.
+    /// Jobs whose values changed or that the new run lacks.
+    pub jobs_changed: usize,
+    /// Jobs only the new run has (not a change: the baseline had less).
+    pub added: Vec<String>,
+    /// Rows compared by time: an interval on each side.
     pub timed_rows: usize,
+    /// Rows with a single reading on a side, not judged.
+    pub single: usize,
     /// Each timed row's new median over its old.
     pub ratios: Vec<f64>,
     /// Rows whose time changed beyond both intervals.
@@ -167,6 +174,15 @@ pub fn compare(old: &Path, new: &Path, opts: &CompareOptions) -> Result<Comparis
         only_new: b.difference(&a).filter(|n| wanted(n)).cloned().collect(),
         ..Comparison::default()
     };
+    if a.intersection(&b).filter(|n| wanted(n)).count() == 0 {
+        return Err(format!(
+            "no experiment to compare: {} holds {}, {} holds {}",
+            old.display(),
+            a.iter().cloned().collect::<Vec<_>>().join(", "),
+            new.display(),
+            b.iter().cloned().collect::<Vec<_>>().join(", ")
+        ));
+    }
     for name in a.intersection(&b).filter(|n| wanted(n)) {
         out.experiments
             .push(experiment(name, &old.join(name), &new.join(name), opts)?);
@@ -218,23 +234,27 @@ fn experiment(
         c.hash_changed = Some((x, y));
     }
     for (key, x) in &a {
-        match b.get(key) {
+        let changes = match b.get(key) {
             Some(y) => {
                 c.jobs += 1;
-                c.values.extend(job_changes(x, y, tolerance));
+                job_changes(x, y, tolerance)
             }
-            None => c
-                .values
-                .push(format!("{} missing from the new run", job_name(x))),
-        }
+            None => vec![format!("{} missing from the new run", job_name(x))],
+        };
+        c.jobs_changed += usize::from(!changes.is_empty());
+        c.values.extend(changes);
     }
     for (key, y) in &b {
         if !a.contains_key(key) {
-            c.values
+            c.added
                 .push(format!("{} new (not in the baseline)", job_name(y)));
         }
     }
-    match (summary(old), summary(new)) {
+    let (ha, hb) = (hash(&a), hash(&b));
+    match (
+        summary(old, name, ha.as_deref()),
+        summary(new, name, hb.as_deref()),
+    ) {
         (Ok(x), Ok(y)) => times_and_ranks(&x, &y, opts.noise, &mut c),
         (Err(e), _) | (_, Err(e)) => c.notes.push(format!("times and ranks not compared: {e}")),
     }
@@ -252,7 +272,16 @@ fn jobs(dir: &Path, notes: &mut Vec<String>) -> BTreeMap<JobKey, JobResult> {
             unread.unreadable
         ));
     }
-    results.into_iter().map(|r| (r.key(), r)).collect()
+    let lines = results.len();
+    let jobs: BTreeMap<JobKey, JobResult> = results.into_iter().map(|r| (r.key(), r)).collect();
+    if jobs.len() < lines {
+        notes.push(format!(
+            "{}: {} line(s) repeat a job of an earlier line; the last of each is compared",
+            path.display(),
+            lines - jobs.len()
+        ));
+    }
+    jobs
 }
 
 /// How a job is named in a change.
@@ -260,11 +289,16 @@ fn job_name(r: &JobResult) -> String {
     format!("{} n = {} repeat {}", r.rule, r.budget, r.repeat)
 }
 
-/// Whether two numbers agree: bit for bit (NaN agrees with NaN), or within
-/// `tolerance` of the larger magnitude.
+/// Whether two numbers agree: bit for bit (NaN agrees with NaN), or, both
+/// finite, within `tolerance` of the larger magnitude.
 fn agree(x: f64, y: f64, tolerance: Option<f64>) -> bool {
     if x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()) {
         return true;
+    }
+    // A non-finite number agrees only with itself: against an infinite
+    // magnitude every difference is "within" a relative tolerance.
+    if !(x.is_finite() && y.is_finite()) {
+        return false;
     }
     match tolerance {
         Some(t) => x == y || (x - y).abs() <= t * x.abs().max(y.abs()),
@@ -337,8 +371,9 @@ fn numbers(v: &[f64]) -> String {
     }
 }
 
-/// An experiment folder's summary.json.
-fn summary(dir: &Path) -> Result<ExperimentSummary, String> {
+/// An experiment folder's summary.json, checked to be of experiment `name`
+/// and of the results' experiment file (`hash`).
+fn summary(dir: &Path, name: &str, hash: Option<&str>) -> Result<ExperimentSummary, String> {
     let path = dir.join(SUMMARY_FILE);
     let text = std::fs::read_to_string(&path).map_err(|e| {
         format!(
@@ -360,10 +395,22 @@ fn summary(dir: &Path) -> Result<ExperimentSummary, String> {
             s.summary_version
         ));
     }
-    s.experiments
+    let e = s
+        .experiments
         .into_iter()
         .next()
-        .ok_or_else(|| format!("{}: no experiment in it", path.display()))
+        .ok_or_else(|| format!("{}: no experiment in it", path.display()))?;
+    if e.experiment != name || hash.is_some_and(|h| h != e.experiment_hash) {
+        return Err(format!(
+            "{}: the summary of {:?} (file hash {}), not of the results beside it ({name:?}, {}): \
+             a stale or misplaced summary (`lightquad run --resume` writes it anew)",
+            path.display(),
+            e.experiment,
+            e.experiment_hash,
+            hash.unwrap_or("no job")
+        ));
+    }
+    Ok(e)
 }
 
 /// The rows' times and the rules' ranks, old against new.
@@ -374,11 +421,15 @@ fn times_and_ranks(
     c: &mut ExperimentComparison,
 ) {
     type Key = (String, String, usize);
+    // A failed row's time is the failure's, not the rule's.
     let rows = |s: &ExperimentSummary| -> BTreeMap<Key, TimeInterval> {
         let mut m = BTreeMap::new();
         for q in &s.quantities {
             for r in &q.rules {
                 for row in &r.rows {
+                    if row.flags.iter().any(|f| f.kind == "failed") {
+                        continue;
+                    }
                     if let Some(t) = row.seconds {
                         m.insert((q.quantity.clone(), r.label.clone(), row.budget), t);
                     }
@@ -390,8 +441,12 @@ fn times_and_ranks(
     let (ra, rb) = (rows(a), rows(b));
     for (key, old) in &ra {
         let Some(new) = rb.get(key) else { continue };
-        c.timed_rows += 1;
         c.ratios.push(new.median / old.median);
+        if old.samples < 2 || new.samples < 2 {
+            c.single += 1;
+            continue;
+        }
+        c.timed_rows += 1;
         let ratio = new.median / old.median;
         let speed = if new.high < old.low && ratio * (1.0 + noise) < 1.0 {
             Speed::Faster
@@ -442,9 +497,20 @@ fn times_and_ranks(
 }
 
 impl Comparison {
-    /// Job-level value changes, missing and new jobs included.
+    /// What fails the comparison: every difference in a job's values, and
+    /// every job and experiment of the baseline the new run lacks.
     pub fn values_changed(&self) -> usize {
-        self.experiments.iter().map(|e| e.values.len()).sum()
+        self.experiments
+            .iter()
+            .map(|e| e.values.len())
+            .sum::<usize>()
+            + self.only_old.len()
+    }
+
+    /// Jobs in both runs whose values differ, and the baseline's jobs the
+    /// new run lacks.
+    pub fn jobs_changed(&self) -> usize {
+        self.experiments.iter().map(|e| e.jobs_changed).sum()
     }
 
     /// Jobs compared.
@@ -465,7 +531,7 @@ impl Comparison {
         (!r.is_empty()).then(|| r[r.len() / 2])
     }
 
-    /// Rows faster, slower, and timed in both.
+    /// Rows faster, slower, and timed in both with an interval on each side.
     pub fn speeds(&self) -> (usize, usize, usize) {
         let count = |s| {
             self.experiments
@@ -495,20 +561,39 @@ impl Comparison {
             None => "bit for bit".to_string(),
             Some(t) => format!("within a relative {t:e}"),
         };
+        let single: usize = self.experiments.iter().map(|e| e.single).sum();
+        let single = if single > 0 {
+            format!(
+                "; {single} row(s) with a single reading on a side (one repeat) not judged: \
+                 one reading has no interval"
+            )
+        } else {
+            String::new()
+        };
+        let missing = if self.only_old.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; {} experiment(s) of the baseline missing from the new run",
+                self.only_old.len()
+            )
+        };
         let _ = writeln!(
             md,
-            "- experiments compared: {}{}{}\n- values ({how}): {} change(s) over {} job(s) in both\n\
+            "- experiments compared: {}{}{}\n- values ({how}): {} of {} job(s) in both differ or \
+             are missing from the new run ({} difference(s)){missing}\n\
              - times: {faster} row(s) faster ({:.1}%), {slower} slower ({:.1}%), {} without a change \
              the timings can tell, of {timed} (faster or slower: the two medians' confidence \
              intervals are apart and their ratio is beyond {:.2}x either way, the noise \
-             threshold; {pace})\n- ranks at the middle target: {ranks} rule(s) changed rank; {swapped} \
-             pair(s) of rules ranked apart in both runs swapped order (the other changes are \
-             rules moving between tied and apart)\n",
+             threshold; {pace}{single})\n- ranks at the middle target: {ranks} rule(s) changed \
+             rank; {swapped} pair(s) of rules ranked apart in both runs swapped order (the other \
+             changes are rules moving between tied and apart)\n",
             self.experiments.len(),
             listed(", only in the baseline: ", &self.only_old),
             listed(", only in the new run: ", &self.only_new),
-            self.values_changed(),
+            self.jobs_changed(),
             self.jobs(),
+            self.values_changed() - self.only_old.len(),
             share(faster),
             share(slower),
             timed - faster - slower,
@@ -545,6 +630,12 @@ fn listed(lead: &str, names: &[String]) -> String {
     }
 }
 
+/// A user's string (an experiment, rule or failure, a hash from a file) as
+/// Markdown text on one line.
+fn one_line(s: &str) -> String {
+    super::markdown::plain(&s.replace(['\n', '\r'], " "))
+}
+
 /// Lines shown per kind of change before the rest are counted.
 const SHOWN: usize = 20;
 
@@ -552,6 +643,7 @@ const SHOWN: usize = 20;
 fn experiment_markdown(md: &mut String, e: &ExperimentComparison) {
     let changed = e.hash_changed.is_some()
         || !e.values.is_empty()
+        || !e.added.is_empty()
         || !e.times.is_empty()
         || !e.ranks.is_empty()
         || !e.notes.is_empty();
@@ -559,21 +651,29 @@ fn experiment_markdown(md: &mut String, e: &ExperimentComparison) {
     if !changed {
         return;
     }
-    let _ = writeln!(md, "## {}\n", super::markdown::plain(&e.name));
+    let _ = writeln!(md, "## {}\n", one_line(&e.name));
     if let Some((a, b)) = &e.hash_changed {
         let _ = writeln!(
             md,
-            "The experiment file changed (hash {a} -> {b}): values may differ for that reason.\n"
+            "The experiment file changed (hash {} -> {}): values may differ for that reason.\n",
+            one_line(a),
+            one_line(b)
         );
     }
     for n in &e.notes {
-        let _ = writeln!(md, "- {}", super::markdown::plain(n));
+        let _ = writeln!(md, "- {}", one_line(n));
     }
     for v in e.values.iter().take(SHOWN) {
-        let _ = writeln!(md, "- value: {}", super::markdown::plain(v));
+        let _ = writeln!(md, "- value: {}", one_line(v));
     }
     if e.values.len() > SHOWN {
         let _ = writeln!(md, "- and {} more value change(s)", e.values.len() - SHOWN);
+    }
+    for v in e.added.iter().take(SHOWN) {
+        let _ = writeln!(md, "- {}", one_line(v));
+    }
+    if e.added.len() > SHOWN {
+        let _ = writeln!(md, "- and {} more new job(s)", e.added.len() - SHOWN);
     }
     if !e.times.is_empty() {
         md.push_str(
@@ -583,8 +683,8 @@ fn experiment_markdown(md: &mut String, e: &ExperimentComparison) {
             let _ = writeln!(
                 md,
                 "| {} | {} | {} | {} | {:.2e} | {:.2e} | {:.2} | {:.1e} to {:.1e} | {:.1e} to {:.1e} |",
-                super::markdown::plain(&t.row.0),
-                super::markdown::plain(&t.row.1),
+                one_line(&t.row.0),
+                one_line(&t.row.1),
                 t.row.2,
                 if t.speed == Speed::Faster {
                     "faster"
@@ -616,8 +716,8 @@ fn experiment_markdown(md: &mut String, e: &ExperimentComparison) {
         let _ = writeln!(
             md,
             "- rank of {} on {}: {} -> {}",
-            super::markdown::plain(label),
-            super::markdown::plain(q),
+            one_line(label),
+            one_line(q),
             rank(*a),
             rank(*b)
         );
@@ -626,9 +726,9 @@ fn experiment_markdown(md: &mut String, e: &ExperimentComparison) {
         let _ = writeln!(
             md,
             "- {} and {} swapped order on {}",
-            super::markdown::plain(x),
-            super::markdown::plain(y),
-            super::markdown::plain(q)
+            one_line(x),
+            one_line(y),
+            one_line(q)
         );
     }
     md.push('\n');

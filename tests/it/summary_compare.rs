@@ -166,7 +166,7 @@ fn timing_repeats_leave_values_and_counts_as_the_first_call_gave_them() {
 }
 
 /// The same experiment run twice, the second time with the trapezoid rule
-/// spinning 200 us more per call: `compare` finds no value changed and
+/// spinning 20 ms more per call: `compare` finds no value changed and
 /// calls every trapezoid row slower (over 20x against calls of a few
 /// microseconds), no other row by anything like it; the binary exits
 /// non-zero only where a value changed.
@@ -177,7 +177,7 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         "rules": [{"rule": "trapezoid"}, {"rule": "simpson"}, {"rule": "gauss-legendre"}],
         "budgets": [5, 17, 65], "repeats": 3, "reference": {"type": "closed-form"}}"#;
     run(&dir, "old", text);
-    SLOW_NS.store(200_000, Ordering::Relaxed);
+    SLOW_NS.store(20_000_000, Ordering::Relaxed);
     run(&dir, "new", text);
     SLOW_NS.store(0, Ordering::Relaxed);
     let c = compare(
@@ -188,7 +188,8 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
     .expect("compares");
     assert_eq!((c.values_changed(), c.jobs()), (0, 27), "{}", c.markdown());
     // Every trapezoid row is slower, by far more than any timing noise (a
-    // spin of 200 us on calls of a few us); a row of another rule called
+    // spin of 20 ms on calls of a few us, beyond a preempted reading of a
+    // loaded machine); a row of another rule called
     // changed (possible on a loaded machine: its intervals apart and its
     // time beyond 1.5x) is nowhere near that.
     let e = &c.experiments[0];
@@ -249,6 +250,51 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         .output()
         .expect("runs");
     assert!(o.status.success(), "{}", stderr(&o));
+    // An infinite value agrees with a finite one under no tolerance.
+    let jobs = fs::read_to_string(&path).expect("results");
+    fs::write(&path, jobs.replacen("\"value\":[", "\"value\":[\"inf\",", 1)).expect("write");
+    let o = bin()
+        .arg("compare")
+        .arg(dir.join("old"))
+        .arg(dir.join("new"))
+        .args(["--tolerance", "1e-12"])
+        .output()
+        .expect("runs");
+    assert!(!o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    // An experiment of the baseline missing from the new run fails it too;
+    // nothing in common is no comparison at all.
+    let copy = dir.join("old/second");
+    fs::create_dir_all(&copy).expect("mkdir");
+    fs::copy(dir.join("old/slowed/results.jsonl"), copy.join("results.jsonl")).expect("copy");
+    let o = bin()
+        .arg("compare")
+        .arg(dir.join("old"))
+        .arg(dir.join("old"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    fs::write(&path, jobs).expect("write");
+    let o = bin()
+        .arg("compare")
+        .arg(dir.join("old"))
+        .arg(dir.join("new"))
+        .args(["--tolerance", "1e-12"])
+        .output()
+        .expect("runs");
+    assert!(stderr(&o).contains("1 value change(s)"), "{}", stderr(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("only in the baseline: second"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    let o = bin()
+        .arg("compare")
+        .arg(dir.join("old"))
+        .arg(dir.join("new"))
+        .args(["--experiment", "second"])
+        .output()
+        .expect("runs");
+    assert!(stderr(&o).contains("no experiment to compare"), "{}", stderr(&o));
     let _ = fs::remove_dir_all(&dir);
 }
 

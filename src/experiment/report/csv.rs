@@ -8,12 +8,14 @@ use super::Page;
 use super::rows::scale_of;
 use crate::experiment::reference::rms;
 use crate::experiment::run::JobResult;
+use crate::family::Flag;
 
 /// A CSV line per job and quantity (a channel vector as `;`-separated
 /// numbers): `reference` is the quantity's reference per channel and
 /// `rel_error` the job's root-mean-square error over channels against it,
 /// relative to the reference's root mean square as in the report (both
-/// empty where the quantity has no reference).
+/// empty where the quantity has no reference; the error empty where the
+/// value underflowed).
 pub(super) fn csv(page: &Page, results: &[JobResult]) -> String {
     let mut csv = String::from(
         "experiment,rule_index,rule,budget,repeat,seed,quantity,value,estimated_error,evaluations,seconds,reference,rel_error,failure\n",
@@ -44,7 +46,11 @@ pub(super) fn csv(page: &Page, results: &[JobResult]) -> String {
             let _ = writeln!(csv, "{lead},,,,,{:e},,,{why}", r.seconds);
         }
         for (q, m) in &r.quantities {
+            // A value that underflowed has no error f64 can show (0 against
+            // a reference that also reads 0): empty, as the report's "—".
+            let underflow = m.flags.contains(&Flag::Underflow);
             let (reference, error) = match page.reference.values.get(q) {
+                Some(v) if underflow => (join(v), String::new()),
                 Some(v) => (join(v), format!("{:e}", true_error(&m.value, v))),
                 None => (String::new(), String::new()),
             };

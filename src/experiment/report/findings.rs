@@ -48,9 +48,10 @@ fn targets(page: &Page, s: &Section) -> String {
             }
             [] => format!("No rule reaches {t:.0e}."),
             [(a, x, _)] => format!("Only {a} reaches {t:.0e}, in {x:.2e} s."),
-            [(a, x, i), (b, y, j), ..] if i.overlaps(j) => format!(
+            [(a, x, i), (b, y, j), ..] if !i.apart(j) => format!(
                 "{a} and {b} reach {t:.0e} in {x:.2e} and {y:.2e} s, not told apart (their \
-                 times' confidence intervals overlap; {} of {} rules reach it).",
+                 times' confidence intervals overlap, or single readings within 1.5x; {} of {} \
+                 rules reach it).",
                 reached.len(),
                 s.fits.len()
             ),

@@ -22,13 +22,14 @@ pub struct Slope {
     pub high: f64,
     /// Rows fitted (3 or 4: the largest budgets above the error floor).
     pub points: usize,
-    /// The largest factor by which a fitted error lies off the line.
+    /// The largest factor by which a fitted error lies off the line (at
+    /// most the largest f64).
     pub off: f64,
     /// The error grew by more than 1.5x from one fitted row to the next.
     pub growing: bool,
     /// True where the slope is no order: errors more than 2x off the line
-    /// (4x for a random rule), or a deterministic rule's error growing
-    /// between fitted rows.
+    /// (4x for a random rule), or a deterministic rule's error growing by
+    /// more than 1.5x between fitted rows (`growing`).
     pub erratic: bool,
 }
 
@@ -47,7 +48,7 @@ impl Slope {
             low: l.slope - l.half_width,
             high: l.slope + l.half_width,
             points: l.points,
-            off: l.off,
+            off: l.off.min(f64::MAX),
             growing: o.grew,
             erratic: l.off > limit || (!random && o.grew),
         }
@@ -201,9 +202,10 @@ fn extrapolate(mine: &[&Row], target: f64, cost: &Order) -> Option<Extrapolated>
         return None;
     }
     let scale = evaluations / last.evaluations;
-    Some(Extrapolated {
+    let x = Extrapolated {
         evaluations,
         budget: last.budget as f64 * scale,
         seconds: last.seconds * scale,
-    })
+    };
+    (x.budget.is_finite() && x.seconds.is_finite()).then_some(x)
 }

@@ -47,18 +47,20 @@ pub fn ranks(ranked: &[Ranked]) -> Vec<usize> {
     out
 }
 
-/// Whether two reached times are not told apart: their intervals overlap
-/// (equal times where either has none).
+/// Whether two reached times are not told apart: their intervals overlap,
+/// or, where either is a single reading, they are within the noise of a
+/// run ([`TimeInterval::apart`]); equal times where either has no time.
 pub fn tied(a: &Ranked, b: &Ranked) -> bool {
     match (a.time, b.time, a.seconds, b.seconds) {
-        (Some(x), Some(y), _, _) => x.overlaps(&y),
+        (Some(x), Some(y), _, _) => !x.apart(&y),
         (_, _, Some(x), Some(y)) => x == y,
         _ => false,
     }
 }
 
 /// Said of a rule whose rank it shares with the one before.
-pub const TIED: &str = "tied: its time's confidence interval overlaps that of the rule before";
+pub const TIED: &str = "tied: its time's confidence interval overlaps that of the rule before \
+(a single reading: within 1.5x of it)";
 
 /// Said of a rule ranked while exact from its first budget.
 pub const EXACT_FROM_START: &str = "at the error floor from its first budget: this integrand is \

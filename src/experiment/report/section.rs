@@ -363,7 +363,8 @@ fn orders_and_plots(
             // integrand), unless the value underflowed: 0 against 0 is not
             // an easy integrand but one f64 cannot hold.
             exact_from_start: first.is_some_and(|r| {
-                r.rel_error <= floor.max(1e-14) && !r.flags.contains(&RowFlag::Job(Flag::Underflow))
+                r.rel_error <= fit_floor(accuracy)
+                    && !r.flags.contains(&RowFlag::Job(Flag::Underflow))
             }),
         });
         // NaN (failed) rows are dropped; the plot puts unresolved errors on

@@ -100,8 +100,9 @@ pub struct QuantitySummary {
 pub struct ReferenceSummary {
     /// Per channel.
     pub value: Vec<Option<f64>>,
-    /// Its relative accuracy (0: exact to rounding, or unknown).
-    pub accuracy: f64,
+    /// Its relative accuracy (0: exact to rounding, or unknown; null: not
+    /// finite, as a stated uncertainty far above the value makes it).
+    pub accuracy: Option<f64>,
     /// Where the reference comes from, in a sentence.
     pub source: String,
 }
@@ -132,8 +133,9 @@ pub struct RuleSummary {
     /// Shares its rank with the rule ranked before it: their times'
     /// confidence intervals overlap.
     pub tied: bool,
-    /// Its error is unresolved from its smallest budget on (exact, or at the
-    /// reference's accuracy): the rank says little about it in general.
+    /// Its error is at or below the floor no order is fitted under (1e-12, or
+    /// ten times the reference's accuracy) from its smallest budget on: the
+    /// rank says little about it in general.
     pub exact_from_start: bool,
 }
 
@@ -260,7 +262,7 @@ fn quantity(page: &Page, i: usize, s: &Section) -> QuantitySummary {
     let reference = match (&s.reference, page.reference.values.get(q)) {
         (Ok(_), Some(v)) => Some(ReferenceSummary {
             value: v.iter().map(|&x| finite(x)).collect(),
-            accuracy: page.reference.accuracy_of(q),
+            accuracy: finite(page.reference.accuracy_of(q)),
             source: page.reference.note.clone(),
         }),
         _ => None,
