@@ -59,8 +59,8 @@ pub fn tied(a: &Ranked, b: &Ranked) -> bool {
 }
 
 /// Said of a rule whose rank it shares with the one before.
-pub const TIED: &str = "tied: its time's confidence interval overlaps that of the rule before \
-(a single reading: within 1.5x of it)";
+pub const TIED: &str = "tied: not told apart from the rule before (their times' intervals \
+overlap, or, for a single reading, are within 1.5x)";
 
 /// Said of a rule ranked while exact from its first budget.
 pub const EXACT_FROM_START: &str = "at the error floor from its first budget: this integrand is \
