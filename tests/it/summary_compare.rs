@@ -252,7 +252,11 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
     assert!(o.status.success(), "{}", stderr(&o));
     // An infinite value agrees with a finite one under no tolerance.
     let jobs = fs::read_to_string(&path).expect("results");
-    fs::write(&path, jobs.replacen("\"value\":[", "\"value\":[\"inf\",", 1)).expect("write");
+    fs::write(
+        &path,
+        jobs.replacen("\"value\":[", "\"value\":[\"inf\",", 1),
+    )
+    .expect("write");
     let o = bin()
         .arg("compare")
         .arg(dir.join("old"))
@@ -260,12 +264,20 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         .args(["--tolerance", "1e-12"])
         .output()
         .expect("runs");
-    assert!(!o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    assert!(
+        !o.status.success(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
     // An experiment of the baseline missing from the new run fails it too;
     // nothing in common is no comparison at all.
     let copy = dir.join("old/second");
     fs::create_dir_all(&copy).expect("mkdir");
-    fs::copy(dir.join("old/slowed/results.jsonl"), copy.join("results.jsonl")).expect("copy");
+    fs::copy(
+        dir.join("old/slowed/results.jsonl"),
+        copy.join("results.jsonl"),
+    )
+    .expect("copy");
     let o = bin()
         .arg("compare")
         .arg(dir.join("old"))
@@ -294,7 +306,11 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         .args(["--experiment", "second"])
         .output()
         .expect("runs");
-    assert!(stderr(&o).contains("no experiment to compare"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no experiment to compare"),
+        "{}",
+        stderr(&o)
+    );
     let _ = fs::remove_dir_all(&dir);
 }
 
