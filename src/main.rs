@@ -341,7 +341,8 @@ fn run(command: Command) -> Result<(), Failure> {
             }
             if c.values_changed() > 0 && !allow_value_changes {
                 return Err(format!(
-                    "{} value change(s) against the baseline (listed above; \
+                    "{} difference(s) against the baseline: changed values, or jobs or \
+                     experiments missing from the new run (listed above; \
                      --allow-value-changes to accept them)",
                     c.values_changed()
                 )

@@ -198,11 +198,30 @@ fn experiments_in(dir: &Path) -> Result<BTreeSet<String>, String> {
             dir.display()
         )
     })?;
-    let names: BTreeSet<String> = entries
-        .flatten()
-        .filter(|e| e.path().join("results.jsonl").is_file())
-        .filter_map(|e| e.file_name().to_str().map(str::to_string))
-        .collect();
+    let mut names = BTreeSet::new();
+    for e in entries.flatten() {
+        let results = e.path().join("results.jsonl");
+        match std::fs::metadata(&results) {
+            Ok(m) if m.is_file() => {}
+            Ok(_) => {
+                return Err(format!(
+                    "{}: not a regular file (a device, a pipe, or a link to one): expected a \
+                     run's results",
+                    results.display()
+                ));
+            }
+            Err(_) => continue,
+        }
+        match e.file_name().to_str() {
+            Some(n) => names.insert(n.to_string()),
+            None => {
+                return Err(format!(
+                    "{}: a folder name that is not UTF-8: no run writes one",
+                    e.path().display()
+                ));
+            }
+        };
+    }
     if names.is_empty() {
         return Err(format!(
             "{}: no experiment folder with a results.jsonl: expected a report folder (the --out \
@@ -371,10 +390,32 @@ fn numbers(v: &[f64]) -> String {
     }
 }
 
+/// The largest summary.json compare reads (the bundled suite's largest,
+/// an image experiment's, is far below a megabyte).
+const MAX_SUMMARY_BYTES: u64 = 256 << 20;
+
 /// An experiment folder's summary.json, checked to be of experiment `name`
 /// and of the results' experiment file (`hash`).
 fn summary(dir: &Path, name: &str, hash: Option<&str>) -> Result<ExperimentSummary, String> {
     let path = dir.join(SUMMARY_FILE);
+    // A pipe would block the read and a device (a link to /dev/zero) never
+    // end it: only a regular file of a summary's size is read.
+    match std::fs::metadata(&path) {
+        Ok(m) if !m.is_file() => {
+            return Err(format!(
+                "{}: not a regular file (a device, a pipe, or a link to one)",
+                path.display()
+            ));
+        }
+        Ok(m) if m.len() > MAX_SUMMARY_BYTES => {
+            return Err(format!(
+                "{}: {} bytes, more than the {MAX_SUMMARY_BYTES} a summary is read up to",
+                path.display(),
+                m.len()
+            ));
+        }
+        _ => {}
+    }
     let text = std::fs::read_to_string(&path).map_err(|e| {
         format!(
             "{}: {e} (a report written before summary.json existed, or a run killed before its \
@@ -413,6 +454,18 @@ fn summary(dir: &Path, name: &str, hash: Option<&str>) -> Result<ExperimentSumma
     Ok(e)
 }
 
+/// Whether a time read from a summary is one a run writes: finite and
+/// positive, its median inside its interval (an edited file's -1 s, or a
+/// low end above the high, is no time to judge by).
+fn plausible(t: &TimeInterval) -> bool {
+    [t.low, t.median, t.high]
+        .iter()
+        .all(|x| x.is_finite() && *x > 0.0)
+        && t.low <= t.median
+        && t.median <= t.high
+        && (0.0..=1.0).contains(&t.confidence)
+}
+
 /// The rows' times and the rules' ranks, old against new.
 fn times_and_ranks(
     a: &ExperimentSummary,
@@ -430,7 +483,7 @@ fn times_and_ranks(
                     if row.flags.iter().any(|f| f.kind == "failed") {
                         continue;
                     }
-                    if let Some(t) = row.seconds {
+                    if let Some(t) = row.seconds.filter(plausible) {
                         m.insert((q.quantity.clone(), r.label.clone(), row.budget), t);
                     }
                 }
@@ -439,6 +492,19 @@ fn times_and_ranks(
         m
     };
     let (ra, rb) = (rows(a), rows(b));
+    let implausible: usize = [a, b]
+        .iter()
+        .flat_map(|s| &s.quantities)
+        .flat_map(|q| &q.rules)
+        .flat_map(|r| &r.rows)
+        .filter(|row| row.seconds.is_some_and(|t| !plausible(&t)))
+        .count();
+    if implausible > 0 {
+        c.notes.push(format!(
+            "{implausible} row time(s) in the summaries are no time a run writes (not positive \
+             and finite, or outside their own interval): not judged"
+        ));
+    }
     for (key, old) in &ra {
         let Some(new) = rb.get(key) else { continue };
         c.ratios.push(new.median / old.median);

@@ -240,7 +240,7 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         .output()
         .expect("runs");
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("1 value change(s)"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("1 difference(s)"), "{}", stderr(&o));
     // Within a relative tolerance of 1e-12 it agrees again.
     let o = bin()
         .arg("compare")
@@ -250,6 +250,38 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         .output()
         .expect("runs");
     assert!(o.status.success(), "{}", stderr(&o));
+    // A time no run writes (an edited summary) is not judged, and a summary
+    // that is not a regular file is named, not read.
+    let summary = dir.join("new/slowed/summary.json");
+    let text = fs::read_to_string(&summary).expect("summary");
+    fs::write(&summary, text.replacen("\"median\": ", "\"median\": -", 1)).expect("write");
+    let c = compare(
+        &dir.join("old"),
+        &dir.join("new"),
+        &CompareOptions::default(),
+    )
+    .expect("compares");
+    assert!(
+        c.markdown()
+            .contains("1 row time(s) in the summaries are no time"),
+        "{}",
+        c.markdown()
+    );
+    fs::remove_file(&summary).expect("rm");
+    fs::create_dir(&summary).expect("mkdir");
+    let c = compare(
+        &dir.join("old"),
+        &dir.join("new"),
+        &CompareOptions::default(),
+    )
+    .expect("compares");
+    assert!(
+        c.markdown().contains("not a regular file"),
+        "{}",
+        c.markdown()
+    );
+    fs::remove_dir(&summary).expect("rmdir");
+    fs::write(&summary, text).expect("write");
     // An infinite value agrees with a finite one under no tolerance.
     let jobs = fs::read_to_string(&path).expect("results");
     fs::write(
@@ -293,7 +325,7 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         .args(["--tolerance", "1e-12"])
         .output()
         .expect("runs");
-    assert!(stderr(&o).contains("1 value change(s)"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("1 difference(s)"), "{}", stderr(&o));
     assert!(
         String::from_utf8_lossy(&o.stdout).contains("only in the baseline: second"),
         "{}",
