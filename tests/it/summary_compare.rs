@@ -130,6 +130,17 @@ fn registry() -> Registry {
     lightquad::families::builtin().with::<Counted>()
 }
 
+/// `lightquad compare <dir>/old <dir>/<new> extra...`.
+fn compare_bin(dir: &Path, new: &str, extra: &[&str]) -> std::process::Output {
+    bin()
+        .arg("compare")
+        .arg(dir.join("old"))
+        .arg(dir.join(new))
+        .args(extra)
+        .output()
+        .expect("runs")
+}
+
 /// Runs experiment text `text` into `<dir>/<run>`.
 fn run(dir: &Path, run: &str, text: &str) {
     let file = dir.join(format!("{run}.json"));
@@ -206,12 +217,7 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
     }
     // The binary agrees, reading only the folders (the counted family is
     // not in its registry).
-    let o = bin()
-        .args(["compare"])
-        .arg(dir.join("old"))
-        .arg(dir.join("new"))
-        .output()
-        .expect("runs");
+    let o = compare_bin(&dir, "new", &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let md = String::from_utf8_lossy(&o.stdout).to_string();
     for n in [5, 17, 65] {
@@ -233,22 +239,11 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         1,
     );
     fs::write(&path, edited).expect("write");
-    let o = bin()
-        .arg("compare")
-        .arg(dir.join("old"))
-        .arg(dir.join("new"))
-        .output()
-        .expect("runs");
+    let o = compare_bin(&dir, "new", &[]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("1 difference(s)"), "{}", stderr(&o));
     // Within a relative tolerance of 1e-12 it agrees again.
-    let o = bin()
-        .arg("compare")
-        .arg(dir.join("old"))
-        .arg(dir.join("new"))
-        .args(["--tolerance", "1e-12"])
-        .output()
-        .expect("runs");
+    let o = compare_bin(&dir, "new", &["--tolerance", "1e-12"]);
     assert!(o.status.success(), "{}", stderr(&o));
     // A time no run writes (an edited summary) is not judged, and a summary
     // that is not a regular file is named, not read.
@@ -289,13 +284,7 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         jobs.replacen("\"value\":[", "\"value\":[\"inf\",", 1),
     )
     .expect("write");
-    let o = bin()
-        .arg("compare")
-        .arg(dir.join("old"))
-        .arg(dir.join("new"))
-        .args(["--tolerance", "1e-12"])
-        .output()
-        .expect("runs");
+    let o = compare_bin(&dir, "new", &["--tolerance", "1e-12"]);
     assert!(
         !o.status.success(),
         "{}",
@@ -310,34 +299,17 @@ fn compare_calls_a_slowed_rule_slower_and_nothing_else() {
         copy.join("results.jsonl"),
     )
     .expect("copy");
-    let o = bin()
-        .arg("compare")
-        .arg(dir.join("old"))
-        .arg(dir.join("old"))
-        .output()
-        .expect("runs");
+    let o = compare_bin(&dir, "old", &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     fs::write(&path, jobs).expect("write");
-    let o = bin()
-        .arg("compare")
-        .arg(dir.join("old"))
-        .arg(dir.join("new"))
-        .args(["--tolerance", "1e-12"])
-        .output()
-        .expect("runs");
+    let o = compare_bin(&dir, "new", &["--tolerance", "1e-12"]);
     assert!(stderr(&o).contains("1 difference(s)"), "{}", stderr(&o));
     assert!(
         String::from_utf8_lossy(&o.stdout).contains("only in the baseline: second"),
         "{}",
         String::from_utf8_lossy(&o.stdout)
     );
-    let o = bin()
-        .arg("compare")
-        .arg(dir.join("old"))
-        .arg(dir.join("new"))
-        .args(["--experiment", "second"])
-        .output()
-        .expect("runs");
+    let o = compare_bin(&dir, "new", &["--experiment", "second"]);
     assert!(
         stderr(&o).contains("no experiment to compare"),
         "{}",

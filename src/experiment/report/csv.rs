@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::Page;
-use super::rows::scale_of;
+use super::rows::{halving, scale_of};
 use crate::experiment::reference::rms;
 use crate::experiment::run::JobResult;
 use crate::family::Flag;
@@ -75,11 +75,7 @@ pub(super) fn csv(page: &Page, results: &[JobResult]) -> String {
 fn true_error(value: &[f64], reference: &[f64]) -> f64 {
     let n = value.len().max(reference.len());
     let at = |v: &[f64], c: usize| v.get(c).copied().unwrap_or(f64::NAN);
-    let huge = value
-        .iter()
-        .chain(reference)
-        .any(|x| x.abs() > f64::MAX / 2.0);
-    let (halve, double) = if huge { (0.5, 2.0) } else { (1.0, 1.0) };
+    let (halve, double) = halving(value.iter().chain(reference));
     rms((0..n).map(|c| at(value, c) * halve - at(reference, c) * halve)) / scale_of(reference)
         * double
 }

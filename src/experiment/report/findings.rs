@@ -80,7 +80,7 @@ fn orders(s: &Section) -> String {
         .fits
         .iter()
         .filter_map(|f| {
-            let (o, erratic) = f.order?;
+            let (o, erratic) = f.evaluations_slope.map(|s| (s.slope, s.erratic))?;
             Some(if erratic {
                 format!("{} erratic (not an order)", f.label)
             } else {

@@ -160,6 +160,18 @@ pub fn rows(
     out
 }
 
+/// The factors a difference of `numbers` is taken with, `(halve, double)`:
+/// near the top of the range the halves are subtracted and the result
+/// doubled (exact for normal numbers): 1.7e308 against -1.7e308 overflowed
+/// to an error of inf. `(1, 1)` otherwise.
+pub(super) fn halving<'a>(mut numbers: impl Iterator<Item = &'a f64>) -> (f64, f64) {
+    if numbers.any(|x| x.abs() > f64::MAX / 2.0) {
+        (0.5, 2.0)
+    } else {
+        (1.0, 1.0)
+    }
+}
+
 /// The scale of a quantity's relative errors: the reference's root mean
 /// square, or 1 (absolute errors) where that is 0.
 pub(super) fn scale_of(reference: &[f64]) -> f64 {
@@ -255,16 +267,12 @@ fn row(
     if value.iter().any(|v| !v.is_finite()) && !flags.contains(&RowFlag::NonFinite) {
         flags.push(RowFlag::NonFinite);
     }
-    // True error: the root mean square over repeats and channels. Near the
-    // top of the range the halves are subtracted and the result doubled
-    // (exact for normal numbers): 1.7e308 against -1.7e308 overflowed to an
-    // error of inf.
-    let huge = reference.iter().any(|r| r.abs() > f64::MAX / 2.0)
-        || measured
+    // True error: the root mean square over repeats and channels.
+    let (halve, double) = halving(
+        reference
             .iter()
-            .flat_map(|m| &m.value)
-            .any(|v| v.abs() > f64::MAX / 2.0);
-    let (halve, double) = if huge { (0.5, 2.0) } else { (1.0, 1.0) };
+            .chain(measured.iter().flat_map(|m| &m.value)),
+    );
     let diffs: Vec<f64> = measured
         .iter()
         .flat_map(|m| {

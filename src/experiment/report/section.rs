@@ -76,11 +76,6 @@ pub struct Fit {
     /// Per target as shown: the time in seconds, "not reached" (with its
     /// extrapolation) or "below reference accuracy".
     pub times: Vec<String>,
-    /// Per target: the time in seconds where the rule reached it.
-    pub seconds: Vec<Option<f64>>,
-    /// The fitted slope against evaluations and whether it is erratic
-    /// (not an order), where one was fitted.
-    pub order: Option<(f64, bool)>,
 }
 
 /// Computes the sections of a page, one per quantity in the file's order.
@@ -302,9 +297,7 @@ fn fit(page: &Page, i: usize, mine: &[&Row], dimension: usize, accuracy: f64) ->
         slope_budget: shown(resolution_slope),
         slope_evaluations: shown(evaluations_slope),
         times: reach.iter().map(Reach::shown).collect(),
-        seconds: reach.iter().map(Reach::seconds).collect(),
         reach,
-        order: evaluations_slope.map(|s| (s.slope, s.erratic)),
     }
 }
 
@@ -348,7 +341,11 @@ fn orders_and_plots(
         }
         let label = label(page, i);
         let fit = fit(page, i, &mine, dimension, accuracy);
-        let at_middle = Reach::of(&mine, middle, accuracy, None);
+        // The middle target is one of the targets, already judged.
+        let at_middle = match fit.reach.get(page.targets.len() / 2) {
+            Some(r) => r.clone(),
+            None => Reach::of(&mine, middle, accuracy, None),
+        };
         fits.push(fit);
         let first = mine
             .iter()

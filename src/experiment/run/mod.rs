@@ -46,7 +46,7 @@ use rand::SeedableRng;
 use serde::{Deserialize, Serialize};
 
 use super::Loaded;
-use super::timing::{Timed, timed};
+use super::timing::timed;
 use super::validate::{Experiment, min_budget};
 use crate::family::{Family, Measured, Quantity};
 
@@ -206,21 +206,18 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         let result = evaluate();
         let once = start.elapsed().as_secs_f64();
         // Timing repeats only time: the values and counts are the first call's.
-        let time = if result.is_ok() {
+        let seconds = if result.is_ok() {
             timed(once, || {
                 let _ = std::hint::black_box(evaluate());
             })
         } else {
-            Timed {
-                seconds: once,
-                samples: vec![once],
-            }
+            once
         };
-        out.seconds += time.seconds;
+        out.seconds += seconds;
         match result {
             Ok(values) => {
                 for (k, mut m) in values {
-                    m.seconds = Some(time.seconds);
+                    m.seconds = Some(seconds);
                     outcome.insert(k, m);
                 }
             }
