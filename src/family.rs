@@ -32,6 +32,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::{QuadError, SpecError};
+use crate::experiment::external::External;
 use crate::experiment::tagged::below;
 use crate::quadrature::{AnyRule, BaseRule, Product, Rule};
 
@@ -305,6 +306,141 @@ impl<E: JsonSchema> JsonSchema for Method<E> {
     }
 }
 
+/// A method as an experiment file lists it in `rules`: one of the family's
+/// own ([`Method`]), or an external program ([`External`]) that the runner
+/// asks for its estimates (a family never sees one).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Listed<E> {
+    /// A quadrature rule or the family's estimator.
+    Own(Method<E>),
+    /// `{"rule": "external", ...}`.
+    External(External),
+}
+
+impl<E: Estimator> Listed<E> {
+    /// The family's method, if it is one.
+    pub fn own(&self) -> Option<&Method<E>> {
+        match self {
+            Listed::Own(m) => Some(m),
+            Listed::External(_) => None,
+        }
+    }
+
+    /// The name in experiment files (an external program's own name).
+    pub fn name(&self) -> &str {
+        match self {
+            Listed::Own(m) => m.name(),
+            Listed::External(x) => &x.name,
+        }
+    }
+
+    /// The name, with a product's factors ([`Method::label`]).
+    pub fn label(&self) -> String {
+        match self {
+            Listed::Own(m) => m.label(),
+            Listed::External(x) => x.name.clone(),
+        }
+    }
+
+    /// The smallest budget it accepts in `dim` dimensions (1 for a program).
+    pub fn min_budget(&self, dim: usize) -> usize {
+        match self {
+            Listed::Own(m) => m.min_budget(dim),
+            Listed::External(_) => 1,
+        }
+    }
+
+    /// The resolution per axis a budget buys: a program's as a sampler's,
+    /// the largest `m` with `m^dim <= n` ([`Estimator::resolution`]).
+    pub fn resolution(&self, n: usize, dim: usize) -> f64 {
+        match self {
+            Listed::Own(m) => m.resolution(n, dim),
+            Listed::External(_) => crate::quadrature::integer_root(n, dim) as f64,
+        }
+    }
+
+    /// True for randomised rules, estimators and programs.
+    pub fn is_random(&self) -> bool {
+        match self {
+            Listed::Own(m) => m.is_random(),
+            Listed::External(x) => x.random,
+        }
+    }
+}
+
+impl<E: Serialize> Serialize for Listed<E> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Tagged<'a> {
+            rule: &'static str,
+            #[serde(flatten)]
+            external: &'a External,
+        }
+        match self {
+            Listed::Own(m) => m.serialize(s),
+            Listed::External(x) => Tagged {
+                rule: "external",
+                external: x,
+            }
+            .serialize(s),
+        }
+    }
+}
+
+/// `{"rule": "external", ...}` is read here, its faults at their field;
+/// anything else is the family's [`Method`].
+impl<'de, E: Estimator> Deserialize<'de> for Listed<E> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut value = serde_json::Value::deserialize(d)?;
+        if value.get("rule").and_then(|t| t.as_str()) != Some("external") {
+            return Method::deserialize(value)
+                .map(Listed::Own)
+                .map_err(D::Error::custom);
+        }
+        if let Some(map) = value.as_object_mut() {
+            map.remove("rule");
+        }
+        serde_path_to_error::deserialize(value)
+            .map(Listed::External)
+            .map_err(|e| {
+                let path = e.path().to_string();
+                let path = if path == "." { String::new() } else { path };
+                below(&path, &e.into_inner().to_string())
+            })
+    }
+}
+
+/// The schema of `{"rule": "external", ...}`.
+#[derive(JsonSchema)]
+#[allow(dead_code)]
+#[schemars(rename = "External")]
+struct ExternalRule {
+    /// `"external"`.
+    rule: ExternalTag,
+    #[serde(flatten)]
+    external: External,
+}
+
+/// The tag of an external estimator.
+#[derive(JsonSchema)]
+#[allow(dead_code)]
+enum ExternalTag {
+    #[serde(rename = "external")]
+    External,
+}
+
+impl<E: JsonSchema> JsonSchema for Listed<E> {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "ListedMethod".into()
+    }
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let own = generator.subschema_for::<Method<E>>();
+        let external = generator.subschema_for::<ExternalRule>();
+        schemars::json_schema!({ "anyOf": [own, external] })
+    }
+}
+
 /// A fact about one evaluated value that a report must show.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "flag", rename_all = "kebab-case")]
@@ -397,6 +533,11 @@ pub struct Measured {
     /// target is its own cost, not that of every quantity of the job.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seconds: Option<f64>,
+    /// An external estimator's own wall time for it, seconds, as the
+    /// program reported it (start-up excluded); `seconds` is lightquad's
+    /// time of the same request.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub program_seconds: Option<f64>,
 }
 
 impl Measured {
@@ -408,6 +549,7 @@ impl Measured {
             evaluations,
             flags: Vec::new(),
             seconds: None,
+            program_seconds: None,
         }
     }
 
@@ -435,6 +577,7 @@ impl<V: crate::value::Value> From<crate::estimate::Estimate<V>> for Measured {
             .flatten()
             .collect(),
             seconds: None,
+            program_seconds: None,
         }
     }
 }

@@ -77,11 +77,15 @@ enum Command {
         no_cost_limit: bool,
     },
     /// Print the JSON Schema of experiment files (with --summary: of the
-    /// summary.json files a report writes).
+    /// summary.json files a report writes; with --protocol: of the messages
+    /// between lightquad and an external estimator).
     Schema {
         /// The schema of summary.json instead.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "protocol")]
         summary: bool,
+        /// The schema of the external estimators' protocol instead.
+        #[arg(long)]
+        protocol: bool,
     },
     /// Join the results of `run --shard` folders into one report.
     Merge {
@@ -296,10 +300,16 @@ fn run(command: Command) -> Result<(), Failure> {
                 )?;
             }
         }
-        Command::Schema { summary: false } => {
-            writeln!(out, "{}", serde_json::to_string_pretty(&registry.schema())?)?
-        }
-        Command::Schema { summary: true } => writeln!(
+        Command::Schema {
+            summary: false,
+            protocol: false,
+        } => writeln!(out, "{}", serde_json::to_string_pretty(&registry.schema())?)?,
+        Command::Schema { protocol: true, .. } => writeln!(
+            out,
+            "{}",
+            serde_json::to_string_pretty(&experiment::external::protocol::schema())?
+        )?,
+        Command::Schema { summary: true, .. } => writeln!(
             out,
             "{}",
             serde_json::to_string_pretty(&experiment::report::summary_schema())?

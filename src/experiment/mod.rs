@@ -37,6 +37,7 @@
 
 pub mod compare;
 pub mod expected;
+pub mod external;
 pub mod fit;
 pub mod html;
 mod input;

@@ -134,7 +134,13 @@ impl<F: Family> Loaded for Experiment<F> {
             jobs.iter().map(|&(m, n, _)| (m, n)).collect();
         pairs
             .into_iter()
-            .filter_map(|(m, n)| self.spec.rules.get(m).map(|rule| (rule, n)))
+            .filter_map(|(m, n)| {
+                self.spec
+                    .rules
+                    .get(m)
+                    .and_then(|rule| rule.own())
+                    .map(|rule| (rule, n))
+            })
             .flat_map(|(rule, n)| {
                 self.spec
                     .quantities
@@ -222,6 +228,12 @@ fn page<'a, F: Family>(
                 },
                 is_random: m.is_random(),
                 min_budget: super::validate::min_budget::<F>(&exp.scene, m, &spec.quantities),
+                not_run: match exp.programs.get(&i) {
+                    Some(super::external::Found::Skipped(why)) => {
+                        Some(format!("its program is missing: {why}"))
+                    }
+                    _ => None,
+                },
                 resolution: spec
                     .quantities
                     .iter()

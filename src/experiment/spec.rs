@@ -32,7 +32,7 @@ use std::collections::BTreeMap;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use crate::family::{Family, Method};
+use crate::family::{Family, Listed};
 
 /// One experiment file of family `F`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -63,7 +63,7 @@ pub struct ExperimentSpec<F: Family> {
     #[serde(deserialize_with = "super::tagged::names")]
     pub quantities: Vec<F::Quantity>,
     /// Rules and estimators to compare, with their parameters.
-    pub rules: Vec<Method<F::Estimator>>,
+    pub rules: Vec<Listed<F::Estimator>>,
     /// Budgets: a list, or a geometric range.
     pub budgets: Budgets,
     /// Repeats per (rule, budget): run time is their lower median; randomised

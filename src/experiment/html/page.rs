@@ -7,7 +7,7 @@ use std::path::Path;
 
 use crate::experiment::markdown::{escape, inline, to_html};
 use crate::experiment::reference::crosscheck_markdown;
-use crate::experiment::report::{FLAG_LEGEND, Page, SHARED, Section, provenance, skipped};
+use crate::experiment::report::{FLAG_LEGEND, Page, SHARED, Section, not_run, provenance, skipped};
 use crate::experiment::run::{JobResult, write_report_file};
 
 use super::document;
@@ -155,6 +155,13 @@ fn facts(dir: &Path, page: &Page, results: &[JobResult]) -> String {
                 "Budgets below a rule's minimum are skipped for it: {}.",
                 escape(&skipped.join(", "))
             ),
+        ));
+    }
+    let not_run = not_run(page);
+    if !not_run.is_empty() {
+        rows.push((
+            "Not run",
+            format!("No rows: {}.", escape(&not_run.join("; "))),
         ));
     }
     if let Some(p) = provenance(results) {

@@ -131,6 +131,10 @@ pub(super) fn section(page: &Page, s: &Section) -> String {
         escape(&s.slope_heading),
         escape(crate::experiment::report::FIT_NOTE)
     );
+    let verdicts = crate::experiment::report::verdict::markdown(&s.verdicts);
+    if !verdicts.is_empty() {
+        b.push_str(&crate::experiment::markdown::to_html(&verdicts, 0));
+    }
     // Every row.
     let display = page
         .quantities

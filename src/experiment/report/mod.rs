@@ -27,7 +27,7 @@
 //! // against the resolution a budget buys (n - 1 intervals): -2 for the trapezoid rule.
 //! let intervals: BTreeMap<usize, f64> = [8, 16, 32, 64, 128].map(|n| (n, Trapezoid.resolution(n, 1))).into();
 //! let rule = RuleInfo { label: "trapezoid".into(), is_random: false, min_budget: 2,
-//!     resolution: BTreeMap::from([(1, intervals.clone())]) };
+//!     resolution: BTreeMap::from([(1, intervals.clone())]), not_run: None };
 //! let table = rows(&[rule], &results, "exp", &[std::f64::consts::E - 1.0], None);
 //! assert_eq!(table.len(), 5);
 //! let against = Against::Resolution { dimension: 1, by_budget: Some(&intervals) };
@@ -54,6 +54,7 @@ mod ranking;
 mod rows;
 mod section;
 mod summary;
+pub mod verdict;
 
 use std::collections::BTreeMap;
 
@@ -65,6 +66,7 @@ pub use page::{FIT_NOTE, SHARED, interval_cell, provenance, write_experiment, wr
 pub use pictures::Picture;
 pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIED, ranked, ranks, tied};
 pub use rows::{FLAG_LEGEND, Row, RowFlag, rows};
+pub use section::not_run;
 pub use section::{
     Fit, Section, cell, display_line, extra_columns, label, off_cell, over_budget, sections,
     show_value, skipped,
@@ -153,4 +155,7 @@ pub struct RuleInfo {
     /// rule, nodes or samples per axis otherwise); a missing entry is read as
     /// `n^(1/D)`.
     pub resolution: BTreeMap<usize, BTreeMap<usize, f64>>,
+    /// Why it has no jobs (an external program missing, its rule asking to
+    /// be skipped), if so.
+    pub not_run: Option<String>,
 }

@@ -10,7 +10,8 @@ use super::findings::findings;
 use super::ranking::Summary;
 use super::rows::{FLAG_LEGEND, Row, RowFlag};
 use super::section::{
-    cell, display_line, extra_columns, label, off_cell, over_budget, sections, show_value, skipped,
+    cell, display_line, extra_columns, label, not_run, off_cell, over_budget, sections, show_value,
+    skipped,
 };
 use super::summary::{ExperimentSummary, ReportSummary, experiment_summary};
 use crate::experiment::reference::crosscheck_markdown;
@@ -88,6 +89,10 @@ pub fn write_experiment(
              has no error and reaches nothing). {FIT_NOTE}"
         );
         md.push('\n');
+        let verdicts = super::verdict::markdown(&s.verdicts);
+        if !verdicts.is_empty() {
+            let _ = writeln!(md, "{verdicts}");
+        }
         for (what, file, text) in &s.plots {
             write_report_file(&dir.join(file), text.as_bytes())?;
             let _ = writeln!(md, "![error against {what}]({file})");
@@ -192,6 +197,10 @@ fn header(page: &Page, results: &[JobResult]) -> String {
             "Budgets below a rule's minimum are skipped for it: {}.\n",
             skipped.join(", ")
         );
+    }
+    let not_run = not_run(page);
+    if !not_run.is_empty() {
+        let _ = writeln!(md, "Not run, no rows: {}.\n", not_run.join("; "));
     }
     if let Some(p) = provenance(results) {
         let _ = writeln!(md, "{p}\n");

@@ -53,6 +53,8 @@ pub struct Section {
     /// For an image-valued quantity: the reference's image and each rule's
     /// at its largest budget, with error heat maps.
     pub pictures: Vec<Picture>,
+    /// The random rules' statistical verdicts, budget by budget.
+    pub verdicts: Vec<super::verdict::RuleVerdicts>,
 }
 
 /// A rule's fitted slopes and times to the targets, as numbers and as shown.
@@ -97,6 +99,7 @@ pub fn sections(page: &Page, results: &[JobResult]) -> Result<Vec<Section>, Stri
                 plots: Vec::new(),
                 ranking: Vec::new(),
                 pictures: Vec::new(),
+                verdicts: Vec::new(),
             });
             continue;
         };
@@ -130,6 +133,7 @@ pub fn sections(page: &Page, results: &[JobResult]) -> Result<Vec<Section>, Stri
         };
         let mut section = orders_and_plots(page, q, show_value(reference), rows)?;
         section.pictures = pictures;
+        section.verdicts = super::verdict::verdicts(page, results, q);
         out.push(section);
     }
     Ok(out)
@@ -141,6 +145,14 @@ pub fn skipped(page: &Page) -> Vec<String> {
         .iter()
         .filter(|r| page.budgets.first().is_some_and(|&b| b < r.min_budget))
         .map(|r| format!("{} needs at least {}", r.label, r.min_budget))
+        .collect()
+}
+
+/// The rules that did not run at all, and why, in words.
+pub fn not_run(page: &Page) -> Vec<String> {
+    page.rules
+        .iter()
+        .filter_map(|r| Some(format!("{} ({})", r.label, r.not_run.as_ref()?)))
         .collect()
 }
 
@@ -422,5 +434,6 @@ fn orders_and_plots(
         plots,
         ranking,
         pictures: Vec::new(),
+        verdicts: Vec::new(),
     })
 }

@@ -160,6 +160,34 @@ pub struct RowSummary {
     pub seconds: Option<TimeInterval>,
     /// What the row's figures can be trusted for.
     pub flags: Vec<FlagSummary>,
+    /// For a random rule with two or more repeats and a reference: the
+    /// statistical verdict on its bias and error bars.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<VerdictSummary>,
+}
+
+/// The tests of a random rule at one budget
+/// ([`crate::experiment::report::verdict`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct VerdictSummary {
+    /// One of: consistent, biased, se-too-small, se-too-large, no-se,
+    /// too-few-repeats.
+    pub verdict: String,
+    /// The level each test was made at (α Šidák-corrected over the rule's
+    /// budgets and channels).
+    pub level: f64,
+    /// The bias test's smallest p-value over the channels.
+    pub p_bias: f64,
+    /// The error-bar test's smallest p-value, where standard errors were given.
+    pub p_se: Option<f64>,
+    /// The spread of the values over the root mean square standard error
+    /// (1 for honest error bars; null where infinite or none given).
+    pub se_ratio: Option<f64>,
+    /// Repeats within 1.96 standard errors of the reference, and those judged.
+    pub covered: [usize; 2],
+    /// The coverage's Wilson 95% interval.
+    pub coverage: Option<[f64; 2]>,
 }
 
 /// A flag on a row: a code to match on and the sentence the report shows.
@@ -233,6 +261,7 @@ impl From<&Row> for RowSummary {
                     text: f.to_string(),
                 })
                 .collect(),
+            verdict: None,
         }
     }
 }
@@ -279,11 +308,27 @@ fn quantity(page: &Page, i: usize, s: &Section) -> QuantitySummary {
         .fits
         .iter()
         .map(|f| {
+            let judged = s.verdicts.iter().find(|v| v.rule_index == f.rule_index);
             let rows: Vec<RowSummary> = s
                 .rows
                 .iter()
                 .filter(|r| r.rule_index == f.rule_index)
-                .map(RowSummary::from)
+                .map(|r| {
+                    let mut row = RowSummary::from(r);
+                    row.verdict = judged.and_then(|v| {
+                        let (_, j) = v.budgets.iter().find(|(b, _)| *b == r.budget)?;
+                        Some(VerdictSummary {
+                            verdict: serde_json::to_value(j.verdict).ok()?.as_str()?.to_string(),
+                            level: v.level,
+                            p_bias: j.p_bias,
+                            p_se: j.p_se,
+                            se_ratio: j.se_ratio.and_then(finite),
+                            covered: j.covered,
+                            coverage: j.coverage,
+                        })
+                    });
+                    row
+                })
                 .collect();
             let (rank, tied) = rank_of
                 .get(f.label.as_str())

@@ -46,9 +46,11 @@ use rand::SeedableRng;
 use serde::{Deserialize, Serialize};
 
 use super::Loaded;
+use super::external::protocol::{self, Request};
+use super::external::{External, Found};
 use super::timing::timed;
 use super::validate::{Experiment, min_budget};
-use crate::family::{Family, Measured, Quantity};
+use crate::family::{Family, Listed, Measured, Method, Outcome, Quantity};
 
 mod files;
 pub mod links;
@@ -187,11 +189,36 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         ));
         return out;
     };
-    // Each quantity is evaluated alone, from the job's seed, and timed alone:
-    // its time to a target is then its own cost (a family computes only what
-    // the asked-for quantities need).
-    let mut outcome = crate::family::Outcome::new();
-    for q in &spec.quantities {
+    let outcome = match method {
+        Listed::Own(method) => own_outcome(exp, method, budget, seed),
+        Listed::External(x) => external_outcome(exp, x, (rule_index, budget, repeat), seed),
+    };
+    let outcome = match outcome {
+        Ok(outcome) => outcome,
+        Err(why) => {
+            out.failure = Some(why);
+            return out;
+        }
+    };
+    out.seconds = outcome.values().filter_map(|m| m.seconds).sum();
+    match shaped::<F>(&exp.scene, &spec.quantities, outcome) {
+        Ok(values) => out.quantities = values,
+        Err(e) => out.failure = Some(e),
+    }
+    out
+}
+
+/// Each quantity evaluated alone by the family's `method`, from the job's
+/// seed, and timed alone: its time to a target is then its own cost (a
+/// family computes only what the asked-for quantities need).
+fn own_outcome<F: Family>(
+    exp: &Experiment<F>,
+    method: &Method<F::Estimator>,
+    budget: usize,
+    seed: u64,
+) -> Result<Outcome<F::Quantity>, String> {
+    let mut outcome = Outcome::new();
+    for q in &exp.spec.quantities {
         let evaluate = || {
             let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
             F::evaluate(
@@ -213,25 +240,53 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         } else {
             once
         };
-        out.seconds += seconds;
-        match result {
-            Ok(values) => {
-                for (k, mut m) in values {
-                    m.seconds = Some(seconds);
-                    outcome.insert(k, m);
-                }
-            }
-            Err(e) => {
-                out.failure = Some(crate::error::readable(&format!("{}: {e}", q.name())));
-                return out;
-            }
+        let values = result.map_err(|e| crate::error::readable(&format!("{}: {e}", q.name())))?;
+        for (k, mut m) in values {
+            m.seconds = Some(seconds);
+            outcome.insert(k, m);
         }
     }
-    match shaped::<F>(&exp.scene, &spec.quantities, outcome) {
-        Ok(values) => out.quantities = values,
-        Err(e) => out.failure = Some(e),
+    Ok(outcome)
+}
+
+/// Each quantity asked of an external program, once (its request is timed
+/// as it is answered: asking again would be another estimate).
+fn external_outcome<F: Family>(
+    exp: &Experiment<F>,
+    external: &External,
+    (rule_index, budget, repeat): JobKey,
+    seed: u64,
+) -> Result<Outcome<F::Quantity>, String> {
+    let Some(Found::Program(program)) = exp.programs.get(&rule_index) else {
+        return Err(format!(
+            "rules[{rule_index}] ({}): its program was not found",
+            external.name
+        ));
+    };
+    let scene = serde_json::to_value(&exp.spec.scene).map_err(|e| e.to_string())?;
+    let mut outcome = Outcome::new();
+    for &q in &exp.spec.quantities {
+        let request = Request {
+            protocol: protocol::NAME.into(),
+            version: protocol::VERSION,
+            id: 0,
+            experiment: exp.spec.name.clone(),
+            family: F::NAME.into(),
+            scene: scene.clone(),
+            quantity: q.name().into(),
+            channels: F::channels(&exp.scene, q),
+            dimension: F::dimension(&exp.scene, q),
+            budget,
+            seed,
+            repeat,
+        };
+        let m = exp
+            .servers
+            .ask(rule_index, program, request, external.timeout_s)
+            .map_err(|e| crate::error::readable(&format!("external `{}`: {e}", external.name)))?;
+        outcome.insert(q, m);
     }
-    out
+    Ok(outcome)
 }
 
 /// The family's outcome by quantity name, checked to hold exactly the
@@ -281,6 +336,10 @@ fn shaped<F: Family>(
 pub fn jobs<F: Family>(exp: &Experiment<F>, shard: Option<(usize, usize)>) -> Vec<JobKey> {
     let mut all = Vec::new();
     for (r, method) in exp.spec.rules.iter().enumerate() {
+        // An external rule whose program is missing (and may be) has no jobs.
+        if matches!(exp.programs.get(&r), Some(Found::Skipped(_))) {
+            continue;
+        }
         let least = min_budget::<F>(&exp.scene, method, &exp.spec.quantities);
         for &b in exp.budgets.iter().filter(|&&b| b >= least) {
             for k in 0..exp.spec.repeats {
@@ -302,8 +361,8 @@ pub fn jobs<F: Family>(exp: &Experiment<F>, shard: Option<(usize, usize)>) -> Ve
 /// The finished jobs a `--resume` keeps from a results file, and what it
 /// passes over.
 pub struct Finished {
-    /// One result per job (the last line wins), of this experiment file and
-    /// this lightquad release.
+    /// One result per job that did not fail (the last line wins), of this
+    /// experiment file and this lightquad release.
     pub results: Vec<JobResult>,
     /// Lines that are not results of this file's jobs.
     pub unread: Unread,
@@ -320,10 +379,14 @@ pub fn finished_jobs(exp: &dyn Loaded, path: &Path) -> Finished {
     unread.unreadable += misfits;
     let mut other_release = 0;
     for r in read {
-        if r.version == env!("CARGO_PKG_VERSION") {
+        if r.version != env!("CARGO_PKG_VERSION") {
+            other_release += 1;
+        } else if r.failure.is_none() {
             by_key.insert(r.key(), r);
         } else {
-            other_release += 1;
+            // A failed job is tried again (an external program that timed
+            // out or crashed may answer now); the last line wins.
+            by_key.remove(&r.key());
         }
     }
     Finished {

@@ -67,7 +67,11 @@ pub(super) fn check_cost<F: Family>(
     let Some(&largest) = budgets.last() else {
         return Ok(());
     };
-    for (i, m) in spec.rules.iter().enumerate() {
+    for (i, listed) in spec.rules.iter().enumerate() {
+        // An external program's cost is its own: lightquad cannot price it.
+        let Some(m) = listed.own() else {
+            continue;
+        };
         let cost: f64 = spec
             .quantities
             .iter()
@@ -79,7 +83,7 @@ pub(super) fn check_cost<F: Family>(
             // blob of amplitude 1e307 collides about that often a walk):
             // lowering the budget, the advice given, could not help. (The
             // experiment's own smallest budget said so of any single budget.)
-            let least = min_budget::<F>(scene, m, &spec.quantities);
+            let least = min_budget::<F>(scene, listed, &spec.quantities);
             let at_least: f64 = spec
                 .quantities
                 .iter()
@@ -255,11 +259,12 @@ pub fn jobs_cost<F: Family>(
         let need = min_budget::<F>(scene, m, &spec.quantities);
         for &b in budgets.iter().filter(|&&b| b >= need) {
             jobs += repeats;
+            // An external program's work is counted as its budget.
             total += repeats
                 * spec
                     .quantities
                     .iter()
-                    .map(|&q| F::cost(scene, m, b, q))
+                    .map(|&q| m.own().map_or(b as f64, |m| F::cost(scene, m, b, q)))
                     .sum::<f64>();
         }
     }

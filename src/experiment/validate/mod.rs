@@ -32,7 +32,8 @@ use super::source::Origin;
 use super::spec::{Budgets, ExperimentSpec};
 
 pub use crate::error::SpecError;
-use crate::family::{Estimator, Family, Method, Quantity};
+use crate::experiment::external::{Found, Servers};
+use crate::family::{Estimator, Family, Listed, Method, Quantity};
 use crate::quadrature::Rule;
 
 mod cost;
@@ -69,6 +70,10 @@ pub struct Experiment<F: Family> {
     pub known: Option<Known<F::Quantity>>,
     /// Where its file came from: Mitsuba values are looked for relative to it.
     pub origin: Origin,
+    /// The program of each external rule, by rule index.
+    pub programs: BTreeMap<usize, Found>,
+    /// The external rules' running programs.
+    pub servers: Servers,
 }
 
 /// Validates a parsed experiment whose file hashes to `hash`, as if its file
@@ -98,7 +103,7 @@ pub fn validate_from<F: Family>(
             ));
         }
     }
-    check_methods::<F>(&spec, &scene)?;
+    let programs = check_methods::<F>(&spec, &scene, &origin)?;
     let budgets = budgets(&spec.budgets)?;
     // Budgets below a rule's minimum are skipped for that rule; a rule left
     // with none is an error, so no rule silently disappears.
@@ -125,13 +130,15 @@ pub fn validate_from<F: Family>(
         hash: hash.to_string(),
         known,
         origin,
+        programs,
+        servers: Servers::default(),
     })
 }
 
 /// The smallest budget `method` needs for every quantity of the experiment.
 pub fn min_budget<F: Family>(
     scene: &F::Scene,
-    method: &Method<F::Estimator>,
+    method: &Listed<F::Estimator>,
     quantities: &[F::Quantity],
 ) -> usize {
     quantities
@@ -223,68 +230,98 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
 
 /// Every rule's parameters, and that every rule and estimator can compute
 /// every quantity asked for (a rule in the quantity's dimension; an
-/// estimator only the quantities it estimates).
-fn check_methods<F: Family>(spec: &ExperimentSpec<F>, scene: &F::Scene) -> Result<(), SpecError> {
+/// estimator only the quantities it estimates); an external rule's program
+/// found, by rule index.
+fn check_methods<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    origin: &Origin,
+) -> Result<BTreeMap<usize, Found>, SpecError> {
     if spec.rules.is_empty() {
         return Err(SpecError::at(
             "rules",
             format!(
-                "an empty list: name at least one of {}",
+                "an empty list: name at least one of {}, or an external program",
                 Method::<F::Estimator>::names().join(", ")
             ),
         ));
     }
+    let mut programs = BTreeMap::new();
     for (i, method) in spec.rules.iter().enumerate() {
         let at = format!("rules[{i}]");
         match method {
-            Method::Rule(rule) => {
-                rule.check().map_err(|e| SpecError::from_quad(&at, e))?;
-                for (k, q) in spec.quantities.iter().enumerate() {
-                    let dim = F::dimension(scene, *q);
-                    if !rule.dimensions().contains(dim) {
-                        return Err(SpecError::at(
-                            at,
-                            format!(
-                                "rule `{}` integrates in dimension {}, but quantities[{k}] ({}) is an \
-                                 integral in dimension {dim} in family {}: use a rule for dimension {dim}",
-                                rule.name(),
-                                rule.dimensions(),
-                                q.name(),
-                                F::NAME
-                            ),
-                        ));
-                    }
-                }
+            Listed::Own(Method::Rule(rule)) => check_rule::<F>(spec, scene, &at, rule)?,
+            Listed::Own(Method::Estimator(e)) => check_estimator::<F>(spec, scene, &at, e)?,
+            Listed::External(x) => {
+                let found = x
+                    .check(origin, &Method::<F::Estimator>::names())
+                    .map_err(|(field, message)| SpecError::at(format!("{at}.{field}"), message))?;
+                programs.insert(i, found);
             }
-            Method::Estimator(e) => {
-                F::check_estimator(e).map_err(|err| SpecError::from_quad(&at, err))?;
-                let can = F::estimates(e);
-                for (k, q) in spec.quantities.iter().enumerate() {
-                    if !can.contains(q) {
-                        let names: Vec<_> = can.iter().map(Quantity::name).collect();
-                        return Err(SpecError::at(
-                            at,
-                            format!(
-                                "estimator `{}` estimates only {}, but quantities[{k}] is {}: \
-                                 give it an experiment of its own, or use a quadrature rule",
-                                e.name(),
-                                names.join(", "),
-                                q.name()
-                            ),
-                        ));
-                    }
-                    if let Some(why) = F::refuses(scene, e, *q) {
-                        return Err(SpecError::at(
-                            at,
-                            format!(
-                                "estimator `{}` cannot estimate quantities[{k}] ({}) in this scene: {why}",
-                                e.name(),
-                                q.name()
-                            ),
-                        ));
-                    }
-                }
-            }
+        }
+    }
+    Ok(programs)
+}
+
+/// A rule's parameters, and that it integrates in every quantity's dimension.
+fn check_rule<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    at: &str,
+    rule: &crate::quadrature::AnyRule,
+) -> Result<(), SpecError> {
+    rule.check().map_err(|e| SpecError::from_quad(at, e))?;
+    for (k, q) in spec.quantities.iter().enumerate() {
+        let dim = F::dimension(scene, *q);
+        if !rule.dimensions().contains(dim) {
+            return Err(SpecError::at(
+                at,
+                format!(
+                    "rule `{}` integrates in dimension {}, but quantities[{k}] ({}) is an \
+                     integral in dimension {dim} in family {}: use a rule for dimension {dim}",
+                    rule.name(),
+                    rule.dimensions(),
+                    q.name(),
+                    F::NAME
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// An estimator's parameters, and that it estimates every quantity in this scene.
+fn check_estimator<F: Family>(
+    spec: &ExperimentSpec<F>,
+    scene: &F::Scene,
+    at: &str,
+    e: &F::Estimator,
+) -> Result<(), SpecError> {
+    F::check_estimator(e).map_err(|err| SpecError::from_quad(at, err))?;
+    let can = F::estimates(e);
+    for (k, q) in spec.quantities.iter().enumerate() {
+        if !can.contains(q) {
+            let names: Vec<_> = can.iter().map(Quantity::name).collect();
+            return Err(SpecError::at(
+                at,
+                format!(
+                    "estimator `{}` estimates only {}, but quantities[{k}] is {}: \
+                     give it an experiment of its own, or use a quadrature rule",
+                    e.name(),
+                    names.join(", "),
+                    q.name()
+                ),
+            ));
+        }
+        if let Some(why) = F::refuses(scene, e, *q) {
+            return Err(SpecError::at(
+                at,
+                format!(
+                    "estimator `{}` cannot estimate quantities[{k}] ({}) in this scene: {why}",
+                    e.name(),
+                    q.name()
+                ),
+            ));
         }
     }
     Ok(())

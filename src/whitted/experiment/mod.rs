@@ -420,6 +420,7 @@ fn measured<V: Value>(est: &Estimated<V>, rays: u64) -> Measured {
         evaluations: rays,
         flags: Vec::new(),
         seconds: None,
+        program_seconds: None,
     };
     let m = if est.reliable {
         m

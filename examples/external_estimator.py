@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""An external estimator for lightquad (protocol lightquad-estimator/1,
+docs/external-estimators.md): plain Monte Carlo irradiance at a receiver
+point from rectangle lights, standard library only.
+
+Each request names a rendering scene, an irradiance quantity (E_area,
+E_hemisphere, ...: one value, whatever lightquad's form) and a budget n. The
+estimate samples each rectangle uniformly by area, n points:
+
+    E = sum over lights of  A L_e (1/n) sum_i cos(theta_r) cos(theta_e) / r^2
+
+(R-A of docs/EQUATIONS.md), with the sample standard error. A scene with
+occluders, another kind of light, RGB radiance or another quantity gets an
+`error` answer.
+
+Two planted faults, for the report's verdicts to catch:
+    --no-cos     forgets the light's cosine (the pdf of directions missing
+                 its cos factor): biased;
+    --half-se    reports half its standard error: error bars too small.
+"""
+
+import json
+import math
+import random
+import sys
+import time
+
+
+class Unsupported(Exception):
+    """A request this estimator cannot answer."""
+
+
+def sub(a, b):
+    return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def unit(a):
+    length = math.sqrt(dot(a, a))
+    return [a[0] / length, a[1] / length, a[2] / length]
+
+
+def rectangles(scene):
+    """The scene's lights as (origin, edge_u, edge_v, radiance), or Unsupported."""
+    if scene.get("occluders"):
+        raise Unsupported("occluders: this example has no visibility test")
+    lights = []
+    for k, e in enumerate(scene.get("emitters", [])):
+        if e.get("type") != "rectangle":
+            raise Unsupported(f"emitters[{k}] is a {e.get('type')}: only rectangles")
+        if not isinstance(e.get("radiance"), (int, float)):
+            raise Unsupported(f"emitters[{k}]: only a scalar radiance")
+        lights.append((e["origin"], e["edge_u"], e["edge_v"], float(e["radiance"])))
+    return lights
+
+
+def irradiance(scene, n, rng, with_cos=True):
+    """The estimate and its standard error from n samples per light."""
+    x = scene["receiver"]["point"]
+    normal = unit(scene["receiver"]["normal"])
+    lights = rectangles(scene)
+    total, total_sq = 0.0, 0.0
+    for _ in range(n):
+        f = 0.0
+        for origin, eu, ev, radiance in lights:
+            facing = cross(eu, ev)  # the emitting side (e_u x e_v)
+            area = math.sqrt(dot(facing, facing))
+            u, v = rng.random(), rng.random()
+            y = [origin[i] + u * eu[i] + v * ev[i] for i in range(3)]
+            d = sub(y, x)
+            r2 = dot(d, d)
+            cos_r = dot(normal, d) / math.sqrt(r2)
+            cos_e = -dot(facing, d) / (area * math.sqrt(r2))
+            if cos_r <= 0.0 or cos_e <= 0.0:
+                continue
+            f += radiance * area * cos_r * (cos_e if with_cos else 1.0) / r2
+        total += f
+        total_sq += f * f
+    mean = total / n
+    variance = max(total_sq / n - mean * mean, 0.0) * n / (n - 1) if n > 1 else math.inf
+    return mean, math.sqrt(variance / n)
+
+
+def answer(request, with_cos, se_scale):
+    """One response for one request."""
+    if request.get("family") != "rendering" or not request.get("quantity", "").startswith("E_"):
+        raise Unsupported(f"{request.get('family')} {request.get('quantity')}: "
+                          "only the rendering family's irradiance E_*")
+    rng = random.Random(request["seed"])
+    start = time.perf_counter()
+    value, se = irradiance(request["scene"], request["budget"], rng, with_cos)
+    seconds = time.perf_counter() - start
+    std_error = [se * se_scale] if math.isfinite(se) else None
+    response = {"id": request["id"], "value": [value], "evaluations": request["budget"],
+                "seconds": seconds}
+    if std_error is not None:
+        response["std_error"] = std_error
+    return response
+
+
+def main():
+    with_cos = "--no-cos" not in sys.argv[1:]
+    se_scale = 0.5 if "--half-se" in sys.argv[1:] else 1.0
+    for line in sys.stdin:  # one request per line, until lightquad closes stdin
+        request = json.loads(line)
+        try:
+            response = answer(request, with_cos, se_scale)
+        except Unsupported as e:
+            response = {"id": request["id"], "error": str(e)}
+        print(json.dumps(response, allow_nan=False), flush=True)
+
+
+if __name__ == "__main__":
+    main()
