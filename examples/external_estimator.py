@@ -108,6 +108,7 @@ def answer(request, with_cos, se_scale):
 def main():
     with_cos = "--no-cos" not in sys.argv[1:]
     se_scale = 0.5 if "--half-se" in sys.argv[1:] else 1.0
+    print(json.dumps({"protocol": "lightquad-estimator", "version": 1}), flush=True)  # ready
     for line in sys.stdin:  # one request per line, until lightquad closes stdin
         request = json.loads(line)
         try:

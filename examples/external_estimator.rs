@@ -148,6 +148,13 @@ fn answer(request: &Value) -> Value {
 fn main() -> std::io::Result<()> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
+    // Ready: the protocol it speaks.
+    writeln!(
+        out,
+        "{}",
+        json!({"protocol": "lightquad-estimator", "version": 1})
+    )?;
+    out.flush()?;
     for line in std::io::stdin().lock().lines() {
         let request: Value = serde_json::from_str(&line?).unwrap_or(Value::Null);
         writeln!(out, "{}", answer(&request))?;

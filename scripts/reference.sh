@@ -9,7 +9,9 @@
 #                                 one transmittance and one single-scattering value
 #                                 with few samples into a scratch folder, which the
 #                                 Rust test tests/it/mitsuba.rs then checks against
-#                                 lightquad (so the harness cannot rot).
+#                                 lightquad (so the harness cannot rot), and runs
+#                                 one bundled experiment with Mitsuba as an
+#                                 external estimator (reference/serve.py).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -39,6 +41,18 @@ if [ "${1:-}" = "--ci" ]; then
     ../experiments/r-h-vs-a-tilted-rectangle.json ../experiments/mitsuba-r-furnace-bounces.json \
     ../experiments/w-ss-edge-coverage.json)
   LIGHTQUAD_REFERENCE_VALUES="$scratch" cargo test --release --test it mitsuba::
+  # Mitsuba as an external estimator (reference/serve.py): one small bundled
+  # experiment run through it; every one of its jobs must have answered.
+  cargo run --release --quiet -- run experiments/mitsuba-r-furnace-bounces.json --out "$scratch/external"
+  python3 - "$scratch/external/mitsuba-r-furnace-bounces/results.jsonl" <<'PY'
+import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1])]
+mitsuba = [r for r in rows if r["rule"] == "mitsuba"]
+failed = [r["failure"] for r in mitsuba if r["failure"]]
+if not mitsuba or failed:
+    sys.exit(f"reference.sh: Mitsuba as an external estimator: {len(mitsuba)} jobs, failures {failed[:3]}")
+print(f"reference.sh: Mitsuba answered all {len(mitsuba)} of its jobs as an external estimator")
+PY
 else
   # Every experiment that has a committed values file (Mitsuba cannot express
   # every scene: Gaussian blobs, linear gradients and volumetric emission have

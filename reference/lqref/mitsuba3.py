@@ -16,8 +16,29 @@ class MitsubaMissing(RuntimeError):
     """Mitsuba 3 (or the variant) is not available in this Python."""
 
 
+def use_llvm_if_present():
+    """Selects ``llvm_ad_rgb`` instead of ``scalar_rgb`` for what follows when
+    Dr.Jit is told where libLLVM is (``DRJIT_LIBLLVM_PATH`` naming a file) and
+    the build has the variant; returns the variant in use. The values files
+    are computed in ``scalar_rgb``; the server (lqref.serve) takes the faster
+    one."""
+    global VARIANT
+    import os
+
+    path = os.environ.get("DRJIT_LIBLLVM_PATH", "")
+    if _MI is None and path and os.path.isfile(path):
+        try:
+            import mitsuba as mi
+        except ImportError:
+            return VARIANT
+        if "llvm_ad_rgb" in mi.variants():
+            VARIANT = "llvm_ad_rgb"
+    return VARIANT
+
+
 def require_mitsuba():
-    """Imports Mitsuba 3 and Dr.Jit and selects ``scalar_rgb``; returns ``(mi, dr)``.
+    """Imports Mitsuba 3 and Dr.Jit and selects ``VARIANT`` (``scalar_rgb``
+    unless use_llvm_if_present chose LLVM); returns ``(mi, dr)``.
 
     Raises MitsubaMissing with the install command when they are absent."""
     global _MI

@@ -39,6 +39,14 @@ def load(path) -> Experiment:
 
     with open(path, "rb") as f:
         raw = json.loads(f.read().decode("utf-8"))
+    return from_dict(raw, str(path))
+
+
+def from_dict(raw, path) -> Experiment:
+    """An experiment from its parsed JSON ``raw`` (``path`` names where it came
+    from); its family reads the ``scene``."""
+    from .families import FAMILIES
+
     if not isinstance(raw, dict):
         raise SpecError(".", "an experiment file is a JSON object")
     tag = raw.get("family")

@@ -6,6 +6,7 @@ import json
 import math
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -757,3 +758,46 @@ def test_whitted_bad_scenes_are_named(tmp_path, change, path):
         runner.compute(bad, quick=True, out_dir=tmp_path / "v", log=lambda *a: None)
     assert err.value.path == path
     assert not (tmp_path / "v" / "bad.json").exists()
+
+
+# ----------------------------------------------------------------------------
+# Server mode: Mitsuba 3 as a lightquad external estimator (lqref.serve)
+
+
+def _furnace_request(budget, channels=1, family="furnace"):
+    return {"protocol": "lightquad-estimator", "version": 1, "id": 7, "experiment": "t",
+            "family": family, "scene": {"albedo": 0.5, "emission": 1.0, "half_angle": math.pi},
+            "quantity": "L", "channels": channels, "dimension": 2, "budget": budget,
+            "seed": 3, "repeat": 0}
+
+
+def test_serve_answers_the_furnace_within_its_standard_error():
+    from lqref import serve
+
+    # The white furnace: L = L_e / (1 - rho) = 2 (truncation of Mitsuba's
+    # paths at the harness's depth aside, far below the noise here).
+    r = serve.answer(_furnace_request(512))
+    assert r["id"] == 7 and r["evaluations"] == 512
+    assert len(r["value"]) == 1 and len(r["std_error"]) == 1
+    assert abs(r["value"][0] - 2.0) < 5 * r["std_error"][0] + 1e-3, r
+    assert r["seconds"] > 0
+
+
+def test_serve_declines_what_it_cannot_compute():
+    from lqref import serve
+
+    assert "channels" in serve.answer(_furnace_request(16, channels=3))["error"]
+    assert "family" in serve.answer(_furnace_request(16, family="integral"))["error"]
+    bad = _furnace_request(16)
+    bad["scene"] = {"albedo": "white"}
+    assert "error" in serve.answer(bad)
+
+
+def test_serve_speaks_the_protocol_over_pipes():
+    request = json.dumps(_furnace_request(64)) + "\n"
+    done = subprocess.run([sys.executable, str(Path(__file__).resolve().parent.parent / "serve.py")],
+                          input=request, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    hello, answer = done.stdout.splitlines()
+    assert json.loads(hello) == {"protocol": "lightquad-estimator", "version": 1}
+    assert json.loads(answer)["id"] == 7

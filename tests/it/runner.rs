@@ -44,6 +44,7 @@ fn i_experiment() -> (
         is_random: false,
         min_budget: 1,
         resolution: Default::default(),
+        not_run: None,
     }];
     (exp, rules)
 }
@@ -1908,6 +1909,7 @@ fn true_errors_near_the_top_of_the_range_do_not_overflow() {
         is_random: false,
         min_budget: 1,
         resolution: Default::default(),
+        not_run: None,
     };
     let reference = [-1.7e308];
     let rows = lightquad::experiment::report::rows(&[rule], &results, "I_E", &reference, None);

@@ -319,7 +319,9 @@ def _viewer_distance(exp, view, tmp):
     mi, _ = require_mitsuba()
     probe = build_scene(exp, tmp)
     si = probe.ray_intersect(mi.Ray3f(mi.Point3f(0.0, 0.0, 0.0), mi.Vector3f(*view.tolist())))
-    t = float(si.t) if si.is_valid() else math.inf
+    # (In a vectorised variant such as llvm_ad_rgb each is an array of one.)
+    valid = bool(np.asarray(si.is_valid()).reshape(-1)[0])
+    t = float(np.asarray(si.t, dtype=np.float64).reshape(-1)[0]) if valid else math.inf
     return min(1.0, 0.5 * t)
 
 

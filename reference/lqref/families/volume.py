@@ -349,9 +349,9 @@ def tau_constant_sphere(exp, settings=None):
     si = dr.zeros(mi.SurfaceInteraction3f)
     si.t = length
     tr, _pdf = medium.transmittance_eval_pdf(mei, si, True)
-    sigma = float(mei.combined_extinction[0])
+    sigma = _scalar(mei.combined_extinction[0])
     depth = sigma * length
-    value = float(tr[0])
+    value = _scalar(tr[0])
     return {
         "value": value,
         "std_error": 0.0,

@@ -1,7 +1,9 @@
 //! The messages between lightquad and an external estimator, version
-//! [`VERSION`]: one JSON object per line each way, a [`Request`] on the
-//! program's stdin, its [`Response`] on its stdout, one request at a time.
-//! The program answers requests until its stdin ends, then exits; what it
+//! [`VERSION`]: one JSON object per line each way. Once started and ready,
+//! the program writes a [`Hello`] on its stdout (lightquad's clock for a
+//! request starts after it, so start-up is not counted as work); then a
+//! [`Request`] on its stdin gets its [`Response`] on its stdout, one
+//! request at a time, until its stdin ends and it exits. What it
 //! writes to stderr is kept (its last lines are quoted when a job fails) and
 //! never read as an answer. `lightquad schema --protocol` prints the JSON
 //! Schema of both messages.
@@ -33,6 +35,29 @@ pub const VERSION: u32 = 1;
 
 /// The name every request carries in `protocol`.
 pub const NAME: &str = "lightquad-estimator";
+
+/// The program's first line: ready, and the protocol it speaks.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Hello {
+    /// `"lightquad-estimator"`.
+    pub protocol: String,
+    /// The version it speaks: [`VERSION`].
+    pub version: u32,
+}
+
+impl Hello {
+    /// Why a hello is not this protocol's, if it is not.
+    pub fn mismatch(&self) -> Option<String> {
+        (self.protocol != NAME || self.version != VERSION).then(|| {
+            format!(
+                "speaks {:?} version {}, where lightquad speaks {NAME:?} version {VERSION}",
+                crate::error::excerpt(&self.protocol),
+                self.version
+            )
+        })
+    }
+}
 
 /// One estimate lightquad asks for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -97,6 +122,8 @@ pub struct Response {
 #[schemars(rename = "LightquadEstimatorProtocol")]
 #[allow(dead_code)]
 pub struct Messages {
+    /// The program's first line on its stdout, when it is ready.
+    pub hello: Hello,
     /// A request, one line on the program's stdin.
     pub request: Request,
     /// A response, one line on the program's stdout.

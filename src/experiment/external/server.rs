@@ -12,7 +12,7 @@ use std::sync::mpsc::{Receiver, RecvTimeoutError, sync_channel};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
-use super::protocol::{self, Request, Response};
+use super::protocol::{self, Hello, Request, Response};
 use crate::family::Measured;
 
 /// The stderr lines of a program kept for a failed job's message.
@@ -49,7 +49,8 @@ struct Server {
 }
 
 impl Server {
-    fn start(program: &Program) -> Result<Server, String> {
+    /// Starts `program` and waits up to `timeout` for its [`Hello`].
+    fn start(program: &Program, timeout: Duration) -> Result<Server, String> {
         let mut child = Command::new(&program.path)
             .args(&program.args)
             .current_dir(&program.folder)
@@ -72,14 +73,48 @@ impl Server {
         let tail = Arc::new(Mutex::new(VecDeque::new()));
         let kept = tail.clone();
         std::thread::spawn(move || keep_tail(stderr, &kept));
-        Ok(Server {
+        let mut server = Server {
             child,
             stdin,
             lines,
             limit,
             stderr: tail,
             requests: 0,
-        })
+        };
+        server.hello(timeout).map_err(|why| {
+            let tail = server
+                .stderr_tail()
+                .map(|t| format!("; its stderr ended: {t}"))
+                .unwrap_or_default();
+            format!("{why}{tail}")
+        })?;
+        Ok(server)
+    }
+
+    /// Reads the program's [`Hello`].
+    fn hello(&mut self, timeout: Duration) -> Result<(), String> {
+        let text = match self.lines.recv_timeout(timeout) {
+            Ok(Ok(text)) => text,
+            Ok(Err(why)) => return Err(why),
+            Err(RecvTimeoutError::Timeout) => {
+                return Err(format!(
+                    "not ready within timeout_s = {} s (no hello line)",
+                    timeout.as_secs_f64()
+                ));
+            }
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(format!("no hello line{}", self.exited()));
+            }
+        };
+        let hello: Hello = serde_json::from_str(&text).map_err(|e| {
+            format!(
+                "began with {:?}, which is not a hello line {{\"protocol\": \"{}\", \"version\": {}}} ({e})",
+                crate::error::excerpt(&text),
+                protocol::NAME,
+                protocol::VERSION
+            )
+        })?;
+        hello.mismatch().map_or(Ok(()), Err)
     }
 
     /// Sends `request` (its `id` set here) and waits up to `timeout` for the
@@ -231,6 +266,9 @@ fn keep_tail(stderr: impl Read, tail: &Mutex<VecDeque<String>>) {
 #[derive(Default)]
 pub struct Servers {
     idle: Mutex<Vec<(usize, Server)>>,
+    /// Rules whose program failed to start, with why: not started again
+    /// in this run (each start would wait out its timeout once more).
+    broken: Mutex<Vec<(usize, String)>>,
 }
 
 impl std::fmt::Debug for Servers {
@@ -261,7 +299,9 @@ impl Servers {
         );
         let mut server = match taken {
             Some(s) => s,
-            None => Server::start(program).map_err(|e| format!("{what}: {e}"))?,
+            None => self
+                .start(rule, program, timeout_s)
+                .map_err(|e| format!("{what}: {e}"))?,
         };
         match server.ask(request, Duration::from_secs_f64(timeout_s)) {
             Ok((mut m, seconds)) => {
@@ -280,6 +320,27 @@ impl Servers {
                 Err(format!("{what}: {why}{tail}"))
             }
         }
+    }
+
+    /// A fresh process of rule `rule`, unless its program failed to start
+    /// before in this run (then the same failure, said to be an earlier one).
+    fn start(&self, rule: usize, program: &Program, timeout_s: f64) -> Result<Server, String> {
+        let earlier = self.broken.lock().ok().and_then(|broken| {
+            broken
+                .iter()
+                .find(|(r, _)| *r == rule)
+                .map(|(_, why)| why.clone())
+        });
+        if let Some(why) = earlier {
+            return Err(format!(
+                "its program failed to start earlier in this run and is not started again: {why}"
+            ));
+        }
+        Server::start(program, Duration::from_secs_f64(timeout_s)).inspect_err(|why| {
+            if let Ok(mut broken) = self.broken.lock() {
+                broken.push((rule, why.clone()));
+            }
+        })
     }
 
     fn give_back(&self, rule: usize, server: Server) {

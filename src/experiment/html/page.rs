@@ -157,6 +157,9 @@ fn facts(dir: &Path, page: &Page, results: &[JobResult]) -> String {
             ),
         ));
     }
+    for line in crate::experiment::report::external_times(page, results) {
+        rows.push(("External estimator", format!("{}.", escape(&line))));
+    }
     let not_run = not_run(page);
     if !not_run.is_empty() {
         rows.push((

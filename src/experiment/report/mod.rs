@@ -62,7 +62,9 @@ pub use findings::findings;
 pub use fitted::{Extrapolated, Reach, Slope};
 pub use index::write_index;
 pub use order::{Against, ERRATIC, FIT_ROWS, Order, fit_floor, fitted, order, time_to};
-pub use page::{FIT_NOTE, SHARED, interval_cell, provenance, write_experiment, write_summary};
+pub use page::{
+    FIT_NOTE, SHARED, external_times, interval_cell, provenance, write_experiment, write_summary,
+};
 pub use pictures::Picture;
 pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIED, ranked, ranks, tied};
 pub use rows::{FLAG_LEGEND, Row, RowFlag, rows};

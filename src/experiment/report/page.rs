@@ -198,6 +198,9 @@ fn header(page: &Page, results: &[JobResult]) -> String {
             skipped.join(", ")
         );
     }
+    for line in external_times(page, results) {
+        let _ = writeln!(md, "External estimator {line}.\n");
+    }
     let not_run = not_run(page);
     if !not_run.is_empty() {
         let _ = writeln!(md, "Not run, no rows: {}.\n", not_run.join("; "));
@@ -243,6 +246,43 @@ pub fn provenance(results: &[JobResult]) -> Option<String> {
             r.version, r.machine, r.experiment_hash
         )
     })
+}
+
+/// Per external rule that reported its own times, a sentence setting the
+/// median of its own time per request beside lightquad's time of the same
+/// requests (sending, transfer and parsing included).
+pub fn external_times(page: &Page, results: &[JobResult]) -> Vec<String> {
+    let median = |mut xs: Vec<f64>| {
+        xs.sort_by(f64::total_cmp);
+        let n = xs.len();
+        if n % 2 == 1 {
+            xs[n / 2]
+        } else {
+            (xs[n / 2 - 1] + xs[n / 2]) / 2.0
+        }
+    };
+    let mut out = Vec::new();
+    for (i, rule) in page.rules.iter().enumerate() {
+        let pairs: Vec<(f64, f64)> = results
+            .iter()
+            .filter(|r| r.rule_index == i && r.failure.is_none())
+            .flat_map(|r| r.quantities.values())
+            .filter_map(|m| Some((m.program_seconds?, m.seconds?)))
+            .collect();
+        if pairs.is_empty() {
+            continue;
+        }
+        let own = median(pairs.iter().map(|p| p.0).collect());
+        let timed = median(pairs.iter().map(|p| p.1).collect());
+        out.push(format!(
+            "{}: its own time per request, median {own:.3e} s over {} requests, against \
+             lightquad's {timed:.3e} s for the same requests (sending, transfer and parsing \
+             included; the tables use lightquad's)",
+            rule.label,
+            pairs.len()
+        ));
+    }
+    out
 }
 
 /// The table of one quantity: a row per (rule, budget); with several

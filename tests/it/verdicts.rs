@@ -1,0 +1,124 @@
+//! The statistical verdicts: their p-values against independently computed
+//! ones (mpmath quadratures of the densities), and their false-alarm rate on lightquad's own unbiased
+//! estimators over 200 independent seeds.
+
+use lightquad::experiment::report::verdict::{ALPHA, Verdict, judge_budget, sidak, wilson};
+use rayon::prelude::*;
+
+#[test]
+fn p_values_match_mpmath_quadratures() {
+    // t = 1 / (sqrt(2.5) / sqrt 5) = sqrt 2 with 4 degrees of freedom; p = 2
+    // int_t^inf of the density (mpmath, 30 digits) = 0.23019964108049898.
+    let xs: Vec<(f64, f64)> = [1.0, 2.0, 3.0, 4.0, 5.0].map(|x| (x, 1.0)).to_vec();
+    let j = judge_budget(&[xs.clone()], &[2.0], &[0.0], 0.01);
+    assert!((j.t - 1.414_213_562_373_095_1).abs() < 1e-12, "{}", j.t);
+    assert!(
+        (j.p_bias - 0.230_199_641_080_498_98).abs() < 1e-10,
+        "{}",
+        j.p_bias
+    );
+    // Error bars: sd^2 = 2.5, mean s^2 = 1, X = 4 * 2.5 = 10 with 4 degrees
+    // of freedom; 2 int_10^inf of the density (mpmath) =
+    // 0.0808553639890256.
+    assert!((j.p_se.expect("SE given") - 0.080_855_363_989_025_58).abs() < 1e-10);
+    assert!((j.se_ratio.expect("ratio") - 2.5f64.sqrt()).abs() < 1e-12);
+    assert_eq!(j.verdict, Verdict::Consistent);
+    // At level 0.1 the spread is too wide for the claimed errors.
+    assert_eq!(
+        judge_budget(&[xs], &[3.0], &[0.0], 0.1).verdict,
+        Verdict::SeTooSmall
+    );
+    // The reference's tolerance absorbs an offset within it.
+    let shifted: Vec<(f64, f64)> = [11.0, 12.0, 13.0, 14.0, 15.0].map(|x| (x, 1.6)).to_vec();
+    assert_eq!(
+        judge_budget(&[shifted.clone()], &[3.0], &[0.0], 0.01).verdict,
+        Verdict::Biased
+    );
+    assert_eq!(
+        judge_budget(&[shifted], &[3.0], &[10.0], 0.01).verdict,
+        Verdict::Consistent
+    );
+    // No standard error given: the bias test still runs.
+    let bare: Vec<(f64, f64)> = [1.0, 2.0, 3.0].map(|x| (x, f64::INFINITY)).to_vec();
+    assert_eq!(
+        judge_budget(&[bare], &[2.0], &[0.0], 0.01).verdict,
+        Verdict::NoSe
+    );
+    // Wilson's interval for 15 of 16 (statsmodels proportion_confint(15, 16,
+    // method='wilson')): (0.7167, 0.9889).
+    let [lo, hi] = wilson(15, 16);
+    assert!(
+        (lo - 0.716_7).abs() < 1e-4 && (hi - 0.988_9).abs() < 1e-4,
+        "{lo} {hi}"
+    );
+    // Šidák: 1 - 0.99^(1/6).
+    assert!((sidak(0.01, 6) - 0.001_673_653_852_310_441_6).abs() < 1e-12);
+}
+
+/// One experiment of the calibration family, `int_0^1 e^x dx`, with
+/// lightquad's unbiased random rules, run at `seed`: per rule and budget
+/// the repeats' (value, standard error).
+fn repeats_at(seed: u64) -> Vec<(String, Vec<Vec<(f64, f64)>>)> {
+    let text = format!(
+        r#"{{"name": "fa", "family": "calibration", "scene": {{}}, "quantities": ["exp"],
+          "rules": [{{"rule": "monte-carlo"}}, {{"rule": "stratified"}}, {{"rule": "sobol"}}],
+          "budgets": [16, 64, 256], "repeats": 6, "seed": {seed},
+          "reference": {{"type": "closed-form"}}}}"#
+    );
+    let exp = lightquad::families::builtin()
+        .load(serde_json::from_str(&text).expect("json"), "hash")
+        .expect("valid");
+    let results: Vec<_> = exp.jobs(None).into_iter().map(|j| exp.run_job(j)).collect();
+    let mut out = Vec::new();
+    for rule in ["monte-carlo", "stratified", "sobol"] {
+        let per_budget = [16, 64, 256]
+            .iter()
+            .map(|&b| {
+                results
+                    .iter()
+                    .filter(|r| r.rule == rule && r.budget == b)
+                    .map(|r| {
+                        let m = &r.quantities["exp"];
+                        (m.value[0], m.error[0])
+                    })
+                    .collect()
+            })
+            .collect();
+        out.push((rule.to_string(), per_budget));
+    }
+    out
+}
+
+#[test]
+fn the_bias_test_raises_few_false_alarms_on_unbiased_estimators() {
+    let exact = std::f64::consts::E - 1.0;
+    let runs: Vec<_> = (0..200u64).into_par_iter().map(repeats_at).collect();
+    // Per test at a level of 0.05 (enough calls to measure the rate), and
+    // per rule over its three budgets at the reports' ALPHA, Šidák-corrected.
+    let (mut tests, mut alarms, mut families, mut family_alarms) = (0, 0, 0, 0);
+    for run in &runs {
+        for (_, budgets) in run {
+            let level = sidak(ALPHA, budgets.len());
+            let mut any = false;
+            for repeats in budgets {
+                assert_eq!(repeats.len(), 6);
+                tests += 1;
+                let at_05 = judge_budget(std::slice::from_ref(repeats), &[exact], &[0.0], 0.05);
+                alarms += usize::from(at_05.p_bias < 0.05);
+                let j = judge_budget(std::slice::from_ref(repeats), &[exact], &[0.0], level);
+                any |= j.verdict == Verdict::Biased;
+            }
+            families += 1;
+            family_alarms += usize::from(any);
+        }
+    }
+    let rate = alarms as f64 / tests as f64;
+    let family_rate = family_alarms as f64 / families as f64;
+    eprintln!(
+        "bias test false alarms: {alarms} of {tests} tests at level 0.05 ({rate:.4}); \
+         {family_alarms} of {families} rules over 3 budgets at alpha {ALPHA} ({family_rate:.4})"
+    );
+    assert_eq!(tests, 200 * 3 * 3);
+    assert!(rate <= 2.0 * 0.05, "{rate}");
+    assert!(family_rate <= 2.0 * ALPHA, "{family_rate}");
+}
