@@ -44,6 +44,20 @@ fn p_values_match_mpmath_quadratures() {
         judge_budget(&[bare], &[2.0], &[0.0], 0.01).verdict,
         Verdict::NoSe
     );
+    // Three repeats that happen to cluster 0.06 above the reference, each
+    // claiming a standard error of 0.12: within their error bars, so not
+    // biased (their own spread alone would give t = 21); the error-bar test
+    // alone speaks of the clustering.
+    let clustered = vec![(4.7492, 0.16), (4.7512, 0.08), (4.7418, 0.15)];
+    let j = judge_budget(&[clustered], &[4.6856], &[0.0], 0.0033);
+    assert!(j.p_bias > 0.1, "{j:?}");
+    // A constant integrand: every repeat alike, standard errors at rounding
+    // level: consistent, not "SE too large".
+    let constant = vec![(4.68559, 6.85e-15); 3];
+    assert_eq!(
+        judge_budget(&[constant], &[4.68559], &[0.0], 0.01).verdict,
+        Verdict::Consistent
+    );
     // Wilson's interval for 15 of 16 (statsmodels proportion_confint(15, 16,
     // method='wilson')): (0.7167, 0.9889).
     let [lo, hi] = wilson(15, 16);

@@ -248,9 +248,10 @@ pub fn provenance(results: &[JobResult]) -> Option<String> {
     })
 }
 
-/// Per external rule that reported its own times, a sentence setting the
-/// median of its own time per request beside lightquad's time of the same
-/// requests (sending, transfer and parsing included).
+/// Per external rule that reported its own times, a sentence on how much
+/// of lightquad's time of a request the program's own time is (medians over
+/// the requests of each one's ratio and difference, so that budgets of
+/// different cost are not pooled into one time).
 pub fn external_times(page: &Page, results: &[JobResult]) -> Vec<String> {
     let median = |mut xs: Vec<f64>| {
         xs.sort_by(f64::total_cmp);
@@ -268,17 +269,19 @@ pub fn external_times(page: &Page, results: &[JobResult]) -> Vec<String> {
             .filter(|r| r.rule_index == i && r.failure.is_none())
             .flat_map(|r| r.quantities.values())
             .filter_map(|m| Some((m.program_seconds?, m.seconds?)))
+            .filter(|(_, timed)| *timed > 0.0)
             .collect();
         if pairs.is_empty() {
             continue;
         }
-        let own = median(pairs.iter().map(|p| p.0).collect());
-        let timed = median(pairs.iter().map(|p| p.1).collect());
+        let share = median(pairs.iter().map(|(own, timed)| own / timed).collect());
+        let overhead = median(pairs.iter().map(|(own, timed)| timed - own).collect());
         out.push(format!(
-            "{}: its own time per request, median {own:.3e} s over {} requests, against \
-             lightquad's {timed:.3e} s for the same requests (sending, transfer and parsing \
-             included; the tables use lightquad's)",
+            "{}: its own time for a request is {:.0}% of lightquad's time of it (median over {} \
+             requests); the difference, sending, transfer and parsing, is {overhead:.2e} s a \
+             request (median). The tables use lightquad's time",
             rule.label,
+            100.0 * share,
             pairs.len()
         ));
     }
