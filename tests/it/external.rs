@@ -545,3 +545,151 @@ fn the_bundled_examples_are_judged_as_planted() {
         );
     }
 }
+
+#[test]
+fn a_program_that_stops_reading_a_large_request_still_times_out() {
+    // A scene of 3000 lights makes each request far larger than a pipe's
+    // buffer; the program says hello and never reads: the write blocks,
+    // and the timeout must still fire.
+    let dir = scratch("ext-bigreq");
+    let program = HELLO.to_string() + "import time\ntime.sleep(60)\n";
+    std::fs::write(dir.join("prog.py"), program).expect("program");
+    let lights: Vec<Json> = (0..3000)
+        .map(|k| {
+            let x = -1.0 + 2.0 * f64::from(k) / 3000.0;
+            serde_json::json!({"type": "rectangle", "origin": [x, 0.0, 2.0], "edge_u": [0.0004, 0.0, 0.0],
+                "edge_v": [0.0, 0.0004, 0.0], "radiance": 1.0})
+        })
+        .collect();
+    let exp = serde_json::json!({
+        "name": "ext", "family": "rendering",
+        "scene": {"receiver": {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]}, "emitters": lights},
+        "quantities": ["E_area"],
+        "rules": [{"rule": "external", "name": "prog", "command": ["python3", "prog.py"], "timeout_s": 1}],
+        "budgets": [4], "repeats": 2, "reference": {"type": "converged", "n": 2}
+    });
+    let file = dir.join("exp.json");
+    std::fs::write(&file, exp.to_string()).expect("experiment");
+    assert!(std::fs::metadata(&file).expect("file").len() > 1 << 18);
+    let start = Instant::now();
+    let o = run(&file, &dir.join("out"), &[]);
+    assert!(
+        start.elapsed() < Duration::from_secs(30),
+        "{:?}",
+        start.elapsed()
+    );
+    assert!(!o.status.success());
+    let text = std::fs::read_to_string(dir.join("out/ext/results.jsonl")).expect("results");
+    assert_eq!(
+        text.matches("no answer within timeout_s = 1 s").count(),
+        2,
+        "{text}"
+    );
+}
+
+#[test]
+fn a_timeout_stops_what_the_program_started_too() {
+    // `sh -c` forks python (it does not exec it): stopping the shell alone
+    // left python running.
+    let program = HELLO.to_string()
+        + "import os, sys, time\nopen('pid-%d' % os.getpid(), 'w').close()\nsys.stdin.readline()\ntime.sleep(60)\n";
+    let (dir, file) = setup(
+        "ext-group",
+        &program,
+        serde_json::json!({"command": ["sh", "-c", "python3 prog.py; true"], "timeout_s": 1}),
+    );
+    let o = run(&file, &dir.join("out"), &[]);
+    assert!(!o.status.success());
+    let pids: Vec<u32> = std::fs::read_dir(&dir)
+        .expect("dir")
+        .filter_map(|e| {
+            e.ok()?
+                .file_name()
+                .to_str()?
+                .strip_prefix("pid-")?
+                .parse()
+                .ok()
+        })
+        .collect();
+    assert!(!pids.is_empty());
+    std::thread::sleep(Duration::from_millis(500));
+    let alive: Vec<u32> = pids
+        .into_iter()
+        .filter(|p| {
+            std::fs::read_to_string(format!("/proc/{p}/stat")).is_ok_and(|s| {
+                s.rsplit(')')
+                    .next()
+                    .is_some_and(|rest| !rest.trim_start().starts_with('Z'))
+            })
+        })
+        .collect();
+    assert!(alive.is_empty(), "still running after the run: {alive:?}");
+}
+
+#[test]
+fn what_a_program_says_stays_on_one_line_and_false_claims_are_refused() {
+    let program = HELLO.to_string()
+        + "import json, math, sys\n\
+           for line in sys.stdin:\n\
+           \x20   req = json.loads(line)\n\
+           \x20   if req['budget'] == 4:\n\
+           \x20       out = {'id': req['id'], 'error': 'line one\\n# heading\\x1b[31m'}\n\
+           \x20   elif req['repeat'] == 0:\n\
+           \x20       out = {'id': req['id'], 'value': [math.e - 1], 'evaluations': 0}\n\
+           \x20   else:\n\
+           \x20       out = {'id': req['id'], 'value': [math.e - 1], 'seconds': 1e300}\n\
+           \x20   print(json.dumps(out), flush=True)\n";
+    let (dir, file) = setup("ext-text", &program, serde_json::json!({}));
+    let out = dir.join("out");
+    let o = run(&file, &out, &[]);
+    assert!(!o.status.success());
+    let failed = failures(&out);
+    assert_eq!(failed.len(), 4, "{failed:?}");
+    for f in &failed {
+        assert!(!f.chars().any(char::is_control), "{f:?}");
+    }
+    assert!(
+        failed
+            .iter()
+            .any(|f| f.contains("line one # heading\u{fffd}[31m"))
+    );
+    assert!(failed.iter().any(|f| f.contains("`evaluations` is 0")));
+    assert!(
+        failed
+            .iter()
+            .any(|f| f.contains("reported taking 1.000e300 s"))
+    );
+    let report = std::fs::read_to_string(out.join("ext/report.md")).expect("report");
+    assert!(!report.contains("\n# heading") && !report.contains('\u{1b}'));
+}
+
+#[test]
+fn a_failed_job_is_no_sample_of_its_rows_time() {
+    // Repeat 0 fails, repeats 1 and 2 take about 0.05 s each.
+    let program = answering(
+        "import time\n    time.sleep(0.05)\n    if req['repeat'] == 0:\n        print('x', flush=True); continue",
+    );
+    let (dir, file) = setup("ext-time", &program, serde_json::json!({}));
+    let text = std::fs::read_to_string(&file)
+        .expect("file")
+        .replace("\"repeats\":2", "\"repeats\":3");
+    std::fs::write(&file, text).expect("file");
+    let out = dir.join("out");
+    let _ = run(&file, &out, &[]);
+    let summary: Json = serde_json::from_str(
+        &std::fs::read_to_string(out.join("ext/summary.json")).expect("summary"),
+    )
+    .expect("json");
+    let rule = summary["experiments"][0]["quantities"][0]["rules"]
+        .as_array()
+        .expect("rules")
+        .iter()
+        .find(|r| r["label"] == "prog")
+        .expect("prog")
+        .clone();
+    for row in rule["rows"].as_array().expect("rows") {
+        let t = &row["seconds"];
+        assert_eq!(t["samples"], 2, "{row}");
+        assert!(t["low"].as_f64().is_some_and(|s| s >= 0.04), "{row}");
+    }
+}

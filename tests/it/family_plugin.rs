@@ -418,7 +418,8 @@ fn a_non_finite_value_is_a_failed_job_that_resume_and_merge_keep() {
     }
     let report = fs::read_to_string(dir.join("out/poly-moments/report.md")).expect("report");
     assert!(report.contains("non-finite moment"), "{report}");
-    // --resume keeps the failures as they are: nothing re-runs.
+    // --resume runs the failed jobs again (an external program may answer
+    // now), and keeps every finished one as it was.
     let opts = RunOptions {
         out: dir.join("out"),
         resume: true,
@@ -428,13 +429,34 @@ fn a_non_finite_value_is_a_failed_job_that_resume_and_merge_keep() {
     let again = run_files(&registry(), &[dir.join("e.json")], &opts);
     assert!(again.is_err(), "still failed");
     let after = fs::read_to_string(&file).expect("results");
-    // Byte-identical lines (a re-run job would carry a new wall time).
-    let lines = |t: &str| {
-        let mut v: Vec<String> = t.lines().map(str::to_string).collect();
+    // The finished jobs' lines byte-identical (a re-run job would carry a
+    // new wall time); the failed ones run again, and fail again the same way.
+    let lines = |t: &str, failed: bool| {
+        let mut v: Vec<String> = t
+            .lines()
+            .filter(|l| l.contains("\"failure\":null") != failed)
+            .map(str::to_string)
+            .collect();
         v.sort();
         v
     };
-    assert_eq!(lines(&before), lines(&after));
+    assert_eq!(lines(&before, false), lines(&after, false));
+    let failures = |t: &str| {
+        let mut v: Vec<(u64, String)> = lines(t, true)
+            .iter()
+            .map(|l| {
+                let j: serde_json::Value = serde_json::from_str(l).expect("a result line");
+                (
+                    j["seed"].as_u64().expect("seed"),
+                    j["failure"].as_str().expect("failure").to_string(),
+                )
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(failures(&before).len(), 2);
+    assert_eq!(failures(&before), failures(&after));
     // merge: complete (no "incomplete"), the failures reported as failures.
     let merged = lightquad::experiment::merge(&registry(), &[dir.join("out")], &dir.join("m"));
     let e = merged.expect_err("failed jobs").to_string();

@@ -174,7 +174,15 @@ impl External {
                 ),
             ));
         }
-        if taken.contains(&self.name.as_str()) || self.name == "external" {
+        if !self.name.chars().any(|c| c.is_ascii_alphanumeric()) {
+            return Err((
+                "name".into(),
+                format!("{:?}: expected at least one letter or digit", self.name),
+            ));
+        }
+        if taken.iter().any(|t| t.eq_ignore_ascii_case(&self.name))
+            || self.name.eq_ignore_ascii_case("external")
+        {
             return Err((
                 "name".into(),
                 format!(

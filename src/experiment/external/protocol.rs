@@ -117,7 +117,7 @@ pub struct Response {
     pub error: Option<String>,
 }
 
-/// Both messages, for `lightquad schema --protocol`.
+/// The three messages, for `lightquad schema --protocol`.
 #[derive(JsonSchema)]
 #[schemars(rename = "LightquadEstimatorProtocol")]
 #[allow(dead_code)]
@@ -130,9 +130,30 @@ pub struct Messages {
     pub response: Response,
 }
 
-/// The JSON Schema of both messages.
+/// The JSON Schema of the protocol's messages: a line is one of a
+/// [`Hello`], a [`Request`] or a [`Response`] (each also under `$defs`).
 pub fn schema() -> serde_json::Value {
-    serde_json::to_value(schemars::schema_for!(Messages)).unwrap_or_default()
+    let mut root = serde_json::to_value(schemars::schema_for!(Messages)).unwrap_or_default();
+    if let Some(map) = root.as_object_mut() {
+        for key in ["properties", "required", "type", "additionalProperties"] {
+            map.remove(key);
+        }
+        map.insert(
+            "description".into(),
+            "One line of lightquad's external estimator protocol (lightquad-estimator, version 1): \
+             the program's hello, a request from lightquad, or the program's response."
+                .into(),
+        );
+        map.insert(
+            "oneOf".into(),
+            serde_json::json!([
+                {"$ref": "#/$defs/Hello"},
+                {"$ref": "#/$defs/Request"},
+                {"$ref": "#/$defs/Response"}
+            ]),
+        );
+    }
+    root
 }
 
 /// `response` to request `id` as a measured value of `channels` channels at
@@ -154,7 +175,7 @@ pub fn answer(
     if let Some(e) = response.error {
         return Err(format!(
             "the program could not estimate it: {}",
-            crate::error::excerpt(&e)
+            crate::error::excerpt(&super::server::one_line(&e))
         ));
     }
     let Some(value) = response.value else {
@@ -170,6 +191,9 @@ pub fn answer(
         }
         None => vec![f64::INFINITY; channels],
     };
+    if response.evaluations == Some(0) {
+        return Err("`evaluations` is 0: expected the work done, at least 1".into());
+    }
     if let Some(s) = response.seconds
         && !(s.is_finite() && s >= 0.0)
     {

@@ -8,12 +8,16 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::path::PathBuf;
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::mpsc::{Receiver, RecvTimeoutError, sync_channel};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, sync_channel};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 use super::protocol::{self, Hello, Request, Response};
 use crate::family::Measured;
+
+/// How far a program's own time for a request may exceed lightquad's
+/// timing of it (the two clocks read at different moments), seconds.
+const OWN_TIME_SLACK: f64 = 1e-3;
 
 /// The stderr lines of a program kept for a failed job's message.
 const STDERR_LINES: usize = 8;
@@ -41,7 +45,9 @@ pub struct Program {
 /// One running program.
 struct Server {
     child: Child,
-    stdin: ChildStdin,
+    /// Lines for the thread that writes the program's stdin (a write that
+    /// blocks, the program not reading, then never holds up the timeout).
+    writer: SyncSender<String>,
     lines: Receiver<Result<String, String>>,
     limit: Arc<AtomicUsize>,
     stderr: Arc<Mutex<VecDeque<String>>>,
@@ -51,9 +57,13 @@ struct Server {
 impl Server {
     /// Starts `program` and waits up to `timeout` for its [`Hello`].
     fn start(program: &Program, timeout: Duration) -> Result<Server, String> {
+        use std::os::unix::process::CommandExt;
+        // In a process group of its own, so that stopping it stops what it
+        // started too (`sh -c` forks its command).
         let mut child = Command::new(&program.path)
             .args(&program.args)
             .current_dir(&program.folder)
+            .process_group(0)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
@@ -66,6 +76,8 @@ impl Server {
             let _ = child.kill();
             return Err("the program's pipes could not be opened".into());
         };
+        let (writer, to_write) = sync_channel::<String>(1);
+        std::thread::spawn(move || write_lines(stdin, &to_write));
         let limit = Arc::new(AtomicUsize::new(longest_line(1)));
         let (send, lines) = sync_channel(1);
         let cap = limit.clone();
@@ -75,7 +87,7 @@ impl Server {
         std::thread::spawn(move || keep_tail(stderr, &kept));
         let mut server = Server {
             child,
-            stdin,
+            writer,
             lines,
             limit,
             stderr: tail,
@@ -109,7 +121,7 @@ impl Server {
         let hello: Hello = serde_json::from_str(&text).map_err(|e| {
             format!(
                 "began with {:?}, which is not a hello line {{\"protocol\": \"{}\", \"version\": {}}} ({e})",
-                crate::error::excerpt(&text),
+                crate::error::excerpt(&one_line(&text)),
                 protocol::NAME,
                 protocol::VERSION
             )
@@ -131,13 +143,9 @@ impl Server {
             .store(longest_line(request.channels), Ordering::Relaxed);
         let line = serde_json::to_string(&request).map_err(|e| (e.to_string(), false))? + "\n";
         let start = Instant::now();
-        if let Err(e) = self
-            .stdin
-            .write_all(line.as_bytes())
-            .and_then(|()| self.stdin.flush())
-        {
+        if self.writer.send(line).is_err() {
             return Err((
-                format!("could not send the request ({e}){}", self.exited()),
+                format!("could not send the request{}", self.exited()),
                 false,
             ));
         }
@@ -183,10 +191,46 @@ impl Server {
 
 impl Drop for Server {
     fn drop(&mut self) {
+        kill_group(self.child.id());
         let _ = self.child.kill();
         let _ = self.child.wait();
         Watcher::get().forget(self.child.id());
     }
+}
+
+/// Sends SIGKILL to process group `pgid` (the program and what it started).
+fn kill_group(pgid: u32) {
+    let _ = Command::new("kill")
+        .args(["-9", "--", &format!("-{pgid}")])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status();
+}
+
+/// Writes each line of `lines` to the program's stdin until the channel
+/// closes (the server is dropped) or a write fails (the program is gone).
+fn write_lines(mut stdin: ChildStdin, lines: &Receiver<String>) {
+    for line in lines {
+        if stdin
+            .write_all(line.as_bytes())
+            .and_then(|()| stdin.flush())
+            .is_err()
+        {
+            return;
+        }
+    }
+}
+
+/// `text` from a program on one line of a report: line breaks and tabs as
+/// spaces, other control characters as U+FFFD.
+pub fn one_line(text: &str) -> String {
+    text.chars()
+        .map(|c| match c {
+            '\n' | '\r' | '\t' => ' ',
+            c if c.is_control() => '\u{fffd}',
+            c => c,
+        })
+        .collect()
 }
 
 /// Why a line is not a response, with the line's start.
@@ -199,7 +243,7 @@ fn garbage(text: &str, e: &serde_json::Error) -> String {
     };
     format!(
         "answered {:?}, which is not a response ({e}){hint}",
-        crate::error::excerpt(text)
+        crate::error::excerpt(&one_line(text))
     )
 }
 
@@ -247,7 +291,10 @@ fn keep_tail(stderr: impl Read, tail: &Mutex<VecDeque<String>>) {
             Ok(_) => {}
         }
         let text = String::from_utf8_lossy(&buf);
-        let line: String = text.trim_end().chars().take(STDERR_LINE_CHARS).collect();
+        let line: String = one_line(text.trim_end())
+            .chars()
+            .take(STDERR_LINE_CHARS)
+            .collect();
         if line.is_empty() {
             continue;
         }
@@ -307,7 +354,14 @@ impl Servers {
             Ok((mut m, seconds)) => {
                 m.seconds = Some(seconds);
                 self.give_back(rule, server);
-                Ok(m)
+                // The program's request lies within lightquad's timing of it.
+                match m.program_seconds {
+                    Some(own) if own > seconds + OWN_TIME_SLACK => Err(format!(
+                        "{what}: reported taking {own:.3e} s for a request that lightquad timed \
+                         at {seconds:.3e} s from sending it to reading the answer"
+                    )),
+                    _ => Ok(m),
+                }
             }
             Err((why, keep)) => {
                 let tail = server
@@ -352,7 +406,8 @@ impl Servers {
 
 /// A `sh` process that holds the ids of the running programs and, when its
 /// stdin ends (lightquad exited, however it was stopped, kill -9 included),
-/// kills those still listed: no program outlives the run that started it.
+/// kills those still listed with their process groups: no program
+/// outlives the run that started it.
 pub struct Watcher {
     stdin: Mutex<Option<ChildStdin>>,
 }
@@ -366,7 +421,7 @@ while read -r line; do
     -*) pids=$(printf '%s' "$pids" | sed "s/ ${line#-} / /") ;;
   esac
 done
-for p in $pids; do kill -9 "$p" 2>/dev/null; done"#;
+for p in $pids; do kill -9 -- "-$p" 2>/dev/null; kill -9 "$p" 2>/dev/null; done"#;
 
 impl Watcher {
     /// The process's watcher, started on first use (none if `sh` cannot be

@@ -195,15 +195,18 @@ fn row(
     if let Some(f) = jobs.iter().find_map(|j| j.failure.clone()) {
         flags.push(RowFlag::Failed(f));
     }
-    // A sample per repeat: the quantity's own time where the job timed it
-    // alone, the job's otherwise (a failed job; older results files). The
+    // A sample per finished repeat: the quantity's own time where the job
+    // timed it alone, the job's otherwise (older results files). The
     // repeats ran at different moments of the run, so their spread holds
     // the machine's changing load; a job's batches, run back to back, do
     // not (GL at n = 16 on calibration-exp: batches within 3% of each other
     // in each repeat, 0.92 and 1.43 us between two repeats). The lower
     // median: of two samples the faster, as the first pays for cold caches.
+    // A failed job's time is not a time of this row's work (an external
+    // program's failure took none): only finished jobs count.
     let samples: Vec<f64> = jobs
         .iter()
+        .filter(|j| j.failure.is_none())
         .map(|j| {
             j.quantities
                 .get(q)

@@ -79,7 +79,8 @@ impl Verdict {
 pub struct Judged {
     /// Repeats that gave a value.
     pub repeats: usize,
-    /// The largest bias statistic `t` over the channels.
+    /// The bias statistic `t` of the channel with the smallest p-value,
+    /// signed as its mean's offset from the reference.
     pub t: f64,
     /// The smallest two-sided p-value of the bias test over the channels.
     pub p_bias: f64,
@@ -127,7 +128,7 @@ pub fn judge_budget(
         let r = reference.get(c).copied().unwrap_or(f64::NAN);
         let tol = tol.get(c).copied().unwrap_or(0.0);
         let (t, p) = bias(xs, r, tol);
-        if p < out.p_bias || (p == out.p_bias && t > out.t) {
+        if p < out.p_bias || (p == out.p_bias && t.abs() > out.t.abs()) {
             out.t = t;
             out.p_bias = p;
         }
@@ -169,61 +170,103 @@ pub fn judge_budget(
     out
 }
 
-/// The bias test of one channel: `(t, two-sided p)`.
+/// The mean, sample standard deviation and root mean square standard
+/// error (infinite where one is missing) of a channel's repeats, each in
+/// units of `scale`, the largest magnitude among them, so that values near
+/// the top of the f64 range do not overflow their squares.
+struct Moments {
+    scale: f64,
+    mean: f64,
+    sd: f64,
+    se: f64,
+}
+
+fn moments(xs: &[(f64, f64)]) -> Moments {
+    let n = xs.len() as f64;
+    let scale = xs
+        .iter()
+        .map(|&(v, s)| v.abs().max(if s.is_finite() { s } else { 0.0 }))
+        .fold(0.0, f64::max);
+    let scale = if scale > 0.0 && scale.is_finite() {
+        scale
+    } else {
+        1.0
+    };
+    let mean = xs.iter().map(|(v, _)| v / scale).sum::<f64>() / n;
+    let sd = (xs
+        .iter()
+        .map(|(v, _)| (v / scale - mean).powi(2))
+        .sum::<f64>()
+        / (n - 1.0))
+        .sqrt();
+    let se = if xs.iter().all(|(_, s)| s.is_finite()) {
+        (xs.iter().map(|(_, s)| (s / scale).powi(2)).sum::<f64>() / n).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    Moments {
+        scale,
+        mean,
+        sd,
+        se,
+    }
+}
+
+/// The bias test of one channel: `(t, two-sided p)`, `t` signed as the
+/// mean's offset from the reference.
 fn bias(xs: &[(f64, f64)], reference: f64, tol: f64) -> (f64, f64) {
     let n = xs.len() as f64;
-    let mean = xs.iter().map(|(v, _)| v).sum::<f64>() / n;
-    let spread = (xs.iter().map(|(v, _)| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-    // The claimed error bars, where every repeat gives one.
-    let claimed = if xs.iter().all(|(_, s)| s.is_finite()) {
-        (xs.iter().map(|(_, s)| s * s).sum::<f64>() / n).sqrt()
+    let m = moments(xs);
+    // The larger of the spread and the claimed error bars (where given).
+    let sd = if m.se.is_finite() {
+        m.sd.max(m.se)
     } else {
-        0.0
+        m.sd
     };
-    let sd = spread.max(claimed);
     // A reference is known only to within its accuracy (and rounding).
-    let tol = tol.max(4.0 * f64::EPSILON * reference.abs());
-    let off = ((mean - reference).abs() - tol).max(0.0);
+    let r = reference / m.scale;
+    let tol = (tol / m.scale).max(4.0 * f64::EPSILON * r.abs());
+    let off = ((m.mean - r).abs() - tol).max(0.0);
+    let sign = if m.mean < r { -1.0 } else { 1.0 };
     if !off.is_finite() {
-        return (f64::INFINITY, 0.0);
+        return (sign * f64::INFINITY, 0.0);
     }
     if off == 0.0 {
         return (0.0, 1.0);
     }
     if sd == 0.0 {
-        return (f64::INFINITY, 0.0);
+        return (sign * f64::INFINITY, 0.0);
     }
     let t = off / (sd / n.sqrt());
     let p = StudentsT::new(0.0, 1.0, n - 1.0).map_or(f64::NAN, |d| 2.0 * d.sf(t));
-    (t, p)
+    (sign * t, p)
 }
 
 /// The error-bar test of one channel: `(sd / rms(s), two-sided p)`, None
 /// where a standard error is missing.
 fn spread(xs: &[(f64, f64)]) -> Option<(f64, f64)> {
-    if xs.iter().any(|(_, s)| !s.is_finite()) {
+    let m = moments(xs);
+    if !m.se.is_finite() {
         return None;
     }
-    let n = xs.len() as f64;
-    let mean = xs.iter().map(|(v, _)| v).sum::<f64>() / n;
-    let var = xs.iter().map(|(v, _)| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    let se2 = xs.iter().map(|(_, s)| s * s).sum::<f64>() / n;
     // Both at rounding level (a constant integrand: every repeat alike,
     // its standard error the rounding of its sum): nothing to judge.
-    let rounding = (16.0 * f64::EPSILON * mean.abs()).powi(2);
-    if var <= rounding && se2 <= rounding {
+    let rounding = 16.0 * f64::EPSILON * m.mean.abs();
+    if m.sd <= rounding && m.se <= rounding {
         return Some((1.0, 1.0));
     }
-    match (var > 0.0, se2 > 0.0) {
+    match (m.sd > 0.0, m.se > 0.0) {
         (false, false) => return Some((1.0, 1.0)),
         (true, false) => return Some((f64::INFINITY, 0.0)),
         (false, true) => return Some((0.0, 0.0)),
         (true, true) => {}
     }
-    let x = (n - 1.0) * var / se2;
+    let ratio = m.sd / m.se;
+    let n = xs.len() as f64;
+    let x = (n - 1.0) * ratio * ratio;
     let d = ChiSquared::new(n - 1.0).ok()?;
     let p = (2.0 * d.cdf(x).min(d.sf(x))).min(1.0);
-    Some(((var / se2).sqrt(), p))
+    Some((ratio, p))
 }
 
 /// The Wilson score 95% interval of `k` successes in `n` trials.
@@ -313,7 +356,11 @@ pub fn verdicts(
             let Some(m) = r.quantities.get(q) else {
                 continue;
             };
-            if m.value.len() != reference.len() || m.error.len() != reference.len() {
+            // A value that underflows f64 is 0 whatever its truth: no test.
+            if m.value.len() != reference.len()
+                || m.error.len() != reference.len()
+                || m.flags.contains(&crate::family::Flag::Underflow)
+            {
                 continue;
             }
             let cells = by_budget
@@ -370,22 +417,22 @@ pub fn markdown(verdicts: &[RuleVerdicts]) -> String {
         );
     }
     md.push_str(
-        "\n| rule | n | repeats | bias t | p (bias) | sd / SE | p (SE) | coverage | verdict |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---|\n",
+        "\n| verdict | rule | n | repeats | bias t | p (bias) | sd / SE | p (SE) | coverage |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for v in verdicts {
         for (b, j) in &v.budgets {
             let _ = writeln!(
                 md,
-                "| {} | {b} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {b} | {} | {} | {} | {} | {} | {} |",
+                j.verdict.words(),
                 v.label,
                 j.repeats,
                 number(j.t, j.repeats),
                 number(j.p_bias, j.repeats),
                 j.se_ratio.map_or("—".into(), |r| format!("{r:.2}")),
                 j.p_se.map_or("—".into(), |p| format!("{p:.2e}")),
-                coverage(j),
-                j.verdict.words()
+                coverage(j)
             );
         }
     }
@@ -396,7 +443,7 @@ fn number(x: f64, repeats: usize) -> String {
     if repeats < 2 {
         "—".into()
     } else if x.is_infinite() {
-        "inf".into()
+        if x > 0.0 { "inf" } else { "-inf" }.into()
     } else {
         format!("{x:.2e}")
     }
