@@ -85,6 +85,7 @@ pub mod parallel;
 pub mod quadrature;
 pub mod rendering;
 pub mod sum;
+pub mod testing;
 pub mod value;
 pub mod volume;
 pub mod whitted;

@@ -67,6 +67,16 @@ impl Pixel {
         })
     }
 
+    /// The unit square `[0, 1]^2`.
+    pub fn unit_square() -> Self {
+        Pixel {
+            x0: 0.0,
+            y0: 0.0,
+            width: 1.0,
+            height: 1.0,
+        }
+    }
+
     /// The lower corner `[x_0, y_0]`.
     pub fn corner(&self) -> [f64; 2] {
         [self.x0, self.y0]
