@@ -267,6 +267,11 @@ impl<Dom: Domain<2>, P: Fn(&Dom::Point) -> f64> Expected<Dom, P>
 where
     Dom::Point: fmt::Debug,
 {
+    /// Each cell's expected count, cell `[i, j]` at `i n_1 + j`.
+    pub fn counts(&self) -> &[f64] {
+        &self.counts
+    }
+
     /// `N int pdf` over the domain, in samples.
     pub fn total(&self) -> f64 {
         self.counts.iter().sum()

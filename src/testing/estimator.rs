@@ -415,19 +415,36 @@ fn mean_check(c: usize, m: f64, sd: f64, n: usize, r: f64, tol: f64, level: f64)
     }
 }
 
-/// The variance check of one channel against the per-draw variances `var`.
+/// The variance check of one channel against the per-draw variances `var`:
+/// `z = ln(A / B) / sqrt(Var A / A^2 + Var B / B^2 - 2 Cov(A, B) / (A B))`,
+/// `A` the mean of `a_i = R / (R - 1) (x_i - mean)^2`, `B` the mean of
+/// `b_i = var_i`, their (co)variances those of the means, from the
+/// draws' own moments (the delta method; the logarithm takes out most of
+/// the skew of a variance).
 fn variance_check(c: usize, xs: &[f64], m: f64, var: &[f64], level: f64) -> Check {
     let n = xs.len() as f64;
-    let d: Vec<f64> = xs
+    let a: Vec<f64> = xs
+        .iter()
+        .map(|x| n / (n - 1.0) * (x - m) * (x - m))
+        .collect();
+    let (ma, sa) = mean_sd(&a);
+    let (mb, sb) = mean_sd(var);
+    let cov = a
         .iter()
         .zip(var)
-        .map(|(x, v)| n / (n - 1.0) * (x - m) * (x - m) - v)
-        .collect();
-    let (md, sd) = mean_sd(&d);
-    let z = ratio(md, sd / n.sqrt());
+        .map(|(x, y)| (x - ma) * (y - mb))
+        .sum::<f64>()
+        / (n - 1.0);
+    let spread = (sa * sa / (ma * ma) + sb * sb / (mb * mb) - 2.0 * cov / (ma * mb)) / n;
+    let z = if ma == mb {
+        0.0
+    } else if ma > 0.0 && mb > 0.0 {
+        ratio((ma / mb).ln(), spread.max(0.0).sqrt())
+    } else {
+        (ma - mb).signum() * f64::INFINITY
+    };
     let p = two_sided(z, f64::INFINITY);
-    let (_, spread) = mean_sd(xs);
-    let claimed = (var.iter().sum::<f64>() / n).sqrt();
+    let (spread, claimed) = (ma.sqrt(), mb.sqrt());
     Check {
         kind: CheckKind::Variance,
         channel: c,

@@ -52,6 +52,7 @@ mod sobol_dims;
 mod spec_fuzz;
 mod sum_lanes;
 mod summary_compare;
+mod testing_api;
 mod tracking_cost;
 mod tracking_diagnostic;
 mod verdicts;
