@@ -26,6 +26,9 @@
 //! }));
 //! let hidden = truth::<Rendering>(&scene, RenderingQuantity::EArea, 1e-12)?;
 //! assert!(hidden.value[0] < open.value[0] && hidden.accuracy[0] < 1e-10);
+//! // Its evaluation does not split at the shadow's edge on the light, so it
+//! // doubts its own error estimate, and says so.
+//! assert!(!hidden.verified);
 //! println!("{}", hidden.how);
 //! # Ok::<(), lightquad::experiment::SpecError>(())
 //! ```
@@ -50,6 +53,11 @@ pub struct Truth {
     pub value: Vec<f64>,
     /// Its absolute accuracy per channel.
     pub accuracy: Vec<f64>,
+    /// False where a converged evaluation doubts its own error estimate
+    /// (across a discontinuity it does not split at, such as an
+    /// occluder's shadow edge on a light): `accuracy` is then its change
+    /// between budgets, which can understate the error.
+    pub verified: bool,
     /// How it was found, in a sentence.
     pub how: String,
 }
@@ -93,6 +101,7 @@ pub fn truth<F: Family>(
         return Ok(Truth {
             value,
             accuracy,
+            verified: true,
             how: format!(
                 "the closed form of {} ({} family)",
                 quantity.name(),
@@ -161,6 +170,7 @@ fn converged<F: Family>(
     Ok(Truth {
         value: value.clone(),
         accuracy: accuracy.clone(),
+        verified: !found.unverified.iter().any(|q| q == name),
         how: format!(
             "the converged evaluation of {name} ({} family): {}",
             F::NAME,

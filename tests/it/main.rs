@@ -53,6 +53,7 @@ mod spec_fuzz;
 mod sum_lanes;
 mod summary_compare;
 mod testing_api;
+mod testing_light;
 mod tracking_cost;
 mod tracking_diagnostic;
 mod verdicts;

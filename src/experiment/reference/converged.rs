@@ -180,6 +180,7 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
             note: format!("none: {why}."),
             accuracy: BTreeMap::new(),
             channel_accuracy: BTreeMap::new(),
+            unverified: Vec::new(),
         }
     };
     let (mut coarse, mut fine) = match (converged_measured(exp, n), converged_measured(exp, 2 * n))
@@ -317,5 +318,6 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
         ),
         accuracy,
         channel_accuracy: per_channel,
+        unverified: doubted,
     }
 }

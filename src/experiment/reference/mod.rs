@@ -79,6 +79,10 @@ pub struct Reference {
     /// last change or its own error estimate, the larger, and never below
     /// [`CONVERGED_FLOOR`] of its value).
     pub channel_accuracy: BTreeMap<String, Vec<f64>>,
+    /// Quantities whose converged evaluation doubts its own error estimate
+    /// (across a discontinuity it does not split at): their accuracy is
+    /// the change between budgets, unverified.
+    pub unverified: Vec<String>,
 }
 
 impl Reference {
@@ -266,6 +270,7 @@ pub fn reference<F: Family>(exp: &Experiment<F>) -> Reference {
             note: format!("none: {why}."),
             accuracy: BTreeMap::new(),
             channel_accuracy: BTreeMap::new(),
+            unverified: Vec::new(),
         };
     };
     // Relative accuracy per quantity: the stated uncertainty against the
@@ -293,6 +298,7 @@ pub fn reference<F: Family>(exp: &Experiment<F>) -> Reference {
         note: known.note.clone(),
         accuracy,
         channel_accuracy: BTreeMap::new(),
+        unverified: Vec::new(),
     }
 }
 
