@@ -214,3 +214,27 @@ fn the_api_reports_its_failures_without_panicking() -> Result<(), QuadError> {
     assert!(e.contains("sample 0") && e.contains("1.5"), "{e}");
     Ok(())
 }
+
+#[test]
+fn ground_truth_of_the_volume_and_furnace_families() -> Result<(), Box<dyn std::error::Error>> {
+    use lightquad::family::Family;
+    use lightquad::rendering::closed::{Furnace, FurnaceQuantity};
+    use lightquad::volume::experiment::{Volume, VolumeQuantity};
+    // Transmittance through a constant sphere along a chord at offset b:
+    // exp(-kappa 2 sqrt(R^2 - b^2)).
+    let (kappa, b) = (2.5, 0.3);
+    let sphere: <Volume as Family>::SceneSpec = serde_json::from_value(serde_json::json!({
+        "ray": {"origin": [-3.0, b, 0.0], "direction": [1.0, 0.0, 0.0]},
+        "medium": {"type": "constant-sphere", "centre": [0.0, 0.0, 0.0], "radius": 1.0, "kappa": kappa}
+    }))?;
+    let tau = truth::<Volume>(&sphere, VolumeQuantity::Tau, 1e-12)?;
+    let exact = (-kappa * 2.0 * (1.0f64 - b * b).sqrt()).exp();
+    assert!((tau.value[0] - exact).abs() < 1e-14 * exact, "{tau:?} vs {exact}");
+    // The white furnace: L = L_e / (1 - rho).
+    let furnace: <Furnace as Family>::SceneSpec = serde_json::from_value(serde_json::json!({
+        "albedo": 0.9, "emission": 2.0, "point": [0.0, 0.0, -1.0]
+    }))?;
+    let l = truth::<Furnace>(&furnace, FurnaceQuantity::L, 1e-12)?;
+    assert!((l.value[0] - 20.0).abs() < 1e-12 * 20.0, "{l:?}");
+    Ok(())
+}
