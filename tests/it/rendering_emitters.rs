@@ -526,85 +526,34 @@ fn round<D: Domain<2, Point = Vec3>>(d: &D, u: [f64; 2]) -> Option<[f64; 2]> {
 }
 
 /// Chi-square goodness of fit of `light`'s sampling `how` from `x` against
-/// its own density, as Mitsuba 3's and pbrt-v4's tests do: `n` directions
-/// binned in `40 x 80` cells of `(cos theta, phi)` over the whole sphere;
-/// each cell's expected count `n int_cell pdf dw` by adaptive Genz–Malik
-/// on 4 x 4 boxes of it (each to 1e-9 absolute, so a cell cut by the light's silhouette, where the
-/// density jumps, is integrated to a small fraction of a count), one cell
-/// for the samples that miss (`None`) against `n` times what the cells leave;
-/// cells expecting fewer than 5 pooled. Returns (statistic, dof, p-value).
+/// its own density, as Mitsuba 3's and pbrt-v4's tests do, by
+/// `lightquad::testing::ChiSquare`: `n` directions binned in `40 x 80`
+/// cells of `(cos theta, phi)` over the whole sphere; each cell's expected
+/// count by adaptive Genz–Malik on 4 x 4 boxes of it (to 0.016 samples a
+/// cell, so a cell cut by the light's silhouette, where the density jumps,
+/// is integrated to a small fraction of a count), one bin for the samples
+/// that miss (`None`); bins expecting fewer than 5 pooled; and the
+/// density's integral against the fraction of draws that gave a sample.
 fn light_chi_square(
     light: &AnyEmitter<f64>,
     how: LightSampling,
     x: &Receiver,
     n: usize,
     seed: u64,
-) -> (f64, usize, f64) {
-    use lightquad::quadrature::GenzMalik;
-    let (res_z, res_phi) = (40usize, 80usize);
-    let direction = |z: f64, phi: f64| {
-        let r = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
-        Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    };
-    let cubature = GenzMalik {
-        abs_tol: 1e-9,
-        rel_tol: 0.0,
-    };
-    let mut expected = vec![0.0; res_z * res_phi];
-    for iz in 0..res_z {
-        for ip in 0..res_phi {
-            let (z0, dz) = (-1.0 + 2.0 * iz as f64 / res_z as f64, 2.0 / res_z as f64);
-            let (p0, dp) = (
-                2.0 * PI * ip as f64 / res_phi as f64,
-                2.0 * PI / res_phi as f64,
-            );
-            // dw = dz dphi over each of 4 x 4 boxes of the cell (so that a
-            // corner of the light inside the cell is not missed by a single
-            // box's 17 points), as a map of the unit square.
-            let mut e = 0.0;
-            for (bz, bp) in (0..16).map(|b| (b / 4, b % 4)) {
-                let (z, p) = (z0 + dz * bz as f64 / 4.0, p0 + dp * bp as f64 / 4.0);
-                e += cubature
-                    .integrate(200_000, &mut rng(0), |u: [f64; 2]| {
-                        light.pdf(x, how, direction(z + dz / 4.0 * u[0], p + dp / 4.0 * u[1]))
-                            * (dz / 4.0)
-                            * (dp / 4.0)
-                    })
-                    .expect("the density is finite")
-                    .value;
-            }
-            expected[iz * res_phi + ip] = e * n as f64;
-        }
-    }
-    let mut observed = vec![0.0; res_z * res_phi];
-    let mut missed = 0.0;
-    let mut r = rng(seed);
-    for _ in 0..n {
-        let u = [r.random::<f64>(), r.random::<f64>()];
-        match light.sample(x, how, u) {
-            None => missed += 1.0,
-            Some(s) => {
-                let iz = (((s.wi.z + 1.0) / 2.0 * res_z as f64) as usize).min(res_z - 1);
-                let phi = s.wi.y.atan2(s.wi.x).rem_euclid(2.0 * PI);
-                let ip = ((phi / (2.0 * PI) * res_phi as f64) as usize).min(res_phi - 1);
-                observed[iz * res_phi + ip] += 1.0;
-            }
-        }
-    }
-    let total: f64 = expected.iter().sum();
-    // The pdf integrates to the chance of a sample exactly (its Jacobian is
-    // the map's, tested above); cubature across the silhouette, where the
-    // density jumps, leaves up to about 1e-4 of n in all (the triangle's
-    // cells expect 1.000115 n), a count or less in each boundary cell.
-    assert!(
-        total <= n as f64 * (1.0 + 3e-4),
-        "the cells expect {total} of {n}"
-    );
-    common::pearson(
-        (n as f64 - total).max(0.0),
-        missed,
-        expected.into_iter().zip(observed),
-    )
+    tests: usize,
+) -> Result<lightquad::testing::chi_square::Outcome, QuadError> {
+    let sphere = lightquad::domain::SphericalCap::sphere(Vec3::zeros(), 1.0)?;
+    lightquad::testing::ChiSquare::new(sphere)
+        .cells([40, 80])
+        .samples(n)
+        .cubature_boxes(4)
+        .cubature_tolerance(0.016)
+        .tests(tests)
+        .run(
+            |w: &Vec3| light.pdf(x, how, *w),
+            |u| light.sample(x, how, u).map(|s| s.wi),
+            seed,
+        )
 }
 
 /// Chi-square of a sphere light's area sampling, binned on the sphere: its
@@ -690,17 +639,19 @@ fn light_sampling_chi_square_goodness_of_fit(light_name: &str) -> Result<(), Qua
         .enumerate()
     {
         let seed = 40 + 2 * i as u64 + j as u64;
-        let (stat, dof, p) = match (light, how) {
-            (AnyEmitter::Sphere(_), LightSampling::Area) => {
-                sphere_area_chi_square(SPHERE.0, SPHERE.1, light, &x, 1_000_000, seed)
-            }
-            _ => light_chi_square(light, how, &x, 1_000_000, seed),
-        };
-        println!("chi2 {name} {how:?}: {stat:.1} on {dof} dof, p = {p:.3}");
-        assert!(
-            p > threshold,
-            "{name} {how:?}: chi2 = {stat} on {dof} dof, p = {p} < {threshold}"
-        );
+        if let (AnyEmitter::Sphere(_), LightSampling::Area) = (light, how) {
+            let (stat, dof, p) =
+                sphere_area_chi_square(SPHERE.0, SPHERE.1, light, &x, 1_000_000, seed);
+            println!("chi2 {name} {how:?}: {stat:.1} on {dof} dof, p = {p:.3}");
+            assert!(
+                p > threshold,
+                "{name} {how:?}: chi2 = {stat} on {dof} dof, p = {p} < {threshold}"
+            );
+            continue;
+        }
+        let out = light_chi_square(light, how, &x, 1_000_000, seed, tests)?;
+        println!("{name} {how:?}: {out}");
+        assert!(out.passed, "{name} {how:?}: {out}");
     }
     Ok(())
 }

@@ -229,7 +229,10 @@ fn ground_truth_of_the_volume_and_furnace_families() -> Result<(), Box<dyn std::
     }))?;
     let tau = truth::<Volume>(&sphere, VolumeQuantity::Tau, 1e-12)?;
     let exact = (-kappa * 2.0 * (1.0f64 - b * b).sqrt()).exp();
-    assert!((tau.value[0] - exact).abs() < 1e-14 * exact, "{tau:?} vs {exact}");
+    assert!(
+        (tau.value[0] - exact).abs() < 1e-14 * exact,
+        "{tau:?} vs {exact}"
+    );
     // The white furnace: L = L_e / (1 - rho).
     let furnace: <Furnace as Family>::SceneSpec = serde_json::from_value(serde_json::json!({
         "albedo": 0.9, "emission": 2.0, "point": [0.0, 0.0, -1.0]
