@@ -15,6 +15,8 @@
 //! `volume_term` (transmittance and emission along a ray through a constant
 //! sphere) and `experiment_from_code` (an experiment file run from code into
 //! a report) each check their result against a closed form they compute;
+//! `verify_a_sampler` tests a hemisphere sampler and two planted bugs with
+//! [`testing`] (lightquad's tests for a renderer's own `cargo test`);
 //! `gl_race` times Gauss–Legendre integration against the crates `bilby` and
 //! `gauss-quad`, and `tracking_race` times the tracking estimators for
 //! `scripts/tracking_race.py`, which races them against Mitsuba 3.

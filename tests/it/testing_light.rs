@@ -68,7 +68,7 @@ fn visible(y: Vec3) -> bool {
     let (cx, h, r) = BLOCKER;
     let t = h / y.z;
     let p = y * t;
-    !((p.x - cx).powi(2) + p.y * p.y <= r * r)
+    (p.x - cx).powi(2) + p.y * p.y > r * r
 }
 
 /// The renderer's estimate of the irradiance at the origin from `n` light
