@@ -7,7 +7,7 @@
 //! | a sampler against its density over a domain (chi-square, and the density's integral against the sampler's success rate) | [`ChiSquare`] |
 //! | an estimator against a value: mean (t-test), variance, coverage of its error bars | [`EstimatorTest`] |
 //! | the convergence order of a method over budgets, with its confidence interval | [`Order`] |
-//! | the value of a quantity of any family's scene, by closed form or converged evaluation, with its accuracy | [`truth`] |
+//! | the value of a quantity of any family's scene, by closed form or converged evaluation, with its accuracy | [`truth()`] |
 //!
 //! Every test is seeded (the same seed gives the same verdict) and made at
 //! a stated `alpha`, Šidák-corrected over the checks of one call and over
