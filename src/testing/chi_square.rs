@@ -17,9 +17,15 @@
 //! can miss by `10^-4` with an error estimate that does not say so). A
 //! density that does not integrate to the chance of a sample fails it.
 //!
-//! Both tests are made at `alpha` Šidák-corrected over `2 x tests`, so a
-//! correct sampler fails one of `tests` such calls with probability about
-//! `alpha`.
+//! A sample where the density is 0 fails the test outright (the density
+//! says it cannot be drawn; an estimator would divide by it).
+//!
+//! Both tests are made at `alpha` Šidák-corrected over `tests` (the
+//! integral's, which forgives its tolerance, rarely rejects a correct
+//! sampler), so a correct sampler fails one of `tests` such calls with
+//! probability about `alpha`: `tests/it/testing_api.rs` measures it over
+//! 2000 tests of four samplers and asserts it within `[alpha / 2, 2
+//! alpha]` (`-- --nocapture` prints it).
 
 use std::fmt;
 
@@ -37,6 +43,12 @@ pub const MIN_EXPECTED: f64 = 5.0;
 
 /// The most cells a test may have.
 pub const MAX_CELLS: usize = 1 << 22;
+
+/// The most cubature boxes in all (cells times boxes per cell).
+pub const MAX_BOXES: usize = 1 << 24;
+
+/// The most tests a suite may declare.
+pub const MAX_TESTS: usize = 1 << 40;
 
 /// The most samples a test may draw.
 pub const MAX_SAMPLES: usize = 1 << 36;
@@ -144,9 +156,9 @@ impl<Dom: Domain<2>> ChiSquare<Dom> {
         &self.domain
     }
 
-    /// The per-test level: `alpha` Šidák-corrected over `2 x tests`.
+    /// The per-test level: `alpha` Šidák-corrected over `tests`.
     pub fn level(&self) -> f64 {
-        sidak(self.alpha, 2 * self.tests)
+        sidak(self.alpha, self.tests)
     }
 
     /// Checks the settings, naming the one that is wrong.
@@ -163,8 +175,19 @@ impl<Dom: Domain<2>> ChiSquare<Dom> {
         }
         check_count("samples", self.samples, 1, MAX_SAMPLES)?;
         check_alpha(self.alpha)?;
-        check_count("tests", self.tests, 1, usize::MAX)?;
+        check_count("tests", self.tests, 1, MAX_TESTS)?;
         check_count("cubature_boxes", self.boxes, 1, 64)?;
+        let boxes = (a * b).saturating_mul(self.boxes * self.boxes);
+        if boxes > MAX_BOXES {
+            return Err(QuadError::invalid(
+                "cubature_boxes",
+                self.boxes,
+                format!(
+                    "at most {MAX_BOXES} boxes in all with the {a} x {b} cells (here {boxes}): \
+                     fewer cells or boxes"
+                ),
+            ));
+        }
         if !(self.integral_tolerance.is_finite() && (0.0..1.0).contains(&self.integral_tolerance)) {
             return Err(QuadError::invalid(
                 "integral_tolerance",
@@ -306,6 +329,20 @@ where
     /// more (pooling the rest), so the statistic has a degree of freedom.
     fn check_bins(&self) -> Result<(), QuadError> {
         let n = self.test.samples as f64;
+        if !self.total().is_finite() {
+            return Err(QuadError::invalid(
+                "pdf",
+                format!("an integral of {:e} over the domain", self.total() / n),
+                "a density whose integral over the domain is finite (at most 1)",
+            ));
+        }
+        if self.total() < MIN_EXPECTED && self.total() < 1e-6 * n {
+            return Err(QuadError::invalid(
+                "pdf",
+                format!("an integral of {:e} over the domain", self.total() / n),
+                "a density whose integral over the domain, the chance of a sample, is not 0",
+            ));
+        }
         let refused = (n - self.total()).max(0.0);
         let big = self
             .counts
@@ -345,6 +382,8 @@ where
         let [a, b] = self.test.cells;
         let mut observed = vec![0u64; a * b];
         let mut missed = 0u64;
+        let mut zero: Option<(usize, String)> = None;
+        let mut zeros = 0usize;
         let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
         for k in 0..self.test.samples {
             let u = [rng.random::<f64>(), rng.random::<f64>()];
@@ -359,12 +398,19 @@ where
                     "a point of the domain (its invert found none)",
                 ));
             };
-            density(&self.pdf, &p, &format!("sample {k}"))?;
+            if density(&self.pdf, &p, &format!("sample {k}"))? == 0.0 {
+                zeros += 1;
+                zero.get_or_insert_with(|| (k, format!("{p:?}")));
+            }
             let i = ((v[0] * a as f64) as usize).min(a - 1);
             let j = ((v[1] * b as f64) as usize).min(b - 1);
             observed[i * b + j] += 1;
         }
-        Ok(self.judge(&observed, missed))
+        let mut out = self.judge(&observed, missed);
+        out.zero_density = zeros;
+        out.first_zero = zero.map(|(k, p)| format!("sample {k} at {p}"));
+        out.passed &= zeros == 0;
+        Ok(out)
     }
 
     /// The chi-square and integral tests of the observed counts.
@@ -378,12 +424,14 @@ where
             .enumerate()
             .map(|(k, (&e, &o))| Bin {
                 holds: Holds::Cell(k),
+                merged: false,
                 expected: e,
                 observed: o as f64,
             })
             .collect();
         bins.push(Bin {
             holds: Holds::Refused,
+            merged: false,
             expected: (n - total).max(0.0),
             observed: missed as f64,
         });
@@ -406,6 +454,8 @@ where
             .collect::<Vec<_>>();
         Outcome {
             passed: p_value > level && p_integral > level && dof > 0,
+            zero_density: 0,
+            first_zero: None,
             statistic,
             dof,
             p_value,
@@ -463,6 +513,8 @@ enum Holds {
 #[derive(Debug, Clone, Copy)]
 struct Bin {
     holds: Holds,
+    /// True where the pooled bins joined it (their counts are in it).
+    merged: bool,
     expected: f64,
     observed: f64,
 }
@@ -500,6 +552,7 @@ fn pearson(bins: Vec<Bin>) -> (f64, usize, Vec<Bin>) {
     if pool.0 >= MIN_EXPECTED {
         kept.push(Bin {
             holds: Holds::Pool,
+            merged: false,
             expected: pool.0,
             observed: pool.1,
         });
@@ -509,6 +562,7 @@ fn pearson(bins: Vec<Bin>) -> (f64, usize, Vec<Bin>) {
     {
         smallest.expected += pool.0;
         smallest.observed += pool.1;
+        smallest.merged = pool.0 > 0.0 || pool.1 > 0.0;
     }
     let mut statistic: f64 = kept.iter().map(Bin::term).sum();
     if !impossible.is_empty() {
@@ -518,7 +572,7 @@ fn pearson(bins: Vec<Bin>) -> (f64, usize, Vec<Bin>) {
     let mut worst: Vec<Bin> = impossible;
     let mut rest: Vec<Bin> = kept
         .into_iter()
-        .filter(|b| b.holds != Holds::Pool)
+        .filter(|b| b.holds != Holds::Pool && !b.merged)
         .collect();
     rest.sort_by(|x, y| y.term().total_cmp(&x.term()));
     worst.extend(rest);
@@ -546,6 +600,16 @@ fn integral_p(integral: f64, tolerance: f64, successes: u64, samples: usize) -> 
         return 0.0;
     }
     (2.0 * Normal::standard().sf(off / se)).min(1.0)
+}
+
+/// `x` with `digits` decimals where that is readable, else in scientific
+/// notation.
+fn number(x: f64, digits: usize) -> String {
+    if x == 0.0 || (1e-3..1e7).contains(&x.abs()) {
+        format!("{x:.digits$}")
+    } else {
+        format!("{x:.digits$e}")
+    }
 }
 
 /// A cell of a failed test, as Mitsuba's harness lists them.
@@ -590,6 +654,10 @@ pub struct Outcome {
     pub samples: usize,
     /// The cells farthest from their expectation (largest terms first).
     pub worst: Vec<Cell>,
+    /// Samples where the density is 0 (any fails the test).
+    pub zero_density: usize,
+    /// The first of them, in words.
+    pub first_zero: Option<String>,
 }
 
 impl Outcome {
@@ -604,13 +672,16 @@ impl fmt::Display for Outcome {
         let verdict = if self.passed { "passed" } else { "FAILED" };
         writeln!(
             f,
-            "chi-square goodness of fit {verdict}: statistic {:.1} on {} degrees of freedom, p = {:.3e} (level {:.2e})",
-            self.statistic, self.dof, self.p_value, self.level
+            "chi-square goodness of fit {verdict}: statistic {} on {} degrees of freedom, p = {:.3e} (level {:.2e})",
+            number(self.statistic, 1),
+            self.dof,
+            self.p_value,
+            self.level
         )?;
         writeln!(
             f,
-            "  the pdf integrates to {:.6}; {:.6} of {} draws gave a sample (p = {:.3e}, {:.0e} forgiven)",
-            self.pdf_integral,
+            "  the pdf integrates to {}; {:.6} of {} draws gave a sample (p = {:.3e}, {:.0e} forgiven)",
+            number(self.pdf_integral, 6),
             self.success_fraction,
             self.samples,
             self.p_integral,
@@ -618,25 +689,38 @@ impl fmt::Display for Outcome {
         )?;
         write!(
             f,
-            "  expected counts within {:.2e} samples in all (cubature)",
+            "  expected counts within {:.2e} samples in all (cubature's own estimate)",
             self.cubature_error
         )?;
-        if !self.passed {
+        if let Some(first) = &self.first_zero {
+            write!(
+                f,
+                "\n  {} samples where the pdf is 0, the first {first}",
+                self.zero_density
+            )?;
+        }
+        if !self.passed && !self.worst.is_empty() {
             write!(f, "\n  worst cells (observed / expected):")?;
             for c in &self.worst {
                 match c.index {
                     Some([i, j]) => write!(
                         f,
-                        "\n    [{i}, {j}] u0 in [{:.4}, {:.4}], u1 in [{:.4}, {:.4}], centre {}: {} / {:.1}",
+                        "\n    [{i}, {j}] u0 in [{:.4}, {:.4}], u1 in [{:.4}, {:.4}], centre {}: {} / {}",
                         c.u[0][0],
                         c.u[0][1],
                         c.u[1][0],
                         c.u[1][1],
                         c.centre,
                         c.observed,
-                        c.expected
+                        number(c.expected, 1)
                     )?,
-                    None => write!(f, "\n    {}: {} / {:.1}", c.centre, c.observed, c.expected)?,
+                    None => write!(
+                        f,
+                        "\n    {}: {} / {}",
+                        c.centre,
+                        c.observed,
+                        number(c.expected, 1)
+                    )?,
                 }
             }
         }

@@ -12,7 +12,7 @@
 //! Every test is seeded (the same seed gives the same verdict) and made at
 //! a stated `alpha`, Šidák-corrected over the checks of one call and over
 //! the `tests` a suite says it makes, so that correct code fails a suite
-//! with probability about `alpha`. Bad settings and bad values from the
+//! with probability about `alpha` (measured in `tests/it/testing_api.rs`). Bad settings and bad values from the
 //! code under test (a density that is negative or NaN, a point off the
 //! domain) are an `Err` naming them, never a panic.
 //!

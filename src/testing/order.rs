@@ -41,9 +41,23 @@ pub struct Order {
 }
 
 impl Order {
-    /// The order of `(cost, error)` points: at least two with a positive,
-    /// finite cost and error, else an error.
+    /// The order of `(cost, error)` points: at least two of distinct
+    /// cost, each with a positive, finite cost and error, else an error
+    /// naming the point.
     pub fn fit(points: &[(f64, f64)]) -> Result<Order, QuadError> {
+        // Every point is fitted or the call fails: a point the fit left out
+        // (an error that overflowed, an exact 0) would hide what it says.
+        if let Some((k, p)) = points
+            .iter()
+            .enumerate()
+            .find(|(_, (c, e))| !(c.is_finite() && *c > 0.0 && e.is_finite() && *e > 0.0))
+        {
+            return Err(QuadError::invalid(
+                format!("points[{k}]"),
+                format!("{p:?}"),
+                "a finite cost > 0 and a finite error > 0 (an exact result has no order)",
+            ));
+        }
         let Some(line) = fit::line(points) else {
             return Err(QuadError::invalid(
                 "points",
@@ -82,7 +96,7 @@ impl Order {
         for (b, &n) in budgets.iter().enumerate() {
             let mut sum = 0.0;
             for k in 0..repeats {
-                let v = method(n, &mut repeat_rng(seed ^ ((b as u64) << 32), k));
+                let v = method(n, &mut repeat_rng(seed, b * repeats + k));
                 if !v.is_finite() {
                     return Err(QuadError::invalid(
                         format!("the value at budget {n}, repeat {k}"),

@@ -12,8 +12,8 @@ use lightquad::domain::{Disk, Vec3};
 use lightquad::rand::RngExt;
 use lightquad::rand_pcg::Pcg64;
 use lightquad::rendering::experiment::{
-    DiskLightSpec, DiskSpec, EmitterSpec, OccluderSpec, ReceiverSpec, Rendering, RenderingQuantity,
-    SceneSpec,
+    BrdfSpec, DiskLightSpec, DiskSpec, EmitterSpec, LambertSpec, OccluderSpec, ReceiverSpec,
+    Rendering, RenderingQuantity, SceneSpec,
 };
 use lightquad::testing::{ChiSquare, EstimatorTest, Order, truth};
 
@@ -174,6 +174,17 @@ fn ground_truth_agrees_with_closed_forms_computed_here() -> Result<(), Box<dyn s
         (cone.value[0] - annulus).abs() < 1e-10 * annulus,
         "{cone:?}"
     );
+    // Reflected radiance off a Lambertian receiver of albedo 0.6: rho / pi
+    // times the irradiance, with the blocker off the axis (converged).
+    let mut lit = scene(Some(([0.5, 0.0, 1.0], 0.4)));
+    lit.receiver.brdf = Some(BrdfSpec::Lambert(LambertSpec { albedo: 0.6 }));
+    lit.receiver.toward_viewer = Some([0.0, 0.0, 1.0]);
+    let radiance = truth::<Rendering>(&lit, RenderingQuantity::LArea, 1e-12)?;
+    let want = 0.6 / PI * 1.392_596_048_186_321_6;
+    assert!(
+        (radiance.value[0] - want).abs() < 1e-12 * want,
+        "{radiance:?} vs {want}"
+    );
     Ok(())
 }
 
@@ -239,5 +250,19 @@ fn ground_truth_of_the_volume_and_furnace_families() -> Result<(), Box<dyn std::
     }))?;
     let l = truth::<Furnace>(&furnace, FurnaceQuantity::L, 1e-12)?;
     assert!((l.value[0] - 20.0).abs() < 1e-12 * 20.0, "{l:?}");
+    Ok(())
+}
+
+#[test]
+fn ground_truth_takes_a_loose_goal() -> Result<(), Box<dyn std::error::Error>> {
+    let (cx, h, r) = BLOCKER;
+    let occluded = scene(Some(([cx, 0.0, h], r)));
+    for goal in [0.05, 0.5, f64::MAX] {
+        let t = truth::<Rendering>(&occluded, RenderingQuantity::EArea, goal)?;
+        assert!(
+            (t.value[0] - 1.392_596_048_186_321_6).abs() < goal.min(1e-3),
+            "{goal}: {t:?}"
+        );
+    }
     Ok(())
 }

@@ -282,7 +282,9 @@ pub fn wilson(k: usize, n: usize) -> [f64; 2] {
 /// The per-test level that keeps the chance of any false call among `m`
 /// tests at `alpha` (Šidák).
 pub fn sidak(alpha: f64, m: usize) -> f64 {
-    1.0 - (1.0 - alpha).powf(1.0 / m.max(1) as f64)
+    // -expm1(ln(1 - alpha) / m): no cancellation for a small alpha or a
+    // large m (1 - (1 - alpha)^(1/m) rounds to 0 there).
+    -((-alpha).ln_1p() / m.max(1) as f64).exp_m1()
 }
 
 /// One random rule's verdicts on one quantity, budget by budget.
