@@ -12,5 +12,6 @@
 //! assert!((emission(0.5, 2.0, 3.0) - want).abs() < 1e-14);
 //! ```
 
+pub mod exchange;
 pub mod rendering;
 pub mod volume;

@@ -17,6 +17,7 @@ mod coverage;
 mod coverage_small_n;
 mod domains;
 mod estimate_honesty;
+mod exchange_exact;
 mod external;
 mod family_plugin;
 mod furnace_family;
