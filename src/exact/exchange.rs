@@ -149,7 +149,7 @@ fn polygon_normal(name: &str, ps: &[Vec3]) -> Result<Vec3, QuadError> {
         .sum();
     let size = ps.iter().map(|p| (p - ps[0]).norm()).fold(0.0, f64::max);
     let len = newell.norm();
-    if !(len > 1e-12 * size * size) {
+    if len.is_nan() || len <= 1e-12 * size * size {
         return Err(QuadError::invalid(
             name,
             format!("{:?}", ps),
