@@ -4,7 +4,7 @@
 //! ```
 //! let registry = lightquad::families::builtin();
 //! let names: Vec<&str> = registry.entries().iter().map(|f| f.name).collect();
-//! assert_eq!(names, ["calibration", "volume", "rendering", "whitted", "furnace", "integral"]);
+//! assert_eq!(names, ["calibration", "volume", "rendering", "whitted", "furnace", "exchange", "integral"]);
 //! assert!(registry.get("volume").expect("registered").quantities().contains(&"tau"));
 //! ```
 
@@ -19,6 +19,7 @@ pub fn builtin() -> Registry {
         .with::<crate::rendering::experiment::Rendering>()
         .with::<crate::whitted::experiment::Whitted>()
         .with::<crate::rendering::closed::Furnace>()
+        .with::<crate::rendering::exchange::Exchange>()
         .with::<crate::integral::Integral>()
 }
 
@@ -48,6 +49,7 @@ mod tests {
         names_agree::<crate::rendering::experiment::Rendering>()?;
         names_agree::<crate::whitted::experiment::Whitted>()?;
         names_agree::<crate::rendering::closed::Furnace>()?;
+        names_agree::<crate::rendering::exchange::Exchange>()?;
         names_agree::<crate::integral::Integral>()?;
         // Every family listed above is the registry's.
         assert_eq!(
@@ -62,6 +64,7 @@ mod tests {
                 "rendering",
                 "whitted",
                 "furnace",
+                "exchange",
                 "integral"
             ]
         );

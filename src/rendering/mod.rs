@@ -14,6 +14,7 @@
 //! | [`mis`] | multiple importance sampling of light and BRDF samples (balance, power heuristics) |
 //! | [`arcs`] | the exact arcs of a great half-circle of directions that a shape, a cone or a half-space covers (pieces on which visibility is constant) |
 //! | [`cap`] | spherical caps and cones of directions given by `1 - cos theta_max` |
+//! | [`exchange`] | light between two surfaces: form factor, flux and mean irradiance of a receiving patch (R-3P, R-A over both surfaces) |
 //! | [`furnace`] | the full equation in a closed scene (an integrating sphere, the white furnace): Neumann series bounce by bounce and path tracing with Russian roulette |
 //! | [`experiment`] | the family of the experiment layer (`"family": "rendering"`): scene format, quantities by form, MIS estimators, closed forms, converged reference |
 //!
@@ -27,6 +28,7 @@ pub mod cap;
 pub mod clipped;
 pub mod closed;
 pub mod emitter;
+pub mod exchange;
 pub mod experiment;
 pub mod forms;
 pub mod furnace;

@@ -358,7 +358,7 @@ pub struct GgxSpec {
 pub const MAX_COORDINATE: f64 = 1e100;
 
 /// `[x, y, z]` as a vector.
-fn vec3(v: [f64; 3]) -> Vec3 {
+pub(crate) fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
 }
 
@@ -380,7 +380,7 @@ pub(crate) fn renamed(e: QuadError, from: &str, to: &str) -> QuadError {
 }
 
 /// The position and size fields of an emitter, by name.
-fn emitter_numbers(spec: &EmitterSpec) -> Vec<(&'static str, Vec<f64>)> {
+pub(crate) fn emitter_numbers(spec: &EmitterSpec) -> Vec<(&'static str, Vec<f64>)> {
     match spec {
         EmitterSpec::Rectangle(r) => vec![
             ("origin", r.origin.to_vec()),
@@ -401,7 +401,7 @@ fn emitter_numbers(spec: &EmitterSpec) -> Vec<(&'static str, Vec<f64>)> {
 }
 
 /// The position and size fields of an occluder, by name.
-fn occluder_numbers(spec: &OccluderSpec) -> Vec<(&'static str, Vec<f64>)> {
+pub(crate) fn occluder_numbers(spec: &OccluderSpec) -> Vec<(&'static str, Vec<f64>)> {
     match spec {
         OccluderSpec::Sphere(s) => vec![("centre", s.centre.to_vec()), ("radius", vec![s.radius])],
         OccluderSpec::Disk(d) => vec![("centre", d.centre.to_vec()), ("radius", vec![d.radius])],
@@ -424,7 +424,7 @@ fn occluder_numbers(spec: &OccluderSpec) -> Vec<(&'static str, Vec<f64>)> {
 /// field of `fields` (its name and numbers) holding a number beyond it
 /// (`scene.emitters[0].centre[0]`), or at the surface where only the sum of
 /// fields reaches beyond it (an origin and an edge each of 6e99).
-fn bounded(path: &str, o: &Occluder, fields: &[(&str, Vec<f64>)]) -> Result<(), SpecError> {
+pub(crate) fn bounded(path: &str, o: &Occluder, fields: &[(&str, Vec<f64>)]) -> Result<(), SpecError> {
     let extent = o.extent();
     if extent.is_finite() && extent <= MAX_COORDINATE {
         return Ok(());
@@ -458,7 +458,7 @@ fn bounded(path: &str, o: &Occluder, fields: &[(&str, Vec<f64>)]) -> Result<(), 
     ))
 }
 
-fn emitter(spec: &EmitterSpec) -> Result<AnyEmitter<f64>, QuadError> {
+pub(crate) fn emitter(spec: &EmitterSpec) -> Result<AnyEmitter<f64>, QuadError> {
     Ok(match spec {
         EmitterSpec::Rectangle(r) => {
             RectangleLight::new(vec3(r.origin), vec3(r.edge_u), vec3(r.edge_v), r.radiance)?.into()
@@ -488,7 +488,7 @@ fn emitter(spec: &EmitterSpec) -> Result<AnyEmitter<f64>, QuadError> {
     })
 }
 
-fn occluder(spec: &OccluderSpec) -> Result<Occluder, QuadError> {
+pub(crate) fn occluder(spec: &OccluderSpec) -> Result<Occluder, QuadError> {
     match spec {
         OccluderSpec::Sphere(s) => Occluder::sphere(vec3(s.centre), s.radius),
         OccluderSpec::Disk(d) => Occluder::disk(vec3(d.centre), vec3(d.normal), d.radius),
