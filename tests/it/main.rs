@@ -18,6 +18,7 @@ mod coverage_small_n;
 mod domains;
 mod estimate_honesty;
 mod exchange_exact;
+mod exchange_family;
 mod external;
 mod family_plugin;
 mod furnace_family;

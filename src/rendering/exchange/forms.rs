@@ -76,7 +76,9 @@ impl Transport<'_> {
                 let light = e.surface(&self.point_receiver(self.receiver.map([0.5, 0.5]).0)?)?;
                 rule.integrate(n, rng, |u: [f64; 4]| self.area_kernel(e, k, &light, u))
             }
-            ExchangeForm::Cone => rule.try_integrate(n, rng, |u: [f64; 4]| self.cone_kernel(e, k, u)),
+            ExchangeForm::Cone => {
+                rule.try_integrate(n, rng, |u: [f64; 4]| self.cone_kernel(e, k, u))
+            }
             ExchangeForm::Contour => rule.try_integrate(n, rng, |u: [f64; 2]| {
                 let (x, jr) = self.receiver.map(u);
                 Ok(std::f64::consts::PI * self.point_factor(k, x)? * jr)
@@ -157,13 +159,17 @@ impl Transport<'_> {
                     return Ok(0.0);
                 }
                 let lit = lit_triangles(self.scene, x, k).ok_or_else(|| {
-                    no_contour("a blocker whose plane does not separate the receiver from the light")
+                    no_contour(
+                        "a blocker whose plane does not separate the receiver from the light",
+                    )
                 })?;
                 lit.iter()
                     .map(|t| polygon_form_factor(x, n, &t.vertices()))
                     .sum()
             }
-            _ => Err(no_contour("a light other than a rectangle, triangle or disk")),
+            _ => Err(no_contour(
+                "a light other than a rectangle, triangle or disk",
+            )),
         }
     }
 }

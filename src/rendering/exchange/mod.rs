@@ -190,11 +190,9 @@ impl ExchangeQuantity {
 
     /// `sum_k w_k G_k` of this quantity, from per-emitter `G_k`.
     pub fn combine(&self, built: &Built, g: &[Estimate<f64>]) -> Estimate<f64> {
-        g.iter()
-            .enumerate()
-            .fold(Estimate::zero(), |sum, (k, gk)| {
-                sum.combine(gk.clone().scaled(self.weight(built, k)))
-            })
+        g.iter().enumerate().fold(Estimate::zero(), |sum, (k, gk)| {
+            sum.combine(gk.scaled(self.weight(built, k)))
+        })
     }
 }
 
@@ -312,12 +310,21 @@ impl Family for Exchange {
 
     /// Per emitter, the rule's evaluations in the form's dimension, each
     /// testing every blocker; the cone form builds a cone per evaluation.
-    fn cost(built: &Built, method: &Method<NoEstimator>, budget: usize, q: ExchangeQuantity) -> f64 {
+    fn cost(
+        built: &Built,
+        method: &Method<NoEstimator>,
+        budget: usize,
+        q: ExchangeQuantity,
+    ) -> f64 {
         let per = match method {
             Method::Rule(rule) => rule.evaluations(budget, q.form().dimension()),
             Method::Estimator(e) => match *e {},
         };
-        let cone = if q.form() == ExchangeForm::Cone { 2.0 } else { 1.0 };
+        let cone = if q.form() == ExchangeForm::Cone {
+            2.0
+        } else {
+            1.0
+        };
         per * cone * built.scene.emitters().len() as f64 * (1.0 + blockers(built))
     }
 
@@ -329,7 +336,11 @@ impl Family for Exchange {
         quantities: &[ExchangeQuantity],
     ) -> Result<Outcome<ExchangeQuantity>, QuadError> {
         let Method::Rule(rule) = method else {
-            return Err(QuadError::invalid("rule", method.name(), "a quadrature rule"));
+            return Err(QuadError::invalid(
+                "rule",
+                method.name(),
+                "a quadrature rule",
+            ));
         };
         quantities
             .iter()
@@ -339,7 +350,9 @@ impl Family for Exchange {
 
     fn closed_form(built: &Built, q: ExchangeQuantity) -> Option<Vec<f64>> {
         let f = reference::closed_form_factor(built)?;
-        Some(vec![f * std::f64::consts::PI * built.receiver.area() * q.weight(built, 0)])
+        Some(vec![
+            f * std::f64::consts::PI * built.receiver.area() * q.weight(built, 0),
+        ])
     }
 
     fn closed_forms_available() -> &'static str {
@@ -350,13 +363,18 @@ impl Family for Exchange {
 
     fn converged_cost(built: &Built, n: usize, quantities: &[ExchangeQuantity]) -> [f64; 2] {
         let budget = reference::converged_budget(built, n);
-        let q = quantities.first().copied().unwrap_or(ExchangeQuantity::FArea);
+        let q = quantities
+            .first()
+            .copied()
+            .unwrap_or(ExchangeQuantity::FArea);
         let form = reference::converged_form(built);
         let rule = Method::Rule(converged_rule());
-        let evaluations = built.scene.emitters().len() as f64
-            * budget as f64
-            * (1.0 + blockers(built));
-        [evaluations, Self::memory(built, &rule, budget, q).max(0.0) * form.dimension() as f64]
+        let evaluations =
+            built.scene.emitters().len() as f64 * budget as f64 * (1.0 + blockers(built));
+        [
+            evaluations,
+            Self::memory(built, &rule, budget, q).max(0.0) * form.dimension() as f64,
+        ]
     }
 
     fn converged(

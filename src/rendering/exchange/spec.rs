@@ -10,8 +10,8 @@ use crate::error::{QuadError, SpecError};
 use crate::experiment::tagged;
 use crate::rendering::emitter::{AnyEmitter, Emitter};
 use crate::rendering::experiment::{
-    DiskSpec, EmitterSpec, OccluderSpec, RectangleSpec, TriangleSpec, bounded,
-    build_emitter, build_occluder, emitter_numbers, occluder_numbers, vec3,
+    DiskSpec, EmitterSpec, OccluderSpec, RectangleSpec, TriangleSpec, bounded, build_emitter,
+    build_occluder, emitter_numbers, occluder_numbers, vec3,
 };
 use crate::rendering::occluder::Occluder;
 use crate::rendering::scene::Scene;

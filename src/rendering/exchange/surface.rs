@@ -57,10 +57,12 @@ impl Surface {
     /// from the plane through `p` with unit normal `n`.
     pub fn span_along(&self, p: Vec3, n: Vec3) -> (f64, f64) {
         match self.corners() {
-            Some(cs) => cs.iter().fold((f64::NEG_INFINITY, f64::INFINITY), |(hi, lo), c| {
-                let s = n.dot(&(c - p));
-                (hi.max(s), lo.min(s))
-            }),
+            Some(cs) => cs
+                .iter()
+                .fold((f64::NEG_INFINITY, f64::INFINITY), |(hi, lo), c| {
+                    let s = n.dot(&(c - p));
+                    (hi.max(s), lo.min(s))
+                }),
             None => {
                 let Surface::Disk(d) = self else {
                     return (f64::NAN, f64::NAN);

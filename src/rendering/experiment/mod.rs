@@ -137,11 +137,14 @@ pub use evaluate::evaluate_counted;
 pub use reference::lit_triangles;
 use reference::{closed_form, converged_value};
 use spec::build;
-pub(crate) use spec::{bounded, emitter as build_emitter, emitter_numbers, occluder as build_occluder, occluder_numbers, renamed, vec3};
 pub use spec::{
     BrdfSpec, CapLightSpec, DiskLightSpec, DiskSpec, EmitterSpec, EnvironmentSpec, GgxSpec,
     LambertSpec, MAX_COORDINATE, OccluderSpec, PhongSpec, ReceiverSpec, RectangleLightSpec,
     RectangleSpec, SceneSpec, SphereLightSpec, SphereSpec, TriangleLightSpec, TriangleSpec,
+};
+pub(crate) use spec::{
+    bounded, emitter as build_emitter, emitter_numbers, occluder as build_occluder,
+    occluder_numbers, renamed, vec3,
 };
 use terms::{settings, terms_section};
 

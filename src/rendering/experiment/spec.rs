@@ -424,7 +424,11 @@ pub(crate) fn occluder_numbers(spec: &OccluderSpec) -> Vec<(&'static str, Vec<f6
 /// field of `fields` (its name and numbers) holding a number beyond it
 /// (`scene.emitters[0].centre[0]`), or at the surface where only the sum of
 /// fields reaches beyond it (an origin and an edge each of 6e99).
-pub(crate) fn bounded(path: &str, o: &Occluder, fields: &[(&str, Vec<f64>)]) -> Result<(), SpecError> {
+pub(crate) fn bounded(
+    path: &str,
+    o: &Occluder,
+    fields: &[(&str, Vec<f64>)],
+) -> Result<(), SpecError> {
     let extent = o.extent();
     if extent.is_finite() && extent <= MAX_COORDINATE {
         return Ok(());
