@@ -39,7 +39,7 @@ if [ "${1:-}" = "--ci" ]; then
   (cd reference && .venv/bin/python -m lqref --quick --out "$scratch" \
     ../experiments/mitsuba-tau-constant-sphere.json ../experiments/v-l-single-scattering.json \
     ../experiments/r-h-vs-a-tilted-rectangle.json ../experiments/mitsuba-r-furnace-bounces.json \
-    ../experiments/w-ss-edge-coverage.json)
+    ../experiments/w-ss-edge-coverage.json ../experiments/exchange-perpendicular-squares.json)
   LIGHTQUAD_REFERENCE_VALUES="$scratch" cargo test --release --test it mitsuba::
   # Mitsuba as an external estimator (reference/serve.py): one small bundled
   # experiment run through it; every one of its jobs must have answered.

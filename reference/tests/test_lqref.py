@@ -15,7 +15,7 @@ import pytest
 from lqref import fnv1a64, file_hash
 from lqref import mitsuba3, runner, spec
 from lqref.__main__ import main
-from lqref.families import FAMILIES, furnace, rendering, volume, whitted
+from lqref.families import FAMILIES, exchange, furnace, rendering, volume, whitted
 
 REPO = Path(__file__).resolve().parents[2]
 LIGHTQUAD = REPO / "target" / "release" / "lightquad"
@@ -247,7 +247,7 @@ SPHERE_SCENE = {
 
 
 def test_every_family_module_has_the_interface():
-    assert list(FAMILIES) == ["volume", "rendering", "furnace", "whitted"]
+    assert list(FAMILIES) == ["volume", "rendering", "furnace", "whitted", "exchange"]
     for module in FAMILIES.values():
         assert module.QUANTITIES
         for name in ("Settings", "read_scene", "require_expressible", "unsupported_reason",
@@ -801,3 +801,54 @@ def test_serve_speaks_the_protocol_over_pipes():
     hello, answer = done.stdout.splitlines()
     assert json.loads(hello) == {"protocol": "lightquad-estimator", "version": 1}
     assert json.loads(answer)["id"] == 7
+
+
+# ----------------------------------------------------------------------------
+# exchange: a receiving patch's mean irradiance by an irradiance meter
+
+
+def c11(a, b, c):
+    """Howell C-11: directly opposed a x b rectangles at distance c."""
+    x, y = a / c, b / c
+    return 2 / (math.pi * x * y) * (
+        math.log(math.sqrt((1 + x * x) * (1 + y * y) / (1 + x * x + y * y)))
+        + x * math.sqrt(1 + y * y) * math.atan(x / math.sqrt(1 + y * y))
+        + y * math.sqrt(1 + x * x) * math.atan(y / math.sqrt(1 + x * x))
+        - x * math.atan(x) - y * math.atan(y))
+
+
+def exchange_values(path, passes=256):
+    s = exchange.Settings(quick=True)
+    s.passes = passes
+    exp = spec.load(path)
+    return {q: exchange.compute(exp, q, s) for q in ("F_area", "Phi_cone", "E_mean_contour")}
+
+
+def test_exchange_opposed_rectangles_give_howells_c11(tmp_path):
+    # A 2 x 1 receiver under the same rectangle at height 0.5, radiance 3.
+    path = write_experiment(tmp_path, "opp", {
+        "receiver": {"type": "rectangle", "origin": [0, 0, 0], "edge_u": [2, 0, 0],
+                     "edge_v": [0, 1, 0]},
+        "emitters": [{"type": "rectangle", "origin": [0, 0, 0.5], "edge_u": [0, 1, 0],
+                      "edge_v": [2, 0, 0], "radiance": 3.0}]},
+        ["F_area", "Phi_cone", "E_mean_contour"], family="exchange")
+    f = c11(2.0, 1.0, 0.5)
+    v = exchange_values(path)
+    assert within(v["F_area"], f), v["F_area"]
+    assert within(v["E_mean_contour"], math.pi * 3.0 * f), v["E_mean_contour"]
+    assert within(v["Phi_cone"], 2.0 * math.pi * 3.0 * f), v["Phi_cone"]
+
+
+def test_exchange_light_facing_away_gives_zero_and_bad_scenes_are_named(tmp_path):
+    away = {"receiver": {"type": "disk", "centre": [0, 0, 0], "normal": [0, 0, 1],
+                         "radius": 1.0},
+            "emitters": [{"type": "disk", "centre": [0, 0, 1], "normal": [0, 0, 1],
+                          "radius": 1.0, "radiance": 1.0}]}
+    path = write_experiment(tmp_path, "away", away, ["F_area"], family="exchange")
+    assert exchange_values(path)["F_area"]["value"] == 0.0
+    bad = dict(away, emitters=[{"type": "sphere", "centre": [0, 0, 2], "radius": 0.5,
+                                "radiance": 1.0}])
+    with pytest.raises(spec.SpecError, match=r"scene\.emitters\[0\]\.type"):
+        exchange.read_scene(bad)
+    with pytest.raises(spec.SpecError, match=r"scene\.receiver\.type"):
+        exchange.read_scene(dict(away, receiver={"type": "sphere"}))

@@ -14,6 +14,7 @@ use lightquad::experiment::validate::{deserialize, parse_json, validate};
 use lightquad::family::{Family, Quantity as _};
 use lightquad::quadrature::GaussLegendre;
 use lightquad::rendering::closed::Furnace;
+use lightquad::rendering::exchange::Exchange;
 use lightquad::rendering::experiment::Rendering;
 use lightquad::volume::experiment::{Built, Volume, VolumeQuantity as Quantity};
 use lightquad::volume::{DepthScheme, ShadowMethod, evaluate};
@@ -96,6 +97,7 @@ fn lightquad(file: &Path, name: &str) -> (f64, f64) {
         Some("rendering") => (converged::<Rendering>(file, name), f64::NAN),
         Some("furnace") => (converged::<Furnace>(file, name), f64::NAN),
         Some("whitted") => (converged::<Whitted>(file, name), f64::NAN),
+        Some("exchange") => (converged::<Exchange>(file, name), f64::NAN),
         other => panic!("{}: no comparison for family {other:?}", file.display()),
     }
 }

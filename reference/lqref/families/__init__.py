@@ -16,6 +16,7 @@ A family module provides
   ``value``, ``std_error``, ``samples``, ``method`` and details.
 """
 
-from . import furnace, rendering, volume, whitted
+from . import exchange, furnace, rendering, volume, whitted
 
-FAMILIES = {"volume": volume, "rendering": rendering, "furnace": furnace, "whitted": whitted}
+FAMILIES = {"volume": volume, "rendering": rendering, "furnace": furnace, "whitted": whitted,
+            "exchange": exchange}
