@@ -46,10 +46,13 @@ use crate::quadrature::gauss_kronrod::GaussKronrod;
 /// `F_12 = 1/2 [X - sqrt(X^2 - 4 (R_2/R_1)^2)]`, `R_i = r_i / h`,
 /// `X = 1 + (1 + R_2^2) / R_1^2`.
 ///
-/// Evaluated as `2 c^2 / (X + sqrt((X - 2c)(X + 2c)))` with `c = R_2 / R_1`
-/// and `X - 2c = 1/R_1^2 + (c - 1)^2`: no difference of nearly equal terms
-/// at any distance (distant disks make `X` and the square root agree to
-/// many digits in the printed form).
+/// Multiplied through by `r_1^2` and rationalised it is
+/// `F_12 = 2 r_2^2 / (S + sqrt((S - 2 r_1 r_2)(S + 2 r_1 r_2)))` with
+/// `S = r_1^2 + r_2^2 + h^2` and `S - 2 r_1 r_2 = h^2 + (r_1 - r_2)^2`: no
+/// difference of nearly equal terms at any distance (distant disks make `X`
+/// and the square root of the printed form agree to many digits). Lengths
+/// are taken in units of the largest first, so no square overflows; a
+/// length below 1e-154 of the largest underflows to its limit 0.
 pub fn coaxial_disks(r1: f64, r2: f64, h: f64) -> Result<f64, QuadError> {
     let positive = |name: &str, x: f64| {
         if x.is_finite() && x > 0.0 {
@@ -59,11 +62,12 @@ pub fn coaxial_disks(r1: f64, r2: f64, h: f64) -> Result<f64, QuadError> {
         }
     };
     let (r1, r2, h) = (positive("r1", r1)?, positive("r2", r2)?, positive("h", h)?);
-    let (big1, c) = (r1 / h, r2 / r1);
-    let inv1 = 1.0 / (big1 * big1);
-    let x = 1.0 + inv1 + c * c;
-    let minus = inv1 + (c - 1.0) * (c - 1.0);
-    Ok(2.0 * c * c / (x + (minus * (x + 2.0 * c)).sqrt()))
+    let unit = r1.max(r2).max(h);
+    let (r1, r2, h) = (r1 / unit, r2 / unit, h / unit);
+    let s = r1 * r1 + r2 * r2 + h * h;
+    let minus = h * h + (r1 - r2) * (r1 - r2);
+    let plus = s + 2.0 * r1 * r2;
+    Ok(2.0 * r2 * r2 / (s + (minus * plus).sqrt()))
 }
 
 /// The relative tolerance to which [`polygon_pair`] integrates each edge
@@ -94,13 +98,24 @@ const CONTOUR_BUDGET: usize = 15 + 30 * 1000;
 /// logarithm's constant (which the closed contours cancel) stays small.
 ///
 /// The error is the sum of the outer integrals' estimates, divided as `F`
-/// is. Distant polygons (`F` far below 1) lose digits to cancellation
-/// between edge pairs of size 1: about `1e-16 / F` relative.
+/// is. Distant or small polygons (`F` far below 1) lose digits to
+/// cancellation between edge pairs of size 1, about `1e-16 / F` relative,
+/// and the error says so: a caller wanting 1e-12 checks `error <= 1e-12
+/// value`. One polygon in the other's plane gives 0. The polygons must be
+/// simple (refused otherwise: an edge of length 0, crossing edges).
 pub fn polygon_pair(from: &[Vec3], to: &[Vec3]) -> Result<Estimate<f64>, QuadError> {
     let n1 = polygon_normal("from", from)?;
     let n2 = polygon_normal("to", to)?;
+    simple("from", from, n1)?;
+    simple("to", to, n2)?;
     in_front("to", to, from[0], n1)?;
     in_front("from", from, to[0], n2)?;
+    // One polygon in the other's plane sees it only at grazing angles:
+    // cos theta = 0 over it, no light passes (the contour sum of two
+    // coplanar polygons is their overlap, not a form factor).
+    if in_plane(to, from[0], n1) || in_plane(from, to[0], n2) {
+        return Ok(Estimate::zero());
+    }
     // Lengths in units of the pair's size.
     let all = from.iter().chain(to);
     let centre = all.clone().sum::<Vec3>() / (from.len() + to.len()) as f64;
@@ -168,6 +183,88 @@ fn polygon_normal(name: &str, ps: &[Vec3]) -> Result<Vec3, QuadError> {
         ));
     }
     Ok(n)
+}
+
+/// Whether every corner of `ps` lies in the plane through `p` with unit
+/// normal `n`, to rounding.
+fn in_plane(ps: &[Vec3], p: Vec3, n: Vec3) -> bool {
+    let size = ps.iter().map(|q| (q - p).norm()).fold(0.0, f64::max);
+    ps.iter().all(|q| n.dot(&(q - p)).abs() <= 1e-12 * size)
+}
+
+/// Refuses a polygon with two equal consecutive corners (an edge of length
+/// 0) or two edges that cross or touch other than at their shared corner:
+/// the contour integral of a polygon traversed twice, or of a figure eight,
+/// is not its area's form factor.
+fn simple(name: &str, ps: &[Vec3], n: Vec3) -> Result<(), QuadError> {
+    let k = ps.len();
+    // Coordinates in the polygon's plane.
+    let frame = crate::domain::Frame::from_normal(n)
+        .map_err(|_| QuadError::invalid(name, format!("{ps:?}"), "a polygon with a normal"))?;
+    let flat: Vec<[f64; 2]> = ps
+        .iter()
+        .map(|p| {
+            let l = frame.to_local(p - ps[0]);
+            [l.x, l.y]
+        })
+        .collect();
+    for i in 0..k {
+        if ps[i] == ps[(i + 1) % k] {
+            return Err(QuadError::invalid(
+                name,
+                format!("corners {i} and {} both {:?}", (i + 1) % k, ps[i]),
+                "a polygon whose consecutive corners differ (edges of non-zero length)",
+            ));
+        }
+    }
+    for i in 0..k {
+        for j in i + 1..k {
+            let adjacent = j == i + 1 || (i == 0 && j == k - 1);
+            let (a, b) = (flat[i], flat[(i + 1) % k]);
+            let (c, d) = (flat[j], flat[(j + 1) % k]);
+            if !adjacent && segments_meet(a, b, c, d) {
+                return Err(QuadError::invalid(
+                    name,
+                    format!("edges {i} and {j} of {ps:?} meet"),
+                    "a simple polygon (no edge crossing or touching another but its neighbours)",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether the closed segments `ab` and `cd` of the plane meet.
+fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    let orient = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        let v = (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+        if v > 0.0 {
+            1
+        } else if v < 0.0 {
+            -1
+        } else {
+            0
+        }
+    };
+    let within = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        r[0] >= p[0].min(q[0])
+            && r[0] <= p[0].max(q[0])
+            && r[1] >= p[1].min(q[1])
+            && r[1] <= p[1].max(q[1])
+    };
+    let (o1, o2, o3, o4) = (
+        orient(a, b, c),
+        orient(a, b, d),
+        orient(c, d, a),
+        orient(c, d, b),
+    );
+    if o1 != o2 && o3 != o4 && o1 * o2 <= 0 && o3 * o4 <= 0 && (o1 != 0 || o2 != 0) {
+        return true;
+    }
+    (o1 == 0 && within(a, b, c))
+        || (o2 == 0 && within(a, b, d))
+        || (o3 == 0 && within(c, d, a))
+        || (o4 == 0 && within(c, d, b))
 }
 
 /// Refuses polygon `name` where a corner lies behind the plane through `p`

@@ -221,16 +221,100 @@ pub fn polygon_form_factor(p: Vec3, n: Vec3, corners: &[Vec3]) -> Result<f64, Qu
             clipped.push(x);
         }
     }
+    Ok(contour_sum(&clipped, n, None).abs() / (2.0 * PI))
+}
+
+/// Lambert's sum `sum_i Theta_i (n . Gamma_i)` over the polygon of corners
+/// `rel` (relative to the point). With `toward = Some(d)`, the point lies
+/// in the polygon's plane and each term is its limit at `p + t d`,
+/// `t -> 0+`: a corner at the point stands for `-d`, and an edge through
+/// the point (its ends on opposite sides) subtends `pi` in the plane
+/// through it and `d`, `Gamma = unit((b - a) x d)`.
+fn contour_sum(rel: &[Vec3], n: Vec3, toward: Option<Vec3>) -> f64 {
+    let tiny = |v: &Vec3, scale: f64| v.norm() <= 1e-12 * scale;
+    let scale = rel.iter().map(|v| v.norm()).fold(0.0, f64::max);
     let mut sum = 0.0;
-    for (i, a) in clipped.iter().enumerate() {
-        let b = clipped[(i + 1) % clipped.len()];
+    for (i, &a0) in rel.iter().enumerate() {
+        let b0 = rel[(i + 1) % rel.len()];
+        let (mut a, mut b) = (a0, b0);
+        if let Some(d) = toward {
+            if tiny(&a, scale) {
+                a = -d;
+            }
+            if tiny(&b, scale) {
+                b = -d;
+            }
+            let c = a.cross(&b);
+            if c.norm() <= 1e-12 * a.norm() * b.norm() && a.dot(&b) < 0.0 {
+                let g = (b - a).cross(&d);
+                let len = g.norm();
+                if len > 0.0 {
+                    sum += PI * n.dot(&g) / len;
+                }
+                continue;
+            }
+        }
         let c = a.cross(&b);
         let len = c.norm();
         if len > 0.0 {
             sum += len.atan2(a.dot(&b)) * n.dot(&c) / len;
         }
     }
-    Ok(sum.abs() / (2.0 * PI))
+    sum
+}
+
+/// R-A, [`polygon_form_factor`] at a point `p` in the polygon's own plane,
+/// as its limit from the side the direction `d` leads to: `lim F(p + t d)`
+/// for `t -> 0+` (`d` not in that plane). A receiver touching a light along
+/// an edge (two faces of a box) has its points on the shared edge here,
+/// where `F` at the point itself is 0/0 and the limit (1/2 at right angles,
+/// away from the edge's ends) is the value that keeps the integrand
+/// continuous up to the receiver's edge. Lambert's sum with each term
+/// taken to its limit; the part below `p`'s horizon is clipped first, as
+/// in [`polygon_form_factor`]. The polygon must be convex or its corners
+/// in order; `d` is normalised.
+pub fn polygon_form_factor_toward(
+    p: Vec3,
+    n: Vec3,
+    corners: &[Vec3],
+    d: Vec3,
+) -> Result<f64, QuadError> {
+    let d_len = d.norm();
+    if !(d_len.is_finite() && d_len > 0.0) {
+        return Err(QuadError::invalid(
+            "d",
+            format!("{d:?}"),
+            "a finite non-zero direction",
+        ));
+    }
+    if corners.len() < 3 {
+        return Err(QuadError::invalid(
+            "corners",
+            corners.len(),
+            "a polygon of at least 3 corners",
+        ));
+    }
+    let n = n.normalize();
+    let rel: Vec<Vec3> = corners.iter().map(|c| c - p).collect();
+    // Clipped to the half-space n . v >= 0 as polygon_form_factor does.
+    let mut clipped = Vec::with_capacity(rel.len() + 2);
+    for (i, &a) in rel.iter().enumerate() {
+        let b = rel[(i + 1) % rel.len()];
+        let (ha, hb) = (n.dot(&a), n.dot(&b));
+        if ha >= 0.0 {
+            clipped.push(a);
+        }
+        if (ha >= 0.0) != (hb >= 0.0) {
+            let t = ha / (ha - hb);
+            let mut x = a + (b - a) * t;
+            x -= n * n.dot(&x);
+            clipped.push(x);
+        }
+    }
+    if clipped.len() < 3 {
+        return Ok(0.0);
+    }
+    Ok(contour_sum(&clipped, n, Some(d / d_len)).abs() / (2.0 * PI))
 }
 
 /// R-H, irradiance per unit radiance from a uniform spherical light that

@@ -129,81 +129,14 @@ pub fn mis<V: Value, B: Brdf, G: rand::Rng + ?Sized>(
             "at least 2 samples (a standard error needs two)",
         ));
     }
-    let emitters = scene.emitters();
-    if emitters.is_empty() {
+    if scene.emitters().is_empty() {
         return Ok(Estimate::random(V::zero(), V::zero(), 0));
     }
-    let pmf = 1.0 / emitters.len() as f64;
-    let x = receiver.point();
-    let frame = reflected.frame();
-    let wo = reflected.wo_local();
-    let brdf = reflected.brdf();
-    // p_l(w) of the light strategy for emitter j.
-    let light_pdf = |j: usize, w| pmf * emitters[j].pdf(receiver, sampling, w);
     let mut acc = Welford::<V>::default();
     let mut evaluations = 0u64;
     for _ in 0..n {
-        let mut score = V::zero();
-        if heuristic.uses_light() {
-            evaluations += 1;
-            let k =
-                ((rng.random::<f64>() * emitters.len() as f64) as usize).min(emitters.len() - 1);
-            let u = [rng.random::<f64>(), rng.random::<f64>()];
-            if let Some(s) = emitters[k].sample(receiver, sampling, u) {
-                let cos = receiver.cos_theta(s.wi);
-                let f = if cos > 0.0 {
-                    reflected.weight(s.wi)
-                } else {
-                    0.0
-                };
-                let p_l = pmf * s.pdf;
-                let seen = f > 0.0
-                    && if s.distance.is_finite() {
-                        scene.visible(x, s.point, Some(k))
-                    } else {
-                        scene.visible_to_infinity(x, s.wi)
-                    };
-                if seen && p_l > 0.0 {
-                    let p_b = brdf.pdf(wo, frame.to_local(s.wi));
-                    let w = heuristic.weight(p_l, p_b);
-                    let c = f * cos / p_l * w;
-                    score = score.zip(s.radiance, |a, l| a + l * c);
-                }
-            }
-        }
-        if heuristic.uses_brdf() {
-            evaluations += 1;
-            let u = [rng.random::<f64>(), rng.random::<f64>()];
-            if let Some(b) = brdf.sample(wo, u) {
-                let wi = frame.to_world(b.wi);
-                match scene.first_hit(x, wi) {
-                    FirstHit::Emitter {
-                        index, radiance, ..
-                    } => {
-                        let w = heuristic.weight(b.pdf, light_pdf(index, wi));
-                        score = score.zip(radiance, |a, l| a + l * b.weight * w);
-                    }
-                    FirstHit::Escaped => {
-                        for (j, e) in emitters.iter().enumerate() {
-                            if !e.at_infinity() {
-                                continue;
-                            }
-                            if let Some(h) = e.hit(x, wi, 0.0) {
-                                let w = heuristic.weight(b.pdf, light_pdf(j, wi));
-                                score = score.zip(h.radiance, |a, l| a + l * b.weight * w);
-                            }
-                        }
-                    }
-                    FirstHit::Occluder { .. } => {}
-                }
-            }
-        }
-        if !score.all_finite() {
-            return Err(QuadError::NonFiniteIntegrand {
-                point: vec![],
-                value: format!("{score:?}"),
-            });
-        }
+        let (score, spent) = mis_sample(scene, receiver, reflected, sampling, heuristic, rng)?;
+        evaluations += spent;
         acc.add(score);
     }
     let estimate = Estimate::random(acc.mean(), acc.interval_error(), evaluations);
@@ -212,4 +145,90 @@ pub fn mis<V: Value, B: Brdf, G: rand::Rng + ?Sized>(
     } else {
         estimate
     })
+}
+
+/// One sample of each strategy of [`mis`] at `receiver` (one of them for
+/// the single-strategy heuristics), combined by `heuristic`: the score
+/// whose mean over samples is `L_r(x, wo)`, and the evaluations it took.
+pub fn mis_sample<V: Value, B: Brdf, G: rand::Rng + ?Sized>(
+    scene: &Scene<V>,
+    receiver: &Receiver,
+    reflected: &Reflected<'_, B>,
+    sampling: LightSampling,
+    heuristic: Heuristic,
+    rng: &mut G,
+) -> Result<(V, u64), QuadError> {
+    let emitters = scene.emitters();
+    if emitters.is_empty() {
+        return Ok((V::zero(), 0));
+    }
+    let pmf = 1.0 / emitters.len() as f64;
+    let x = receiver.point();
+    let frame = reflected.frame();
+    let wo = reflected.wo_local();
+    let brdf = reflected.brdf();
+    // p_l(w) of the light strategy for emitter j.
+    let light_pdf = |j: usize, w| pmf * emitters[j].pdf(receiver, sampling, w);
+    let mut evaluations = 0u64;
+    let mut score = V::zero();
+    if heuristic.uses_light() {
+        evaluations += 1;
+        let k = ((rng.random::<f64>() * emitters.len() as f64) as usize).min(emitters.len() - 1);
+        let u = [rng.random::<f64>(), rng.random::<f64>()];
+        if let Some(s) = emitters[k].sample(receiver, sampling, u) {
+            let cos = receiver.cos_theta(s.wi);
+            let f = if cos > 0.0 {
+                reflected.weight(s.wi)
+            } else {
+                0.0
+            };
+            let p_l = pmf * s.pdf;
+            let seen = f > 0.0
+                && if s.distance.is_finite() {
+                    scene.visible(x, s.point, Some(k))
+                } else {
+                    scene.visible_to_infinity(x, s.wi)
+                };
+            if seen && p_l > 0.0 {
+                let p_b = brdf.pdf(wo, frame.to_local(s.wi));
+                let w = heuristic.weight(p_l, p_b);
+                let c = f * cos / p_l * w;
+                score = score.zip(s.radiance, |a, l| a + l * c);
+            }
+        }
+    }
+    if heuristic.uses_brdf() {
+        evaluations += 1;
+        let u = [rng.random::<f64>(), rng.random::<f64>()];
+        if let Some(b) = brdf.sample(wo, u) {
+            let wi = frame.to_world(b.wi);
+            match scene.first_hit(x, wi) {
+                FirstHit::Emitter {
+                    index, radiance, ..
+                } => {
+                    let w = heuristic.weight(b.pdf, light_pdf(index, wi));
+                    score = score.zip(radiance, |a, l| a + l * b.weight * w);
+                }
+                FirstHit::Escaped => {
+                    for (j, e) in emitters.iter().enumerate() {
+                        if !e.at_infinity() {
+                            continue;
+                        }
+                        if let Some(h) = e.hit(x, wi, 0.0) {
+                            let w = heuristic.weight(b.pdf, light_pdf(j, wi));
+                            score = score.zip(h.radiance, |a, l| a + l * b.weight * w);
+                        }
+                    }
+                }
+                FirstHit::Occluder { .. } => {}
+            }
+        }
+    }
+    if !score.all_finite() {
+        return Err(QuadError::NonFiniteIntegrand {
+            point: vec![],
+            value: format!("{score:?}"),
+        });
+    }
+    Ok((score, evaluations))
 }

@@ -46,11 +46,16 @@ fn perpendicular() -> Value {
            "emitters": [light(rect([0.0; 3], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]), 1.0)]})
 }
 
-fn gl() -> Method<lightquad::family::NoEstimator> {
+fn gl() -> Method<lightquad::rendering::exchange::ExchangeMis> {
     serde_json::from_str(r#"{"rule": "gauss-legendre"}"#).expect("rule")
 }
 
-fn by(built: &Built, method: &Method<lightquad::family::NoEstimator>, n: usize, q: Q) -> f64 {
+fn by(
+    built: &Built,
+    method: &Method<lightquad::rendering::exchange::ExchangeMis>,
+    n: usize,
+    q: Q,
+) -> f64 {
     let out = Exchange::evaluate(built, method, n, &mut rng(1), &[q]).expect("evaluates");
     let v = out[&q].value[0];
     assert!(v.is_finite(), "{q:?} at {n}: {v}");
@@ -175,7 +180,7 @@ fn the_occluded_pairs_reference_agrees_with_gauss_legendre_split_at_the_kink() {
     assert!(rel(reference, split) < 1e-12, "{reference} vs {split}");
     // And against the 4-D area form, which sees the occluder by shadow
     // rays: Sobol' at 2^20 points.
-    let sobol: Method<lightquad::family::NoEstimator> =
+    let sobol: Method<lightquad::rendering::exchange::ExchangeMis> =
         serde_json::from_str(r#"{"rule": "sobol"}"#).expect("rule");
     let area = by(&built, &sobol, 1 << 20, Q::FArea);
     assert!(rel(area, reference) < 2e-3, "{area} vs {reference}");
@@ -273,7 +278,7 @@ fn bad_scenes_are_named_at_their_paths_and_doubtful_ones_warned() {
     let built = scene(s);
     for q in [Q::FArea, Q::FCone, Q::FContour] {
         for rule in ["gauss-legendre", "trapezoid", "genz-malik", "sobol"] {
-            let m: Method<lightquad::family::NoEstimator> =
+            let m: Method<lightquad::rendering::exchange::ExchangeMis> =
                 serde_json::from_value(json!({"rule": rule})).expect("rule");
             by(&built, &m, 256, q);
         }

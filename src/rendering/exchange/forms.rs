@@ -21,7 +21,7 @@
 use crate::domain::{Domain, Vec3};
 use crate::error::QuadError;
 use crate::estimate::Estimate;
-use crate::exact::rendering::polygon_form_factor;
+use crate::exact::rendering::{polygon_form_factor, polygon_form_factor_toward};
 use crate::quadrature::Rule;
 use crate::rendering::emitter::{AnyEmitter, Emitter};
 use crate::rendering::experiment::lit_triangles;
@@ -154,23 +154,64 @@ impl Transport<'_> {
                 parallel_disk_point(x, n, disk.centre(), disk.frame().n, disk.radius())
             }
             e @ (AnyEmitter::Rectangle(_) | AnyEmitter::Triangle(_)) => {
-                let y0 = e.surface(&self.point_receiver(x)?)?.map([0.5, 0.5]).0;
-                if e.normal_at(y0).dot(&(x - y0)) <= 0.0 {
-                    return Ok(0.0);
-                }
-                let lit = lit_triangles(self.scene, x, k).ok_or_else(|| {
-                    no_contour(
-                        "a blocker whose plane does not separate the receiver from the light",
-                    )
-                })?;
-                lit.iter()
-                    .map(|t| polygon_form_factor(x, n, &t.vertices()))
-                    .sum()
+                self.polygon_point_factor(e, k, x)
             }
             _ => Err(no_contour(
                 "a light other than a rectangle, triangle or disk",
             )),
         }
+    }
+}
+
+impl Transport<'_> {
+    /// [`Transport::point_factor`] of a polygon light: Lambert's contour
+    /// formula over its lit part, lengths in units of the light's size (so
+    /// no cross product under- or overflows), 0 behind it; at a receiver
+    /// point in the light's plane, the limit from the light's front side
+    /// along the receiver (the value on an edge the two share).
+    fn polygon_point_factor(
+        &self,
+        e: &AnyEmitter<f64>,
+        k: usize,
+        x: Vec3,
+    ) -> Result<f64, QuadError> {
+        let n = self.receiver.normal();
+        let corners = match e {
+            AnyEmitter::Rectangle(r) => Surface::Rectangle(*r.shape()).corners(),
+            AnyEmitter::Triangle(t) => Surface::Triangle(*t.shape()).corners(),
+            _ => None,
+        }
+        .ok_or_else(|| no_contour("a light that is not a polygon"))?;
+        let m = e.normal_at(corners[0]);
+        let size = corners
+            .iter()
+            .map(|c| (c - corners[0]).norm())
+            .fold(0.0, f64::max);
+        let h = m.dot(&(x - corners[0]));
+        let rounding = 64.0 * f64::EPSILON * (x.norm() + corners[0].norm());
+        let toward = if h.abs() <= rounding {
+            let d = m - n * n.dot(&m);
+            if d.norm() <= 1e-12 {
+                return Ok(0.0);
+            }
+            Some(d)
+        } else if h < 0.0 {
+            return Ok(0.0);
+        } else {
+            None
+        };
+        let lit = lit_triangles(self.scene, x, k).ok_or_else(|| {
+            no_contour("a blocker whose plane does not separate the receiver from the light")
+        })?;
+        lit.iter()
+            .map(|t| {
+                let rel = t.vertices().map(|v| (v - x) / size);
+                match toward {
+                    Some(d) => polygon_form_factor_toward(Vec3::zeros(), n, &rel, d),
+                    None => polygon_form_factor(Vec3::zeros(), n, &rel),
+                }
+            })
+            .sum()
     }
 }
 
@@ -196,8 +237,8 @@ fn no_contour(why: &str) -> QuadError {
 /// evaluated without cancellation: with `A = h^2 + a^2 - r^2` and
 /// `B = sqrt((h^2 + (a - r)^2)(h^2 + (a + r)^2))`, `B^2 - A^2 = 4 r^2 h^2`,
 /// so `F = 2 r^2 h^2 / (B (B + A))` for `A >= 0` and `(B - A) / (2B)`
-/// otherwise. `F = 0` where `x` is behind the disk or in its plane; an error
-/// where the planes are not parallel.
+/// otherwise, lengths in units of the largest. `F = 0` where `x` is behind
+/// the disk or in its plane; an error where the planes are not parallel.
 pub fn parallel_disk_point(x: Vec3, n: Vec3, c: Vec3, m: Vec3, r: f64) -> Result<f64, QuadError> {
     if n.cross(&m).norm() > 1e-12 || n.dot(&m) > 0.0 {
         return Err(no_contour(
@@ -210,6 +251,9 @@ pub fn parallel_disk_point(x: Vec3, n: Vec3, c: Vec3, m: Vec3, r: f64) -> Result
         return Ok(0.0);
     }
     let a = (d - m * h).norm();
+    // In units of the largest length, so that no square overflows.
+    let unit = h.max(a).max(r);
+    let (h, a, r) = (h / unit, a / unit, r / unit);
     let big_a = h * h + a * a - r * r;
     let big_b = ((h * h + (a - r) * (a - r)) * (h * h + (a + r) * (a + r))).sqrt();
     Ok(if big_a >= 0.0 {

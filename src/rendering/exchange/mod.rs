@@ -71,17 +71,19 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{QuadError, SpecError};
 use crate::estimate::Estimate;
-use crate::family::{self, Family, Measured, Method, NoEstimator, Outcome};
+use crate::family::{self, Family, Measured, Method, Outcome};
 use crate::quadrature::{AnyRule, BaseRule, GenzMalik, Rule};
 use crate::rendering::emitter::Emitter;
 use crate::rendering::scene::Scene;
 
 pub mod forms;
+mod mis;
 mod reference;
 mod spec;
 pub mod surface;
 
 pub use forms::{ExchangeForm, Transport};
+pub use mis::ExchangeMis;
 pub use spec::{SceneSpec, SurfaceSpec};
 pub use surface::Surface;
 
@@ -227,9 +229,13 @@ impl family::Quantity for ExchangeQuantity {
         ]
     }
 
-    /// Form factors, fluxes and irradiances are never negative.
+    /// A form factor is a fraction, in `[0, 1]`; fluxes and irradiances
+    /// are never negative.
     fn bounds(&self) -> (f64, f64) {
-        (0.0, f64::INFINITY)
+        match self.measure() {
+            Measure::FormFactor => (0.0, 1.0),
+            _ => (0.0, f64::INFINITY),
+        }
     }
 }
 
@@ -280,7 +286,7 @@ impl Family for Exchange {
     type SceneSpec = SceneSpec;
     type Scene = Built;
     type Quantity = ExchangeQuantity;
-    type Estimator = NoEstimator;
+    type Estimator = ExchangeMis;
 
     fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         spec::build(spec)
@@ -304,47 +310,50 @@ impl Family for Exchange {
             .flatten()
     }
 
-    fn estimates(e: &NoEstimator) -> &'static [ExchangeQuantity] {
-        match *e {}
+    /// The light-sampled forms: MIS's light strategy is the quantity's form.
+    fn estimates(_: &ExchangeMis) -> &'static [ExchangeQuantity] {
+        use ExchangeQuantity::*;
+        &[FArea, FCone, PhiArea, PhiCone, EMeanArea, EMeanCone]
     }
 
     /// Per emitter, the rule's evaluations in the form's dimension, each
     /// testing every blocker; the cone form builds a cone per evaluation.
     fn cost(
         built: &Built,
-        method: &Method<NoEstimator>,
+        method: &Method<ExchangeMis>,
         budget: usize,
         q: ExchangeQuantity,
     ) -> f64 {
-        let per = match method {
-            Method::Rule(rule) => rule.evaluations(budget, q.form().dimension()),
-            Method::Estimator(e) => match *e {},
+        let per_emitter = match method {
+            Method::Rule(rule) => {
+                rule.evaluations(budget, q.form().dimension()) * built.scene.emitters().len() as f64
+            }
+            Method::Estimator(_) => 2.0 * budget as f64,
         };
         let cone = if q.form() == ExchangeForm::Cone {
             2.0
         } else {
             1.0
         };
-        per * cone * built.scene.emitters().len() as f64 * (1.0 + blockers(built))
+        per_emitter * cone * (1.0 + blockers(built))
     }
 
     fn evaluate(
         built: &Built,
-        method: &Method<NoEstimator>,
+        method: &Method<ExchangeMis>,
         budget: usize,
         rng: &mut rand_pcg::Pcg64,
         quantities: &[ExchangeQuantity],
     ) -> Result<Outcome<ExchangeQuantity>, QuadError> {
-        let Method::Rule(rule) = method else {
-            return Err(QuadError::invalid(
-                "rule",
-                method.name(),
-                "a quadrature rule",
-            ));
-        };
         quantities
             .iter()
-            .map(|&q| Ok((q, Measured::from(by_rule(built, rule, budget, rng, q)?))))
+            .map(|&q| {
+                let estimate = match method {
+                    Method::Rule(rule) => by_rule(built, rule, budget, rng, q)?,
+                    Method::Estimator(m) => mis::by_mis(built, *m, budget, rng, q)?,
+                };
+                Ok((q, Measured::from(estimate)))
+            })
             .collect()
     }
 
@@ -357,8 +366,9 @@ impl Family for Exchange {
 
     fn closed_forms_available() -> &'static str {
         "closed forms with one emitter and no occluders: two polygons each wholly in front of \
-         the other (the double contour integral), two parallel coaxial disks facing each other \
-         (Howell C-41)"
+         the other (the double contour integral, where its rounding error is below 1e-12 of F: \
+         not for patches far apart beside their size), two parallel coaxial disks facing each \
+         other (Howell C-41)"
     }
 
     fn converged_cost(built: &Built, n: usize, quantities: &[ExchangeQuantity]) -> [f64; 2] {

@@ -5,7 +5,7 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use crate::domain::{Disk, Rectangle, Triangle};
+use crate::domain::{Disk, Rectangle, Triangle, Vec3};
 use crate::error::{QuadError, SpecError};
 use crate::experiment::tagged;
 use crate::rendering::emitter::{AnyEmitter, Emitter};
@@ -90,6 +90,7 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
     let at = "scene.receiver";
     let (receiver, body) = surface(&spec.receiver).map_err(|e| SpecError::from_quad(at, e))?;
     bounded(at, &body, &surface_numbers(&spec.receiver))?;
+    large_enough(at, &receiver)?;
     if spec.emitters.is_empty() {
         return Err(SpecError::at(
             "scene.emitters",
@@ -115,6 +116,9 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         if let Some(o) = e.occluder() {
             bounded(&at, &o, &emitter_numbers(e_spec))?;
         }
+        if let Some(light) = light_surface(&e) {
+            large_enough(&at, &light)?;
+        }
         warnings.extend(placement(&at, &receiver, &e));
         emitters.push(e);
     }
@@ -134,21 +138,17 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
 
 /// The doubts about an emitter's place relative to the receiver: it faces
 /// away from every receiver point, or the receiver faces away from every
-/// point of it (every quantity gets 0 from it), or the two cross (the
-/// kernel `1/r^2` is singular along their common line inside both, and
-/// the rules converge slowly there).
+/// point of it (every quantity gets 0 from it), or the two lie in one plane,
+/// or they cross (the kernel `1/r^2` is singular along their common line
+/// inside both, and the rules converge slowly there). "In a plane" is to
+/// the rounding of the coordinates.
 fn placement(at: &str, receiver: &Surface, e: &AnyEmitter<f64>) -> Option<SpecError> {
-    let Some(Occluder::Rectangle(_) | Occluder::Triangle(_) | Occluder::Disk(_)) = e.occluder()
-    else {
-        return None;
-    };
     let light = light_surface(e)?;
     let (p, n) = (receiver.centre(), receiver.normal());
     let (q, m) = (light.centre(), light.normal());
     let (hi_r, lo_r) = receiver.span_along(q, m);
     let (hi_k, lo_k) = light.span_along(p, n);
-    let size = receiver.area().sqrt().max(light.area().sqrt());
-    let tol = 1e-12 * size;
+    let tol = 64.0 * f64::EPSILON * (p.norm() + q.norm() + (p - q).norm());
     let why = if hi_r <= tol && lo_r >= -tol && hi_k <= tol && lo_k >= -tol {
         "lies in the receiver's plane: no light passes between them (every quantity gets 0 \
          from it)"
@@ -168,6 +168,25 @@ fn placement(at: &str, receiver: &Surface, e: &AnyEmitter<f64>) -> Option<SpecEr
     Some(SpecError::at(at, why))
 }
 
+/// The smallest patch accepted, as the square root of its area.
+pub const MIN_SIZE: f64 = 1e-100;
+
+/// Refuses a patch smaller than [`MIN_SIZE`]: the area form's `1 / r^2`
+/// between its points underflows f64 beyond it.
+fn large_enough(at: &str, surface: &Surface) -> Result<(), SpecError> {
+    let size = surface.area().sqrt();
+    if size >= MIN_SIZE {
+        return Ok(());
+    }
+    Err(SpecError::at(
+        at,
+        format!(
+            "a patch of size {size:e} (the square root of its area): expected at least \
+             {MIN_SIZE:e} (squared distances between the points of smaller ones underflow f64)"
+        ),
+    ))
+}
+
 /// The emitter's surface as a receiving-surface shape (its map and normal).
 fn light_surface(e: &AnyEmitter<f64>) -> Option<Surface> {
     Some(match e {
@@ -178,19 +197,54 @@ fn light_surface(e: &AnyEmitter<f64>) -> Option<Surface> {
     })
 }
 
-/// Whether each surface reaches both sides of the other's plane somewhere
-/// on their common line, tested on a grid of the receiver: a receiver point
-/// on the light's plane inside the light.
+/// Whether the receiver and the light meet inside both: the chord the
+/// light's plane cuts from the receiver, tested at 1025 points for lying on
+/// the light (a meeting shorter than 1/1024 of the chord can be missed).
 fn crosses(receiver: &Surface, light: &Surface) -> bool {
     use crate::domain::Domain;
-    let (q, m) = (light.centre(), light.normal());
-    let steps = 64;
-    let near = receiver.area().sqrt() / steps as f64;
-    (0..=steps).any(|i| {
-        (0..=steps).any(|j| {
-            let (x, _) = receiver.map([i as f64 / steps as f64, j as f64 / steps as f64]);
-            let s = m.dot(&(x - q));
-            s.abs() <= near && light.invert(&(x - m * s)).is_some()
-        })
+    let Some((a, b)) = chord(receiver, light.centre(), light.normal()) else {
+        return false;
+    };
+    let m = light.normal();
+    (0..=1024).any(|i| {
+        let x = a + (b - a) * (i as f64 / 1024.0);
+        let x = x - m * m.dot(&(x - light.centre()));
+        light.invert(&x).is_some()
     })
+}
+
+/// The chord that the plane through `q` with unit normal `m` cuts from the
+/// surface, if it cuts one.
+fn chord(surface: &Surface, q: Vec3, m: Vec3) -> Option<(Vec3, Vec3)> {
+    let side = |x: Vec3| m.dot(&(x - q));
+    let points: Vec<Vec3> = match surface.corners() {
+        Some(cs) => (0..cs.len())
+            .filter_map(|i| {
+                let (a, b) = (cs[i], cs[(i + 1) % cs.len()]);
+                let (sa, sb) = (side(a), side(b));
+                ((sa <= 0.0) != (sb <= 0.0)).then(|| a + (b - a) * (sa / (sa - sb)))
+            })
+            .collect(),
+        None => {
+            let Surface::Disk(d) = surface else {
+                return None;
+            };
+            let n = d.frame().n;
+            let u = m - n * n.dot(&m);
+            let (len, c) = (u.norm(), d.centre());
+            if len <= 1e-12 {
+                return None;
+            }
+            let u = u / len;
+            let s = -side(c) / m.dot(&u);
+            let half2 = d.radius() * d.radius() - s * s;
+            if half2.is_nan() || half2 < 0.0 {
+                return None;
+            }
+            let t = n.cross(&u) * half2.sqrt();
+            let mid = c + u * s;
+            vec![mid - t, mid + t]
+        }
+    };
+    (points.len() >= 2).then(|| (points[0], points[points.len() - 1]))
 }
