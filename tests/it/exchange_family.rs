@@ -86,8 +86,8 @@ fn the_stiff_pairs_reach_their_closed_forms_by_the_contour_form() {
     let f = parallel_rectangles(1.0, 1.0, 0.1).expect("C-11");
     assert!(rel(by(&near, &gl(), 16384, Q::FContour), f) < 1e-10);
     // Sharing an edge (C-14): the kernel is singular along it, and the
-    // contour form's point form factor is not (it tends to 1/2 with a
-    // logarithmic slope), so Gauss–Legendre gets it to 1e-10.
+    // contour form's point form factor is not (it tends to 1/2 there), so
+    // Gauss–Legendre gets it to 1e-10.
     let edge = scene(perpendicular());
     let f = perpendicular_rectangles(1.0, 1.0, 1.0).expect("C-14");
     let closed = Exchange::closed_form(&edge, Q::FArea).expect("closed")[0];
@@ -283,4 +283,159 @@ fn bad_scenes_are_named_at_their_paths_and_doubtful_ones_warned() {
             by(&built, &m, 256, q);
         }
     }
+}
+
+#[test]
+fn the_shared_edge_carries_the_limit_one_half_so_closed_rules_converge_at_their_order() {
+    let edge = scene(perpendicular());
+    let t = edge.transport();
+    // On the shared edge (x = 0), F -> 1/2 from inside the floor.
+    for y in [0.25, 0.5, 0.75] {
+        let f = t
+            .point_factor(0, lightquad::domain::Vec3::new(0.0, y, 0.0))
+            .expect("closed");
+        assert!((f - 0.5).abs() < 1e-15, "{y}: {f}");
+    }
+    // The trapezoid rule's error on the contour form then falls at order 2
+    // in the points per axis (it was first order with 0 on the edge).
+    let f = perpendicular_rectangles(1.0, 1.0, 1.0).expect("C-14");
+    let trapezoid: Method<lightquad::rendering::exchange::ExchangeMis> =
+        serde_json::from_str(r#"{"rule": "trapezoid"}"#).expect("rule");
+    let e1 = rel(by(&edge, &trapezoid, 65 * 65, Q::FContour), f);
+    let e2 = rel(by(&edge, &trapezoid, 129 * 129, Q::FContour), f);
+    let order = (e1 / e2).log2();
+    assert!(order > 1.8, "{e1:e} {e2:e}: order {order}");
+}
+
+#[test]
+fn mis_estimates_agree_with_the_references_within_their_standard_errors() {
+    let mut occluded = opposed(1.0);
+    occluded["occluders"] = json!([rect([0.25, -0.5, 0.5], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])]);
+    for (s, closed) in [
+        (opposed(1.0), true),
+        (occluded, false),
+        (perpendicular(), true),
+    ] {
+        let built = scene(s);
+        let want = if closed {
+            Exchange::closed_form(&built, Q::FArea).expect("closed")[0]
+        } else {
+            Exchange::converged(&built, 400, &[Q::FArea]).expect("converged")[&Q::FArea].value[0]
+        };
+        for (rule, q, scale) in [
+            ("mis-balance", Q::FArea, 1.0),
+            ("mis-power", Q::FCone, 1.0),
+            ("mis-balance", Q::PhiArea, PI * 2.0),
+            ("mis-power", Q::EMeanCone, PI * 2.0),
+        ] {
+            let m: Method<lightquad::rendering::exchange::ExchangeMis> =
+                serde_json::from_value(json!({"rule": rule})).expect("rule");
+            let out = Exchange::evaluate(&built, &m, 1 << 16, &mut rng(3), &[q]).expect("runs");
+            let (v, se) = (out[&q].value[0], out[&q].error[0]);
+            let radiance =
+                lightquad::rendering::emitter::Emitter::radiance(&built.scene.emitters()[0]);
+            let want = want * if scale > 1.0 { PI * radiance } else { 1.0 };
+            assert!(
+                (v - want).abs() < 4.0 * se && se < 2e-2 * want,
+                "{rule} {q:?}: {v} +- {se} vs {want}"
+            );
+        }
+    }
+    // The contour form has no light strategy to combine.
+    let m: Method<lightquad::rendering::exchange::ExchangeMis> =
+        serde_json::from_str(r#"{"rule": "mis-balance"}"#).expect("rule");
+    assert!(Exchange::evaluate(&scene(opposed(1.0)), &m, 64, &mut rng(0), &[Q::FContour]).is_err());
+}
+
+#[test]
+fn extreme_scales_and_degenerate_pairs_give_the_right_value_or_a_named_refusal() {
+    let f = parallel_rectangles(1.0, 1.0, 1.0).expect("C-11");
+    // The unit pair scaled by 1e80 and 1e-80: every length 1e80 (1e-80).
+    for s in [1e80, 1e-80] {
+        let built = scene(
+            json!({"receiver": rect([0.0; 3], [s, 0.0, 0.0], [0.0, s, 0.0]),
+            "emitters": [light(rect([0.0, 0.0, s], [0.0, s, 0.0], [s, 0.0, 0.0]), 1.0)]}),
+        );
+        assert!(rel(by(&built, &gl(), 1024, Q::FContour), f) < 1e-12, "{s}");
+        assert!(rel(by(&built, &gl(), 65536, Q::FArea), f) < 1e-12, "{s}");
+    }
+    // Coplanar and overlapping: no light passes, the closed form is 0.
+    let coplanar = scene(json!({"receiver": floor(),
+        "emitters": [light(rect([0.5, 0.5, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]), 1.0)]}));
+    assert_eq!(Exchange::closed_form(&coplanar, Q::FArea), Some(vec![0.0]));
+    // Tiny squares far apart: the contour sum cancels, so no closed form
+    // (the converged reference takes over).
+    let far = scene(
+        json!({"receiver": rect([0.0; 3], [1e-5, 0.0, 0.0], [0.0, 1e-5, 0.0]),
+        "emitters": [light(rect([0.0, 0.0, 1.0], [0.0, 1e-5, 0.0], [1e-5, 0.0, 0.0]), 1.0)]}),
+    );
+    assert_eq!(Exchange::closed_form(&far, Q::FArea), None);
+    let c = Exchange::converged(&far, 400, &[Q::FContour]).expect("converged");
+    // C-11 at 60 digits (mpmath; the f64 formula itself cancels here).
+    let want = 3.183_098_861_625_700_1e-11;
+    assert!(
+        rel(c[&Q::FContour].value[0], want) < 1e-12,
+        "{:?} vs {want}",
+        c[&Q::FContour]
+    );
+    // Below 1e-100 a patch is refused at its path.
+    let msg = refused(
+        json!({"receiver": rect([0.0; 3], [1e-101, 0.0, 0.0], [0.0, 1e-101, 0.0]),
+               "emitters": [light(floor(), 1.0)]}),
+        json!(["F_area"]),
+    );
+    assert!(
+        msg.contains("scene.receiver") && msg.contains("1e-100"),
+        "{msg}"
+    );
+    // An emitter 1e-12 above the receiver is not "in its plane", nor is a
+    // unit light 1 above a receiver 1e12 wide.
+    let close = json!({"receiver": floor(),
+        "emitters": [light(rect([0.0, 0.0, 1e-12], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]), 1.0)]});
+    assert_eq!(warned(close), "");
+    let wide = json!({"receiver": rect([-5e11, -5e11, 0.0], [1e12, 0.0, 0.0], [0.0, 1e12, 0.0]),
+        "emitters": [light(rect([0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]), 1.0)]});
+    assert_eq!(warned(wide), "");
+    // A long thin receiver crossed by a small light: warned.
+    let thin = json!({"receiver": rect([0.0; 3], [1000.0, 0.0, 0.0], [0.0, 0.001, 0.0]),
+        "emitters": [light(rect([0.5, -0.1, -0.1], [0.0, 0.2, 0.0], [0.0, 0.0, 0.2]), 1.0)]});
+    assert!(warned(thin).contains("crosses the receiver"));
+}
+
+#[test]
+fn the_library_refuses_polygons_that_are_not_simple_and_disks_stay_finite() {
+    use lightquad::domain::Vec3;
+    use lightquad::exact::exchange::{coaxial_disks, polygon_pair};
+    let p = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
+    let floor = [p(0., 0., 0.), p(1., 0., 0.), p(1., 1., 0.), p(0., 1., 0.)];
+    let repeated = [
+        p(0., 0., 1.),
+        p(0., 1., 1.),
+        p(0., 1., 1.),
+        p(1., 1., 1.),
+        p(1., 0., 1.),
+    ];
+    let eight = [p(0., 0., 1.), p(0., 0.5, 1.), p(2., 0., 1.), p(2., 1., 1.)];
+    let twice = [
+        p(0., 0., 1.),
+        p(0., 1., 1.),
+        p(1., 1., 1.),
+        p(1., 0., 1.),
+        p(0., 0., 1.),
+        p(0., 1., 1.),
+        p(1., 1., 1.),
+        p(1., 0., 1.),
+    ];
+    for bad in [&repeated[..], &eight[..], &twice[..]] {
+        match polygon_pair(&floor, bad) {
+            Err(lightquad::QuadError::InvalidParameter { name, .. }) => assert_eq!(name, "to"),
+            other => panic!("{bad:?}: {other:?}"),
+        }
+    }
+    // A tiny disk under a huge one sees all of it; a huge one under a tiny
+    // one sees r^2 / h^2 of it.
+    assert!(rel(coaxial_disks(1e-200, 1.0, 1.0).expect("finite"), 0.5) < 1e-15);
+    assert!(rel(coaxial_disks(1.0, 1e200, 1.0).expect("finite"), 1.0) < 1e-15);
+    let tiny = coaxial_disks(1e200, 1.0, 1.0).expect("finite");
+    assert!((0.0..1e-300).contains(&tiny), "{tiny}");
 }
