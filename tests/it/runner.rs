@@ -594,6 +594,7 @@ fn the_bundled_experiments_run_and_report_every_quantity() {
             "rendering",
             "whitted",
             "furnace",
+            "exchange",
             "integral"
         ]
     );
