@@ -159,9 +159,7 @@ fn polygon_normal(name: &str, ps: &[Vec3]) -> Result<Vec3, QuadError> {
     if let Some(p) = ps.iter().find(|p| !p.iter().all(|x| x.is_finite())) {
         return Err(QuadError::invalid(name, format!("{p:?}"), "finite corners"));
     }
-    let newell: Vec3 = (0..ps.len())
-        .map(|i| ps[i].cross(&ps[(i + 1) % ps.len()]))
-        .sum();
+    let newell = newell(ps);
     let size = ps.iter().map(|p| (p - ps[0]).norm()).fold(0.0, f64::max);
     let len = newell.norm();
     if len.is_nan() || len <= 1e-12 * size * size {
@@ -283,12 +281,16 @@ fn in_front(name: &str, ps: &[Vec3], p: Vec3, n: Vec3) -> Result<(), QuadError> 
     }
 }
 
+/// Newell's vector of a polygon: twice its area along its normal.
+fn newell(ps: &[Vec3]) -> Vec3 {
+    (0..ps.len())
+        .map(|i| ps[i].cross(&ps[(i + 1) % ps.len()]))
+        .sum()
+}
+
 /// The area of a planar polygon: half the length of Newell's vector.
 fn polygon_area(ps: &[Vec3]) -> f64 {
-    let newell: Vec3 = (0..ps.len())
-        .map(|i| ps[i].cross(&ps[(i + 1) % ps.len()]))
-        .sum();
-    0.5 * newell.norm()
+    0.5 * newell(ps).norm()
 }
 
 /// `int_0^x 1/2 ln(t^2 + h^2) dt`'s antiderivative at `x`:

@@ -177,6 +177,13 @@ pub fn perpendicular_rectangles(l: f64, w: f64, h: f64) -> Result<f64, QuadError
 /// (Sutherland–Hodgman), so a polygon partly below the horizon is exact too.
 /// Angles are `atan2(|a x b|, a . b)`, accurate for edges seen at any angle.
 pub fn polygon_form_factor(p: Vec3, n: Vec3, corners: &[Vec3]) -> Result<f64, QuadError> {
+    lambert(p, n, corners, None)
+}
+
+/// Lambert's contour formula at `p` (module functions above): the checks,
+/// the clip at `p`'s horizon and the sum, with each term's limit along
+/// `toward` where given ([`contour_sum`]).
+fn lambert(p: Vec3, n: Vec3, corners: &[Vec3], toward: Option<Vec3>) -> Result<f64, QuadError> {
     if corners.len() < 3 {
         return Err(QuadError::invalid(
             "corners",
@@ -221,7 +228,7 @@ pub fn polygon_form_factor(p: Vec3, n: Vec3, corners: &[Vec3]) -> Result<f64, Qu
             clipped.push(x);
         }
     }
-    Ok(contour_sum(&clipped, n, None).abs() / (2.0 * PI))
+    Ok(contour_sum(&clipped, n, toward).abs() / (2.0 * PI))
 }
 
 /// Lambert's sum `sum_i Theta_i (n . Gamma_i)` over the polygon of corners
@@ -287,34 +294,7 @@ pub fn polygon_form_factor_toward(
             "a finite non-zero direction",
         ));
     }
-    if corners.len() < 3 {
-        return Err(QuadError::invalid(
-            "corners",
-            corners.len(),
-            "a polygon of at least 3 corners",
-        ));
-    }
-    let n = n.normalize();
-    let rel: Vec<Vec3> = corners.iter().map(|c| c - p).collect();
-    // Clipped to the half-space n . v >= 0 as polygon_form_factor does.
-    let mut clipped = Vec::with_capacity(rel.len() + 2);
-    for (i, &a) in rel.iter().enumerate() {
-        let b = rel[(i + 1) % rel.len()];
-        let (ha, hb) = (n.dot(&a), n.dot(&b));
-        if ha >= 0.0 {
-            clipped.push(a);
-        }
-        if (ha >= 0.0) != (hb >= 0.0) {
-            let t = ha / (ha - hb);
-            let mut x = a + (b - a) * t;
-            x -= n * n.dot(&x);
-            clipped.push(x);
-        }
-    }
-    if clipped.len() < 3 {
-        return Ok(0.0);
-    }
-    Ok(contour_sum(&clipped, n, Some(d / d_len)).abs() / (2.0 * PI))
+    lambert(p, n, corners, Some(d / d_len))
 }
 
 /// R-H, irradiance per unit radiance from a uniform spherical light that

@@ -74,7 +74,11 @@ impl Transport<'_> {
         match form {
             ExchangeForm::Area => {
                 let light = e.surface(&self.point_receiver(self.receiver.map([0.5, 0.5]).0)?)?;
-                rule.integrate(n, rng, |u: [f64; 4]| self.area_kernel(e, k, &light, u))
+                // Visibility is a term only where something can block k.
+                let tested = self.scene.has_blockers(Some(k));
+                rule.integrate(n, rng, |u: [f64; 4]| {
+                    self.area_kernel(e, k, &light, tested, u)
+                })
             }
             ExchangeForm::Cone => {
                 rule.try_integrate(n, rng, |u: [f64; 4]| self.cone_kernel(e, k, u))
@@ -104,6 +108,7 @@ impl Transport<'_> {
         e: &AnyEmitter<f64>,
         k: usize,
         light: &D,
+        tested: bool,
         u: [f64; 4],
     ) -> f64 {
         let (x, jr) = self.receiver.map([u[0], u[1]]);
@@ -114,7 +119,7 @@ impl Transport<'_> {
         if cos_r <= 0.0 || cos_k <= 0.0 || r2 == 0.0 {
             return 0.0;
         }
-        if self.scene.has_blockers(Some(k)) && !self.scene.visible(x, y, Some(k)) {
+        if tested && !self.scene.visible(x, y, Some(k)) {
             return 0.0;
         }
         cos_r / r2 * (cos_k / r2) * jr * jk
@@ -176,12 +181,8 @@ impl Transport<'_> {
         x: Vec3,
     ) -> Result<f64, QuadError> {
         let n = self.receiver.normal();
-        let corners = match e {
-            AnyEmitter::Rectangle(r) => Surface::Rectangle(*r.shape()).corners(),
-            AnyEmitter::Triangle(t) => Surface::Triangle(*t.shape()).corners(),
-            _ => None,
-        }
-        .ok_or_else(|| no_contour("a light that is not a polygon"))?;
+        let corners = super::reference::light_corners(e)
+            .ok_or_else(|| no_contour("a light that is not a polygon"))?;
         let m = e.normal_at(corners[0]);
         let size = corners
             .iter()

@@ -14,12 +14,8 @@ use super::surface::Surface;
 use super::{Built, CONVERGED_PER_N, converged_rule};
 
 /// The corners of a polygon light, in order about its emitting normal.
-fn light_corners(e: &AnyEmitter<f64>) -> Option<Vec<Vec3>> {
-    match e {
-        AnyEmitter::Rectangle(r) => Surface::Rectangle(*r.shape()).corners(),
-        AnyEmitter::Triangle(t) => Surface::Triangle(*t.shape()).corners(),
-        _ => None,
-    }
+pub(super) fn light_corners(e: &AnyEmitter<f64>) -> Option<Vec<Vec3>> {
+    Surface::of_light(e)?.corners()
 }
 
 /// `F` from the receiver to the one emitter of an empty scene, where a

@@ -116,7 +116,7 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
         if let Some(o) = e.occluder() {
             bounded(&at, &o, &emitter_numbers(e_spec))?;
         }
-        if let Some(light) = light_surface(&e) {
+        if let Some(light) = Surface::of_light(&e) {
             large_enough(&at, &light)?;
         }
         warnings.extend(placement(&at, &receiver, &e));
@@ -143,7 +143,7 @@ pub(super) fn build(spec: &SceneSpec) -> Result<Built, SpecError> {
 /// inside both, and the rules converge slowly there). "In a plane" is to
 /// the rounding of the coordinates.
 fn placement(at: &str, receiver: &Surface, e: &AnyEmitter<f64>) -> Option<SpecError> {
-    let light = light_surface(e)?;
+    let light = Surface::of_light(e)?;
     let (p, n) = (receiver.centre(), receiver.normal());
     let (q, m) = (light.centre(), light.normal());
     let (hi_r, lo_r) = receiver.span_along(q, m);
@@ -185,16 +185,6 @@ fn large_enough(at: &str, surface: &Surface) -> Result<(), SpecError> {
              {MIN_SIZE:e} (squared distances between the points of smaller ones underflow f64)"
         ),
     ))
-}
-
-/// The emitter's surface as a receiving-surface shape (its map and normal).
-fn light_surface(e: &AnyEmitter<f64>) -> Option<Surface> {
-    Some(match e {
-        AnyEmitter::Rectangle(r) => Surface::Rectangle(*r.shape()),
-        AnyEmitter::Disk(d) => Surface::Disk(*d.shape()),
-        AnyEmitter::Triangle(t) => Surface::Triangle(*t.shape()),
-        _ => return None,
-    })
 }
 
 /// Whether the receiver and the light meet inside both: the chord the

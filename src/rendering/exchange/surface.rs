@@ -4,6 +4,7 @@
 //! surfaces ([`crate::domain`]).
 
 use crate::domain::{Disk, Domain, Rectangle, Triangle, Vec3};
+use crate::rendering::emitter::AnyEmitter;
 
 /// A receiving patch: `edge_u x edge_v` is a parallelogram's normal,
 /// `(b - a) x (c - a)` a triangle's, `normal` a disk's.
@@ -18,6 +19,17 @@ pub enum Surface {
 }
 
 impl Surface {
+    /// The surface of a rectangle, disk or triangle light (`None` for the
+    /// other lights): its map, normal and corners.
+    pub fn of_light(e: &AnyEmitter<f64>) -> Option<Surface> {
+        Some(match e {
+            AnyEmitter::Rectangle(r) => Surface::Rectangle(*r.shape()),
+            AnyEmitter::Disk(d) => Surface::Disk(*d.shape()),
+            AnyEmitter::Triangle(t) => Surface::Triangle(*t.shape()),
+            _ => return None,
+        })
+    }
+
     /// The unit normal of the receiving side.
     pub fn normal(&self) -> Vec3 {
         match self {
