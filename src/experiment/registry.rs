@@ -227,7 +227,14 @@ fn page<'a, F: Family>(
                     m.label()
                 },
                 is_random: m.is_random(),
-                min_budget: super::validate::min_budget::<F>(&exp.scene, m, &spec.quantities),
+                min_budget: spec
+                    .quantities
+                    .iter()
+                    .map(|&q| {
+                        let least = super::validate::quantity_min_budget::<F>(&exp.scene, m, q);
+                        (q.name().to_string(), least)
+                    })
+                    .collect(),
                 not_run: match exp.programs.get(&i) {
                     Some(super::external::Found::Skipped(why)) => {
                         Some(format!("its program is missing: {why}"))

@@ -440,3 +440,98 @@ fn the_library_refuses_polygons_that_are_not_simple_and_disks_stay_finite() {
     let tiny = coaxial_disks(1e200, 1.0, 1.0).expect("finite");
     assert!((0.0..1e-300).contains(&tiny), "{tiny}");
 }
+
+/// Runs `spec` (an experiment file) through the command line and returns
+/// its summary's quantities by name: `quantity -> rule label -> rows`.
+fn summary_rows(
+    tag: &str,
+    spec: Value,
+) -> std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<Value>>> {
+    let dir = crate::common::scratch(tag);
+    let path = dir.join("exp.json");
+    std::fs::write(&path, spec.to_string()).expect("written");
+    let o = crate::common::bin()
+        .args(["run", path.to_str().expect("utf-8"), "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .expect("runs");
+    assert!(o.status.success(), "{}", crate::common::stderr(&o));
+    let name = spec["name"].as_str().expect("name");
+    let text =
+        std::fs::read_to_string(dir.join("out").join(name).join("summary.json")).expect("summary");
+    let summary: Value = serde_json::from_str(&text).expect("json");
+    let mut out = std::collections::BTreeMap::new();
+    for q in summary["experiments"][0]["quantities"]
+        .as_array()
+        .expect("quantities")
+    {
+        let rules = q["rules"].as_array().expect("rules").iter().map(|r| {
+            let rows = r["rows"].as_array().expect("rows").clone();
+            (r["label"].as_str().expect("label").to_string(), rows)
+        });
+        out.insert(
+            q["quantity"].as_str().expect("name").to_string(),
+            rules.collect(),
+        );
+    }
+    out
+}
+
+fn budgets_of(rows: &[Value]) -> Vec<u64> {
+    rows.iter()
+        .map(|r| r["budget"].as_u64().expect("budget"))
+        .collect()
+}
+
+#[test]
+fn a_rules_4d_minimum_does_not_hold_back_its_2d_contour_rows() {
+    // Trapezoid needs 3^4 = 81 nodes in 4-D and 2^2 = 4 in 2-D; Genz–Malik
+    // 57 in 4-D (2^4 + 2*4^2 + 8 + 1) and 17 in 2-D.
+    let mut spec = file(perpendicular(), json!(["F_area", "F_contour"]));
+    spec["name"] = json!("exchange-min-budget");
+    spec["rules"] = json!([{"rule": "trapezoid"}, {"rule": "genz-malik"}]);
+    spec["budgets"] = json!([16, 64, 256]);
+    let rows = summary_rows("exchange-min-budget", spec);
+    assert_eq!(budgets_of(&rows["F_contour"]["trapezoid"]), [16, 64, 256]);
+    assert_eq!(budgets_of(&rows["F_area"]["trapezoid"]), [256]);
+    assert_eq!(budgets_of(&rows["F_contour"]["genz-malik"]), [64, 256]);
+    assert_eq!(budgets_of(&rows["F_area"]["genz-malik"]), [64, 256]);
+    // The contour rows at 16 are values: C-14's 0.2000437950...
+    let f = perpendicular_rectangles(1.0, 1.0, 1.0).expect("C-14");
+    let v = rows["F_contour"]["trapezoid"][0]["value"][0]
+        .as_f64()
+        .expect("value");
+    assert!(rel(v, f) < 0.1, "{v} against {f}");
+}
+
+#[test]
+fn monte_carlo_on_the_infinite_variance_kernel_is_not_called_consistent() {
+    // Along the shared edge the area form's kernel is ~1/r^2 in the 2-D
+    // cross-section: its square is not integrable, so a sample variance is
+    // carried by the few samples nearest the edge, and Monte Carlo flags it.
+    let mut spec = file(perpendicular(), json!(["F_area"]));
+    spec["name"] = json!("exchange-heavy-verdicts");
+    spec["rules"] = json!([{"rule": "monte-carlo"}]);
+    spec["budgets"] = json!([1024, 4096, 16384, 65536]);
+    spec["repeats"] = json!(4);
+    let rows = summary_rows("exchange-heavy-verdicts", spec);
+    let mc = &rows["F_area"]["monte-carlo"];
+    let doubted = |r: &Value| {
+        r["flags"]
+            .as_array()
+            .expect("flags")
+            .iter()
+            .any(|f| f["kind"] == "unreliable-estimate")
+    };
+    let verdict = |r: &Value| {
+        r["verdict"]["verdict"]
+            .as_str()
+            .expect("verdict")
+            .to_string()
+    };
+    assert!(mc.iter().any(doubted), "no row flagged: {mc:?}");
+    for r in mc.iter().filter(|r| doubted(r)) {
+        assert_ne!(verdict(r), "consistent", "{r}");
+    }
+    assert!(mc.iter().any(|r| verdict(r) == "se-in-doubt"), "{mc:?}");
+}

@@ -42,7 +42,7 @@ fn i_experiment() -> (
     let rules = [lightquad::experiment::report::RuleInfo {
         label: "gauss-legendre".into(),
         is_random: false,
-        min_budget: 1,
+        min_budget: Default::default(),
         resolution: Default::default(),
         not_run: None,
     }];
@@ -1908,7 +1908,7 @@ fn true_errors_near_the_top_of_the_range_do_not_overflow() {
     let rule = lightquad::experiment::report::RuleInfo {
         label: "gauss-legendre".into(),
         is_random: false,
-        min_budget: 1,
+        min_budget: Default::default(),
         resolution: Default::default(),
         not_run: None,
     };

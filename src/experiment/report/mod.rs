@@ -26,7 +26,8 @@
 //! // One row per (rule, budget) against the reference e - 1, and the order fitted
 //! // against the resolution a budget buys (n - 1 intervals): -2 for the trapezoid rule.
 //! let intervals: BTreeMap<usize, f64> = [8, 16, 32, 64, 128].map(|n| (n, Trapezoid.resolution(n, 1))).into();
-//! let rule = RuleInfo { label: "trapezoid".into(), is_random: false, min_budget: 2,
+//! let rule = RuleInfo { label: "trapezoid".into(), is_random: false,
+//!     min_budget: BTreeMap::from([("exp".to_string(), 2)]),
 //!     resolution: BTreeMap::from([(1, intervals.clone())]), not_run: None };
 //! let table = rows(&[rule], &results, "exp", &[std::f64::consts::E - 1.0], None);
 //! assert_eq!(table.len(), 5);
@@ -150,8 +151,9 @@ pub struct RuleInfo {
     pub label: String,
     /// True for randomised rules (their estimate is a standard error).
     pub is_random: bool,
-    /// The smallest budget it runs at (smaller budgets are skipped for it).
-    pub min_budget: usize,
+    /// Per quantity, the smallest budget at which it computes it (smaller
+    /// budgets are skipped for that quantity); a quantity not listed: 1.
+    pub min_budget: BTreeMap<String, usize>,
     /// Per dimension, the resolution per axis each budget buys
     /// ([`crate::quadrature::Rule::resolution`]: intervals of a composite
     /// rule, nodes or samples per axis otherwise); a missing entry is read as
@@ -160,4 +162,11 @@ pub struct RuleInfo {
     /// Why it has no jobs (an external program missing, its rule asking to
     /// be skipped), if so.
     pub not_run: Option<String>,
+}
+
+impl RuleInfo {
+    /// The smallest budget at which it computes quantity `q`.
+    pub fn min_budget_of(&self, q: &str) -> usize {
+        self.min_budget.get(q).copied().unwrap_or(1)
+    }
 }

@@ -131,7 +131,14 @@ pub fn rows(
     display: Option<(&Display, &[bool])>,
 ) -> Vec<Row> {
     let mut groups: BTreeMap<(usize, usize), Vec<&JobResult>> = BTreeMap::new();
-    for r in results {
+    // A job below the rule's minimum for `q` did not compute it, whatever
+    // became of the job.
+    let computes_q = |r: &JobResult| {
+        rules
+            .get(r.rule_index)
+            .is_none_or(|rule| r.budget >= rule.min_budget_of(q))
+    };
+    for r in results.iter().filter(|r| computes_q(r)) {
         groups.entry((r.rule_index, r.budget)).or_default().push(r);
     }
     let scale = scale_of(reference);

@@ -2,6 +2,8 @@
 //! Markdown and the HTML page: its rows, fitted orders, times to the targets,
 //! plots and images, and the cells and lines both pages print.
 
+use std::collections::BTreeMap;
+
 use super::Page;
 use super::fitted::{Reach, Slope};
 use super::order::{Against, FIT_ROWS, fit_floor, fitted};
@@ -139,13 +141,29 @@ pub fn sections(page: &Page, results: &[JobResult]) -> Result<Vec<Section>, Stri
     Ok(out)
 }
 
-/// The rules whose minimum budget is above the smallest budget, in words.
+/// The rules whose minimum budget for some quantity is above the smallest
+/// budget, in words: the minimum, and the quantities it holds for where
+/// the others start lower.
 pub fn skipped(page: &Page) -> Vec<String> {
-    page.rules
-        .iter()
-        .filter(|r| page.budgets.first().is_some_and(|&b| b < r.min_budget))
-        .map(|r| format!("{} needs at least {}", r.label, r.min_budget))
-        .collect()
+    let Some(&first) = page.budgets.first() else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for r in &page.rules {
+        let mut by_least: BTreeMap<usize, Vec<&str>> = BTreeMap::new();
+        for &q in &page.quantities {
+            by_least.entry(r.min_budget_of(q)).or_default().push(q);
+        }
+        let one = by_least.len() == 1;
+        for (least, qs) in by_least.into_iter().filter(|(least, _)| *least > first) {
+            out.push(if one {
+                format!("{} needs at least {least}", r.label)
+            } else {
+                format!("{} needs at least {least} for {}", r.label, qs.join(", "))
+            });
+        }
+    }
+    out
 }
 
 /// The rules that did not run at all, and why, in words.

@@ -171,8 +171,8 @@ pub struct RowSummary {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct VerdictSummary {
-    /// One of: consistent, biased, se-too-small, se-too-large, no-se,
-    /// too-few-repeats.
+    /// One of: consistent, biased, se-too-small, se-too-large, se-in-doubt,
+    /// no-se, too-few-repeats.
     pub verdict: String,
     /// The level each test was made at (α Šidák-corrected over the rule's
     /// budgets and channels).

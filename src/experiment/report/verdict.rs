@@ -54,6 +54,11 @@ pub enum Verdict {
     SeTooSmall,
     /// The values spread less than the standard errors say.
     SeTooLarge,
+    /// Neither test rejects, but the method doubted a repeat's standard
+    /// error (a sample variance carried by a few samples, as of an
+    /// infinite-variance integrand or a rare event, or samples all alike):
+    /// the tests assume error bars that nothing vouches for.
+    SeInDoubt,
     /// The mean is the reference, but the method gives no standard error.
     NoSe,
     /// Fewer than two repeats: nothing to test.
@@ -68,6 +73,7 @@ impl Verdict {
             Verdict::Biased => "biased",
             Verdict::SeTooSmall => "SE too small",
             Verdict::SeTooLarge => "SE too large",
+            Verdict::SeInDoubt => "not rejected, SE in doubt",
             Verdict::NoSe => "no SE given",
             Verdict::TooFewRepeats => "too few repeats",
         }
@@ -348,9 +354,11 @@ pub fn verdicts(
         if !rule.is_random {
             continue;
         }
-        // Per budget, per channel, the repeats' (value, standard error).
+        // Per budget, per channel, the repeats' (value, standard error); and
+        // the budgets where the method doubted a repeat's standard error.
         let mut by_budget: std::collections::BTreeMap<usize, Vec<Vec<(f64, f64)>>> =
             std::collections::BTreeMap::new();
+        let mut doubted = std::collections::BTreeSet::new();
         for r in results
             .iter()
             .filter(|r| r.rule_index == i && r.failure.is_none())
@@ -364,6 +372,9 @@ pub fn verdicts(
                 || m.flags.contains(&crate::family::Flag::Underflow)
             {
                 continue;
+            }
+            if m.flags.iter().any(doubts_se) {
+                doubted.insert(r.budget);
             }
             let cells = by_budget
                 .entry(r.budget)
@@ -386,11 +397,28 @@ pub fn verdicts(
             level,
             budgets: by_budget
                 .into_iter()
-                .map(|(b, cells)| (b, judge_budget(&cells, reference, &tol, level)))
+                .map(|(b, cells)| {
+                    let mut j = judge_budget(&cells, reference, &tol, level);
+                    if j.verdict == Verdict::Consistent && doubted.contains(&b) {
+                        j.verdict = Verdict::SeInDoubt;
+                    }
+                    (b, j)
+                })
                 .collect(),
         });
     }
     out
+}
+
+/// Whether a job's flag says its standard error is not a sample standard
+/// error to be trusted: a rejection still stands, but "consistent" would
+/// vouch for error bars the method itself doubted.
+fn doubts_se(flag: &crate::family::Flag) -> bool {
+    use crate::family::Flag;
+    matches!(
+        flag,
+        Flag::UnreliableEstimate | Flag::HeavyWalks { .. } | Flag::AllWalksAlike { .. }
+    )
 }
 
 /// The verdicts as a Markdown section (empty when there are none).
@@ -409,6 +437,19 @@ pub fn markdown(verdicts: &[RuleVerdicts]) -> String {
          coverage is the share of repeats within 1.96 standard errors of the reference, with \
          its Wilson 95% interval (about 95% for honest error bars).\n\n"
     );
+    let in_doubt = |v: &RuleVerdicts| {
+        v.budgets
+            .iter()
+            .any(|(_, j)| j.verdict == Verdict::SeInDoubt)
+    };
+    if verdicts.iter().any(in_doubt) {
+        md.push_str(
+            "\"Not rejected, SE in doubt\": neither test rejects, but the rule flagged a \
+             repeat's standard error as resting on a few samples (an infinite variance, a rare \
+             event) or on samples all alike, so the tests assume error bars that nothing vouches \
+             for.\n\n",
+        );
+    }
     for v in verdicts {
         let _ = writeln!(
             md,

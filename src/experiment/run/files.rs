@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use crate::experiment::validate::Experiment;
+use crate::experiment::validate::{Experiment, quantities_at};
 use crate::family::{Family, Quantity};
 
 use super::{JobKey, JobResult, job_seed, jobs, links};
@@ -37,9 +37,12 @@ pub fn reusable<F: Family>(
                 .rules
                 .get(r.rule_index)
                 .is_some_and(|m| m.label() == r.rule);
+        let asked = exp.spec.rules.get(r.rule_index).map_or_else(Vec::new, |m| {
+            quantities_at::<F>(&exp.scene, m, &exp.spec.quantities, r.budget)
+        });
         let shaped = r.failure.is_some()
-            || (r.quantities.len() == exp.spec.quantities.len()
-                && exp.spec.quantities.iter().all(|q| {
+            || (r.quantities.len() == asked.len()
+                && asked.iter().all(|q| {
                     let want = F::channels(&exp.scene, *q);
                     r.quantities.get(q.name()).is_some_and(|m| {
                         m.value.len() == want

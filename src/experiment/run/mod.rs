@@ -49,7 +49,7 @@ use super::Loaded;
 use super::external::protocol::{self, Request};
 use super::external::{External, Found};
 use super::timing::timed;
-use super::validate::{Experiment, min_budget};
+use super::validate::{Experiment, min_budget, quantities_at};
 use crate::family::{Family, Listed, Measured, Method, Outcome, Quantity};
 
 mod files;
@@ -189,9 +189,10 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         ));
         return out;
     };
+    let asked = quantities_at::<F>(&exp.scene, method, &spec.quantities, budget);
     let outcome = match method {
-        Listed::Own(method) => own_outcome(exp, method, budget, seed),
-        Listed::External(x) => external_outcome(exp, x, (rule_index, budget, repeat), seed),
+        Listed::Own(method) => own_outcome(exp, method, &asked, budget, seed),
+        Listed::External(x) => external_outcome(exp, x, &asked, (rule_index, budget, repeat), seed),
     };
     let outcome = match outcome {
         Ok(outcome) => outcome,
@@ -201,24 +202,25 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         }
     };
     out.seconds = outcome.values().filter_map(|m| m.seconds).sum();
-    match shaped::<F>(&exp.scene, &spec.quantities, outcome) {
+    match shaped::<F>(&exp.scene, &asked, outcome) {
         Ok(values) => out.quantities = values,
         Err(e) => out.failure = Some(e),
     }
     out
 }
 
-/// Each quantity evaluated alone by the family's `method`, from the job's
-/// seed, and timed alone: its time to a target is then its own cost (a
+/// Each quantity `asked` evaluated alone by the family's `method`, from the
+/// job's seed, and timed alone: its time to a target is then its own cost (a
 /// family computes only what the asked-for quantities need).
 fn own_outcome<F: Family>(
     exp: &Experiment<F>,
     method: &Method<F::Estimator>,
+    asked: &[F::Quantity],
     budget: usize,
     seed: u64,
 ) -> Result<Outcome<F::Quantity>, String> {
     let mut outcome = Outcome::new();
-    for q in &exp.spec.quantities {
+    for q in asked {
         let evaluate = || {
             let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
             F::evaluate(
@@ -249,11 +251,12 @@ fn own_outcome<F: Family>(
     Ok(outcome)
 }
 
-/// Each quantity asked of an external program, once (its request is timed
+/// Each quantity `asked` of an external program, once (its request is timed
 /// as it is answered: asking again would be another estimate).
 fn external_outcome<F: Family>(
     exp: &Experiment<F>,
     external: &External,
+    asked: &[F::Quantity],
     (rule_index, budget, repeat): JobKey,
     seed: u64,
 ) -> Result<Outcome<F::Quantity>, String> {
@@ -265,7 +268,7 @@ fn external_outcome<F: Family>(
     };
     let scene = serde_json::to_value(&exp.spec.scene).map_err(|e| e.to_string())?;
     let mut outcome = Outcome::new();
-    for &q in &exp.spec.quantities {
+    for &q in asked {
         let request = Request {
             protocol: protocol::NAME.into(),
             version: protocol::VERSION,
@@ -332,7 +335,8 @@ fn shaped<F: Family>(
 }
 
 /// Every job of an experiment in a fixed order, restricted to a shard; a
-/// rule's budgets below its minimum are left out.
+/// rule's budgets below its minimum for every quantity are left out (a job
+/// computes the quantities whose minimum its budget reaches).
 pub fn jobs<F: Family>(exp: &Experiment<F>, shard: Option<(usize, usize)>) -> Vec<JobKey> {
     let mut all = Vec::new();
     for (r, method) in exp.spec.rules.iter().enumerate() {

@@ -5,7 +5,7 @@ use crate::error::SpecError;
 use crate::experiment::spec::ExperimentSpec;
 use crate::family::Family;
 
-use super::min_budget;
+use super::{min_budget, quantities_at};
 
 /// The most integrand evaluations one job may cost by its family's estimate
 /// ([`Family::cost`]): 1e11, minutes to hours at a nanosecond or more per
@@ -84,10 +84,9 @@ pub(super) fn check_cost<F: Family>(
             // lowering the budget, the advice given, could not help. (The
             // experiment's own smallest budget said so of any single budget.)
             let least = min_budget::<F>(scene, listed, &spec.quantities);
-            let at_least: f64 = spec
-                .quantities
-                .iter()
-                .map(|&q| F::cost(scene, m, least, q))
+            let at_least: f64 = quantities_at::<F>(scene, listed, &spec.quantities, least)
+                .into_iter()
+                .map(|q| F::cost(scene, m, least, q))
                 .sum();
             let advice = if at_least.is_nan() || at_least > MAX_JOB_EVALUATIONS {
                 format!(
@@ -261,10 +260,9 @@ pub fn jobs_cost<F: Family>(
             jobs += repeats;
             // An external program's work is counted as its budget.
             total += repeats
-                * spec
-                    .quantities
-                    .iter()
-                    .map(|&q| m.own().map_or(b as f64, |m| F::cost(scene, m, b, q)))
+                * quantities_at::<F>(scene, m, &spec.quantities, b)
+                    .into_iter()
+                    .map(|q| m.own().map_or(b as f64, |m| F::cost(scene, m, b, q)))
                     .sum::<f64>();
         }
     }

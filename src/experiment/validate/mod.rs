@@ -105,19 +105,23 @@ pub fn validate_from<F: Family>(
     }
     let programs = check_methods::<F>(&spec, &scene, &origin)?;
     let budgets = budgets(&spec.budgets)?;
-    // Budgets below a rule's minimum are skipped for that rule; a rule left
-    // with none is an error, so no rule silently disappears.
+    // Budgets below a rule's minimum for a quantity are skipped for that
+    // rule and quantity; a pair left with none is an error, so no rule
+    // silently disappears from a quantity's table.
     let largest = budgets.last().copied().unwrap_or(0);
     for (i, m) in spec.rules.iter().enumerate() {
-        let need = min_budget::<F>(&scene, m, &spec.quantities);
-        if largest < need {
-            return Err(SpecError::at(
-                "budgets",
-                format!(
-                    "no budget reaches what rules[{i}] ({}) needs: at least {need}",
-                    m.name()
-                ),
-            ));
+        for &q in &spec.quantities {
+            let need = quantity_min_budget::<F>(&scene, m, q);
+            if largest < need {
+                return Err(SpecError::at(
+                    "budgets",
+                    format!(
+                        "no budget reaches what rules[{i}] ({}) needs for {}: at least {need}",
+                        m.name(),
+                        q.name()
+                    ),
+                ));
+            }
         }
     }
     check_cost::<F>(&spec, &scene, &budgets)?;
@@ -135,7 +139,34 @@ pub fn validate_from<F: Family>(
     })
 }
 
-/// The smallest budget `method` needs for every quantity of the experiment.
+/// The smallest budget at which `method` computes quantity `q` (its
+/// minimum in `q`'s dimension).
+pub fn quantity_min_budget<F: Family>(
+    scene: &F::Scene,
+    method: &Listed<F::Estimator>,
+    q: F::Quantity,
+) -> usize {
+    method.min_budget(F::dimension(scene, q))
+}
+
+/// The quantities `method` computes at `budget`: those whose minimum the
+/// budget reaches (a 4-D rule's minimum does not hold back a 2-D quantity
+/// of the same experiment).
+pub fn quantities_at<F: Family>(
+    scene: &F::Scene,
+    method: &Listed<F::Estimator>,
+    quantities: &[F::Quantity],
+    budget: usize,
+) -> Vec<F::Quantity> {
+    quantities
+        .iter()
+        .copied()
+        .filter(|&q| budget >= quantity_min_budget::<F>(scene, method, q))
+        .collect()
+}
+
+/// The smallest budget at which `method` computes any quantity of the
+/// experiment: where its jobs start.
 pub fn min_budget<F: Family>(
     scene: &F::Scene,
     method: &Listed<F::Estimator>,
@@ -143,8 +174,8 @@ pub fn min_budget<F: Family>(
 ) -> usize {
     quantities
         .iter()
-        .map(|q| method.min_budget(F::dimension(scene, *q)))
-        .max()
+        .map(|&q| quantity_min_budget::<F>(scene, method, q))
+        .min()
         .unwrap_or(1)
 }
 
