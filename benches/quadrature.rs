@@ -10,6 +10,8 @@
 //!   cached nodes, against the same peers: the interval through `black_box`
 //!   (as a run-time interval), `*/const` with constant bounds, and `*/par`
 //!   on every core (lightquad's `line_sum_par`, gauss-quad's `par_integrate`).
+//! - `gl_small/*`: the same integral with n = 5 .. 100 nodes, one call per
+//!   iteration: the fixed cost of a call, against the peers' cached rules.
 //! - `sum_overhead/*`: the shared compensated summation against a bare loop
 //!   that only evaluates the integrand at the same nodes, n = 1e3 .. 1e6.
 
@@ -146,5 +148,53 @@ fn sum_overhead(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, gl_nodes, gl_integrate, sum_overhead);
+/// Integrating `cos(50 x)` over a run-time `[a, b] = [-1, 1]` with a few
+/// nodes, one call per iteration, rules built outside the loop (the peers'
+/// cached rules; lightquad's tables for n <= 100 are compiled in):
+/// `lightquad` is `Rule::integrate` with the error estimate off (the peers
+/// have none), `lightquad/estimate` with it on (its companion rules'
+/// evaluations included).
+fn gl_small(c: &mut Criterion) {
+    use lightquad::quadrature::{GaussLegendre, Rule};
+    use rand::SeedableRng;
+    let mut g = c.benchmark_group("gl_small");
+    g.sample_size(50)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(1));
+    let (a, b) = (-1.0f64, 1.0f64);
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+    for n in [5usize, 10, 20, 50, 100] {
+        for (label, rule) in [
+            (
+                "lightquad",
+                GaussLegendre {
+                    error_estimate: false,
+                },
+            ),
+            ("lightquad/estimate", GaussLegendre::default()),
+        ] {
+            g.bench_with_input(BenchmarkId::new(label, n), &n, |bench, &n| {
+                bench.iter(|| {
+                    let (a, b) = (black_box(a), black_box(b));
+                    let h = b - a;
+                    rule.integrate(n, &mut rng, |u: [f64; 1]| integrand(a + h * u[0]))
+                        .map(|e| e.value * h)
+                })
+            });
+        }
+        let Ok(bil) = bilby::GaussLegendre::new(n) else {
+            return;
+        };
+        g.bench_with_input(BenchmarkId::new("bilby", n), &n, |bench, _| {
+            bench.iter(|| bil.rule().integrate(black_box(a), black_box(b), integrand))
+        });
+        let gq = gauss_quad::GaussLegendre::new(std::num::NonZeroUsize::MIN.saturating_add(n - 1));
+        g.bench_with_input(BenchmarkId::new("gauss-quad", n), &n, |bench, _| {
+            bench.iter(|| gq.integrate(black_box(a), black_box(b), integrand))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, gl_nodes, gl_integrate, gl_small, sum_overhead);
 criterion_main!(benches);

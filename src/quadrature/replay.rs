@@ -22,15 +22,23 @@
 
 use std::convert::Infallible;
 
+use smallvec::SmallVec;
+
 /// The most memory one log of an integral holds, in bytes (1 MiB: 65536
 /// one-dimensional real evaluations, 26214 two-dimensional RGB ones; a pass
 /// stopped at the first value beyond `2^500` has mostly logged far fewer).
 pub const LOG_BYTES: usize = 1 << 20;
 
+/// Items a [`Log`] holds in place, before it allocates: a few-node
+/// integral (Gauss–Legendre at n = 10 with its estimate logs 27 points)
+/// allocates nothing; its allocation and release were some 350 of the
+/// 2900 instructions of a call at n = 5 (callgrind).
+const INLINE: usize = 32;
+
 /// What the passes of an integral have seen or drawn, in order, with a
 /// cursor for the pass under way.
 pub struct Log<T> {
-    items: Vec<T>,
+    items: SmallVec<[T; INLINE]>,
     cap: usize,
     cursor: usize,
 }
@@ -39,7 +47,7 @@ impl<T: Copy> Log<T> {
     /// An empty log (it allocates as it grows, never past its cap).
     pub fn new() -> Self {
         Log {
-            items: Vec::new(),
+            items: SmallVec::new(),
             cap: LOG_BYTES / std::mem::size_of::<T>().max(1),
             cursor: 0,
         }
