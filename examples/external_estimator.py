@@ -66,7 +66,7 @@ def irradiance(scene, n, rng, with_cos=True):
     x = scene["receiver"]["point"]
     normal = unit(scene["receiver"]["normal"])
     lights = rectangles(scene)
-    total, total_sq = 0.0, 0.0
+    samples = []
     for _ in range(n):
         f = 0.0
         for origin, eu, ev, radiance in lights:
@@ -81,11 +81,23 @@ def irradiance(scene, n, rng, with_cos=True):
             if cos_r <= 0.0 or cos_e <= 0.0:
                 continue
             f += radiance * area * cos_r * (cos_e if with_cos else 1.0) / r2
-        total += f
-        total_sq += f * f
-    mean = total / n
-    variance = max(total_sq / n - mean * mean, 0.0) * n / (n - 1) if n > 1 else math.inf
-    return mean, math.sqrt(variance / n)
+        samples.append(f)
+    mean = math.fsum(samples) / n
+    m2 = math.fsum((f - mean) ** 2 for f in samples)
+    m4 = math.fsum((f - mean) ** 4 for f in samples)
+    variance = m2 / (n - 1) if n > 1 else math.inf
+    return mean, math.sqrt(variance / n), doubted(n, m2, m4)
+
+
+def doubted(n, m2, m4):
+    """Whether the standard error is in doubt, by lightquad's Monte Carlo
+    test: every sample alike, or a sample variance whose own relative error
+    sqrt((b2 - 1)/n) (b2 the kurtosis) exceeds max(0.5 (16/n)^(1/4), 0.3),
+    as where a few samples carry the spread."""
+    if n < 2 or m2 == 0.0:
+        return True
+    b2 = n * m4 / (m2 * m2)
+    return math.sqrt(max(b2 - 1.0, 0.0) / n) > max(0.5 * (16.0 / n) ** 0.25, 0.3)
 
 
 def answer(request, with_cos, se_scale):
@@ -95,13 +107,15 @@ def answer(request, with_cos, se_scale):
                           "only the rendering family's irradiance E_*")
     rng = random.Random(request["seed"])
     start = time.perf_counter()
-    value, se = irradiance(request["scene"], request["budget"], rng, with_cos)
+    value, se, in_doubt = irradiance(request["scene"], request["budget"], rng, with_cos)
     seconds = time.perf_counter() - start
     std_error = [se * se_scale] if math.isfinite(se) else None
     response = {"id": request["id"], "value": [value], "evaluations": request["budget"],
                 "seconds": seconds}
     if std_error is not None:
         response["std_error"] = std_error
+    if in_doubt:
+        response["doubted"] = True
     return response
 
 

@@ -69,6 +69,45 @@ fn p_values_match_mpmath_quadratures() {
     assert!((sidak(0.01, 6) - 0.001_673_653_852_310_441_6).abs() < 1e-12);
 }
 
+#[test]
+fn where_the_method_doubted_its_error_bars_the_coverage_decides() {
+    // Ten repeats of a heavy-tailed estimator: nine 3 standard errors off
+    // the reference with small error bars, and one lucky draw far off with
+    // a large one, which inflates both the spread and the mean squared
+    // error bar: sd / rms SE is near 1 and the bias is within the spread,
+    // so neither test rejects; one repeat in ten is covered.
+    let mut heavy: Vec<(f64, f64)> = (0..9)
+        .map(|i| (1.0 + if i % 2 == 0 { 0.03 } else { -0.03 }, 0.01))
+        .collect();
+    heavy.push((1.5, 0.5));
+    let j = judge_budget(std::slice::from_ref(&heavy), &[1.0], &[0.0], 1e-6);
+    assert_eq!(j.covered, [1, 10]);
+    assert_eq!(j.verdict, Verdict::Consistent, "{j:?}");
+    // Undoubted, it stays consistent; with one repeat doubted, the
+    // coverage decides: P(X <= 1 | Binomial(10, 0.95)) = 0.05^10 + 10 *
+    // 0.95 * 0.05^9 = 1.86e-11 < 1e-6, so the error bars are too small.
+    assert_eq!(j.clone().in_doubt(0, 1e-6).verdict, Verdict::Consistent);
+    let d = j.in_doubt(1, 1e-6);
+    assert_eq!((d.verdict, d.doubted), (Verdict::SeTooSmall, 1));
+    // Nine of ten covered: P(X <= 9) = 1 - 0.95^10 = 0.4013: in doubt.
+    let fine: Vec<(f64, f64)> = (0..10)
+        .map(|i| (1.0 + 0.01 * ((i % 5) as f64 - 2.0) / 1.4, 0.01))
+        .collect();
+    let j = judge_budget(&[fine], &[1.0], &[0.0], 0.01);
+    assert_eq!(j.verdict, Verdict::Consistent, "{j:?}");
+    assert!(j.covered[0] >= 9, "{j:?}");
+    assert_eq!(j.in_doubt(3, 0.01).verdict, Verdict::SeInDoubt);
+    // Error bars that are a bound (every walk alike, sd = 0): too large
+    // undoubted, in doubt where the method said so. A bias stands.
+    let alike = vec![(0.5, 0.1); 6];
+    let j = judge_budget(&[alike], &[0.5], &[0.0], 0.01);
+    assert_eq!(j.verdict, Verdict::SeTooLarge);
+    assert_eq!(j.in_doubt(6, 0.01).verdict, Verdict::SeInDoubt);
+    let off: Vec<(f64, f64)> = (0..6).map(|i| (2.0 + 0.001 * i as f64, 0.001)).collect();
+    let j = judge_budget(&[off], &[1.0], &[0.0], 0.01);
+    assert_eq!(j.in_doubt(6, 0.01).verdict, Verdict::Biased);
+}
+
 /// One experiment of the calibration family, `int_0^1 e^x dx`, with
 /// lightquad's unbiased random rules, run at `seed`: per rule and budget
 /// the repeats' (value, standard error).

@@ -17,6 +17,12 @@
 //! let measured = answer(response, 3, 1, 1024).map_err(|e| e.to_string())?;
 //! assert_eq!(measured.value, vec![0.25]);
 //! assert_eq!(measured.error, vec![0.01]);
+//! assert!(measured.flags.is_empty());
+//! // A standard error the program doubts flags the row as lightquad's own
+//! // doubted estimates are.
+//! let doubted = serde_json::from_str(r#"{"id": 5, "value": [0.3], "std_error": [0.2], "doubted": true}"#)?;
+//! let measured = answer(doubted, 5, 1, 64).map_err(|e| e.to_string())?;
+//! assert_eq!(measured.flags, vec![lightquad::family::Flag::UnreliableEstimate]);
 //! // The wrong number of channels is refused, naming both counts.
 //! let rgb = serde_json::from_str(r#"{"id": 4, "value": [1, 2, 3]}"#)?;
 //! let e = answer(rgb, 4, 1, 16).err().ok_or("accepted")?;
@@ -111,6 +117,12 @@ pub struct Response {
     /// excluded (lightquad times the request too and reports both).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seconds: Option<f64>,
+    /// True where the program doubts its own standard error (a sample
+    /// variance carried by a few samples, every sample alike): the row is
+    /// flagged as lightquad's own rules' rows are, and the verdicts weigh
+    /// its coverage instead of calling it consistent (default false).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub doubted: Option<bool>,
     /// Why the program could not answer (a scene it cannot express): the job
     /// fails with this message and the program stays running.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -203,6 +215,9 @@ pub fn answer(
     m.value = value;
     m.error = error;
     m.program_seconds = response.seconds;
+    if response.doubted == Some(true) {
+        m.flags.push(crate::family::Flag::UnreliableEstimate);
+    }
     Ok(m)
 }
 

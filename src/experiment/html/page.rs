@@ -153,7 +153,7 @@ fn facts(dir: &Path, page: &Page, results: &[JobResult]) -> String {
             "Skipped",
             format!(
                 "Budgets below a rule's minimum are skipped for it: {}.",
-                escape(&skipped.join(", "))
+                escape(&skipped.join("; "))
             ),
         ));
     }

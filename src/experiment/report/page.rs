@@ -195,7 +195,7 @@ fn header(page: &Page, results: &[JobResult]) -> String {
         let _ = writeln!(
             md,
             "Budgets below a rule's minimum are skipped for it: {}.\n",
-            skipped.join(", ")
+            skipped.join("; ")
         );
     }
     for line in external_times(page, results) {

@@ -188,6 +188,11 @@ pub struct VerdictSummary {
     pub covered: [usize; 2],
     /// The coverage's Wilson 95% interval.
     pub coverage: Option<[f64; 2]>,
+    /// Repeats whose standard error the method itself doubted (a variance
+    /// carried by a few samples, samples or walks all alike); where any is,
+    /// `verdict` weighs the coverage ([`crate::experiment::report::verdict::Judged::in_doubt`]).
+    #[serde(default)]
+    pub doubted: usize,
 }
 
 /// A flag on a row: a code to match on and the sentence the report shows.
@@ -325,6 +330,7 @@ fn quantity(page: &Page, i: usize, s: &Section) -> QuantitySummary {
                             se_ratio: j.se_ratio.and_then(finite),
                             covered: j.covered,
                             coverage: j.coverage,
+                            doubted: j.doubted,
                         })
                     });
                     row

@@ -102,6 +102,45 @@ pub struct Judged {
     pub coverage: Option<[f64; 2]>,
     /// What they say at the per-test level.
     pub verdict: Verdict,
+    /// Repeats whose standard error the method itself doubted
+    /// ([`Judged::in_doubt`]).
+    pub doubted: usize,
+}
+
+impl Judged {
+    /// The verdict where `doubted` of the repeats carry the method's doubt
+    /// of their standard error (a sample variance carried by a few samples,
+    /// samples or walks all alike, an error that is a bound): the tests'
+    /// spread-based verdicts cannot lean on those error bars. A bias and
+    /// error bars too small stand; error bars too large are what a bound
+    /// gives, so in doubt; and where neither test rejects, the coverage
+    /// decides: fewer repeats within 1.96 standard errors than 95%
+    /// coverage makes likely at `level` (one-sided binomial) is error bars
+    /// too small (a heavy tail's lucky repeat inflates the spread the
+    /// error-bar test measures, not the misses), else in doubt.
+    pub fn in_doubt(mut self, doubted: usize, level: f64) -> Judged {
+        self.doubted = doubted;
+        if doubted == 0 {
+            return self;
+        }
+        self.verdict = match self.verdict {
+            Verdict::SeTooLarge => Verdict::SeInDoubt,
+            Verdict::Consistent if coverage_p(self.covered) < level => Verdict::SeTooSmall,
+            Verdict::Consistent => Verdict::SeInDoubt,
+            other => other,
+        };
+        self
+    }
+}
+
+/// `P(X <= k)` for `X ~ Binomial(n, 0.95)`, `[k, n] = covered`: how likely
+/// so few covered repeats are from honest 95% error bars (1 with none).
+fn coverage_p([k, n]: [usize; 2]) -> f64 {
+    use statrs::distribution::{Binomial, DiscreteCDF};
+    if n == 0 {
+        return 1.0;
+    }
+    Binomial::new(0.95, n as u64).map_or(1.0, |d| d.cdf(k as u64))
 }
 
 /// Judges one budget: `channels[c]` holds the repeats' `(value, standard
@@ -124,6 +163,7 @@ pub fn judge_budget(
         covered: [0, 0],
         coverage: None,
         verdict: Verdict::TooFewRepeats,
+        doubted: 0,
     };
     if repeats < 2 {
         return out;
@@ -358,7 +398,8 @@ pub fn verdicts(
         // the budgets where the method doubted a repeat's standard error.
         let mut by_budget: std::collections::BTreeMap<usize, Vec<Vec<(f64, f64)>>> =
             std::collections::BTreeMap::new();
-        let mut doubted = std::collections::BTreeSet::new();
+        let mut doubted: std::collections::BTreeMap<usize, usize> =
+            std::collections::BTreeMap::new();
         for r in results
             .iter()
             .filter(|r| r.rule_index == i && r.failure.is_none())
@@ -374,7 +415,7 @@ pub fn verdicts(
                 continue;
             }
             if m.flags.iter().any(doubts_se) {
-                doubted.insert(r.budget);
+                *doubted.entry(r.budget).or_default() += 1;
             }
             let cells = by_budget
                 .entry(r.budget)
@@ -398,11 +439,8 @@ pub fn verdicts(
             budgets: by_budget
                 .into_iter()
                 .map(|(b, cells)| {
-                    let mut j = judge_budget(&cells, reference, &tol, level);
-                    if j.verdict == Verdict::Consistent && doubted.contains(&b) {
-                        j.verdict = Verdict::SeInDoubt;
-                    }
-                    (b, j)
+                    let j = judge_budget(&cells, reference, &tol, level);
+                    (b, j.in_doubt(doubted.get(&b).copied().unwrap_or(0), level))
                 })
                 .collect(),
         });
@@ -444,10 +482,13 @@ pub fn markdown(verdicts: &[RuleVerdicts]) -> String {
     };
     if verdicts.iter().any(in_doubt) {
         md.push_str(
-            "\"Not rejected, SE in doubt\": neither test rejects, but the rule flagged a \
-             repeat's standard error as resting on a few samples (an infinite variance, a rare \
-             event) or on samples all alike, so the tests assume error bars that nothing vouches \
-             for.\n\n",
+            "\"Not rejected, SE in doubt\": the rule itself doubted the standard error of the \
+             repeats counted beside it (a sample variance carried by a few samples, as of an \
+             infinite variance or a rare event; samples or walks all alike; an error that is a \
+             bound), and neither the tests nor the coverage reject: the error bars rest on the \
+             repeats' agreement alone. Where the rule doubted its error bars, error bars larger \
+             than the spread are in doubt too, and a coverage below what 95% error bars make \
+             likely at the level (one-sided binomial) is \"SE too small\".\n\n",
         );
     }
     for v in verdicts {
@@ -467,8 +508,13 @@ pub fn markdown(verdicts: &[RuleVerdicts]) -> String {
         for (b, j) in &v.budgets {
             let _ = writeln!(
                 md,
-                "| {} | {} | {b} | {} | {} | {} | {} | {} | {} |",
+                "| {}{} | {} | {b} | {} | {} | {} | {} | {} | {} |",
                 j.verdict.words(),
+                if j.doubted > 0 {
+                    format!(" ({} of {} flagged)", j.doubted, j.repeats)
+                } else {
+                    String::new()
+                },
                 v.label,
                 j.repeats,
                 number(j.t, j.repeats),

@@ -109,20 +109,37 @@ pub fn validate_from<F: Family>(
     // rule and quantity; a pair left with none is an error, so no rule
     // silently disappears from a quantity's table.
     let largest = budgets.last().copied().unwrap_or(0);
+    let mut short = Vec::new();
     for (i, m) in spec.rules.iter().enumerate() {
-        for &q in &spec.quantities {
-            let need = quantity_min_budget::<F>(&scene, m, q);
-            if largest < need {
-                return Err(SpecError::at(
-                    "budgets",
-                    format!(
-                        "no budget reaches what rules[{i}] ({}) needs for {}: at least {need}",
-                        m.name(),
-                        q.name()
-                    ),
-                ));
-            }
-        }
+        let unmet: Vec<(&str, usize)> = spec
+            .quantities
+            .iter()
+            .map(|&q| (q.name(), quantity_min_budget::<F>(&scene, m, q)))
+            .filter(|&(_, need)| largest < need)
+            .collect();
+        let Some(&(_, need)) = unmet.first() else {
+            continue;
+        };
+        let one = unmet.len() == spec.quantities.len() && unmet.iter().all(|u| u.1 == need);
+        let each: Vec<String> = unmet.iter().map(|(q, n)| format!("{n} for {q}")).collect();
+        short.push(if one {
+            format!("rules[{i}] ({}) needs at least {need}", m.name())
+        } else {
+            format!(
+                "rules[{i}] ({}) needs at least {}",
+                m.name(),
+                each.join(", ")
+            )
+        });
+    }
+    if !short.is_empty() {
+        return Err(SpecError::at(
+            "budgets",
+            format!(
+                "the largest budget, {largest}, is below what some rules need: {}",
+                short.join("; ")
+            ),
+        ));
     }
     check_cost::<F>(&spec, &scene, &budgets)?;
     let known = known_values::<F>(&spec, &scene, hash, &origin)?;
