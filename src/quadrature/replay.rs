@@ -87,7 +87,7 @@ impl<T: Copy> Log<T> {
     /// [`Log::rewind`]): a bounds check and a store. True when it was logged.
     #[inline(always)]
     pub fn push(&mut self, item: T) -> bool {
-        if self.items.len() < self.items.capacity() {
+        if self.items.len() < self.items.capacity().min(self.cap) {
             self.items.push(item);
             true
         } else {
@@ -195,7 +195,7 @@ impl<R: rand::Rng + ?Sized> LoggedRng<'_, R> {
     fn fresh(&mut self, draw: Draw) {
         if self.replaying {
             let _ = self.log.append(draw);
-        } else if self.log.items.len() < self.log.items.capacity() {
+        } else if self.log.items.len() < self.log.items.capacity().min(self.log.cap) {
             self.log.items.push(draw);
         } else {
             self.log.grow_with(draw);

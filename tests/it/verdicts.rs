@@ -82,6 +82,12 @@ fn where_the_method_doubted_its_error_bars_the_coverage_decides() {
     heavy.push((1.5, 0.5));
     let j = judge_budget(std::slice::from_ref(&heavy), &[1.0], &[0.0], 1e-6);
     assert_eq!(j.covered, [1, 10]);
+    let exact = 0.05f64.powi(10) + 10.0 * 0.95 * 0.05f64.powi(9);
+    assert!(
+        (j.p_coverage - exact).abs() < 1e-12 * exact,
+        "{}",
+        j.p_coverage
+    );
     assert_eq!(j.verdict, Verdict::Consistent, "{j:?}");
     // Undoubted, it stays consistent; with one repeat doubted, the
     // coverage decides: P(X <= 1 | Binomial(10, 0.95)) = 0.05^10 + 10 *
@@ -89,13 +95,13 @@ fn where_the_method_doubted_its_error_bars_the_coverage_decides() {
     assert_eq!(j.clone().in_doubt(0, 1e-6).verdict, Verdict::Consistent);
     let d = j.in_doubt(1, 1e-6);
     assert_eq!((d.verdict, d.doubted), (Verdict::SeTooSmall, 1));
-    // Nine of ten covered: P(X <= 9) = 1 - 0.95^10 = 0.4013: in doubt.
+    // Every repeat covered (P(X <= 10) = 1): in doubt.
     let fine: Vec<(f64, f64)> = (0..10)
         .map(|i| (1.0 + 0.01 * ((i % 5) as f64 - 2.0) / 1.4, 0.01))
         .collect();
     let j = judge_budget(&[fine], &[1.0], &[0.0], 0.01);
     assert_eq!(j.verdict, Verdict::Consistent, "{j:?}");
-    assert!(j.covered[0] >= 9, "{j:?}");
+    assert_eq!((j.covered, j.p_coverage), ([10, 10], 1.0), "{j:?}");
     assert_eq!(j.in_doubt(3, 0.01).verdict, Verdict::SeInDoubt);
     // Error bars that are a bound (every walk alike, sd = 0): too large
     // undoubted, in doubt where the method said so. A bias stands.
@@ -106,6 +112,24 @@ fn where_the_method_doubted_its_error_bars_the_coverage_decides() {
     let off: Vec<(f64, f64)> = (0..6).map(|i| (2.0 + 0.001 * i as f64, 0.001)).collect();
     let j = judge_budget(&[off], &[1.0], &[0.0], 0.01);
     assert_eq!(j.in_doubt(6, 0.01).verdict, Verdict::Biased);
+    // Coverage is judged per channel: three channels of one repeat share its
+    // samples, so 7 of 10 in each (p = 0.0115 per channel) is not 21 of 30
+    // independent trials (p = 1.1e-5).
+    let seven: Vec<(f64, f64)> = (0..10)
+        .map(|i| (1.0 + if i < 7 { 0.0 } else { 0.05 }, 0.01))
+        .collect();
+    let j = judge_budget(
+        &[seven.clone(), seven.clone(), seven],
+        &[1.0; 3],
+        &[0.0; 3],
+        1e-3,
+    );
+    assert_eq!(j.covered, [21, 30]);
+    assert!(
+        (j.p_coverage - 0.011_503_557_379_296_873).abs() < 1e-12,
+        "{}",
+        j.p_coverage
+    );
 }
 
 /// One experiment of the calibration family, `int_0^1 e^x dx`, with

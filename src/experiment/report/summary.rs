@@ -166,6 +166,10 @@ pub struct RowSummary {
     pub verdict: Option<VerdictSummary>,
 }
 
+fn one() -> f64 {
+    1.0
+}
+
 /// The tests of a random rule at one budget
 /// ([`crate::experiment::report::verdict`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -188,6 +192,10 @@ pub struct VerdictSummary {
     pub covered: [usize; 2],
     /// The coverage's Wilson 95% interval.
     pub coverage: Option<[f64; 2]>,
+    /// The coverage's one-sided binomial p-value against 95% error bars,
+    /// the smallest over the channels (1 where no standard error is given).
+    #[serde(default = "one")]
+    pub p_coverage: f64,
     /// Repeats whose standard error the method itself doubted (a variance
     /// carried by a few samples, samples or walks all alike); where any is,
     /// `verdict` weighs the coverage ([`crate::experiment::report::verdict::Judged::in_doubt`]).
@@ -330,6 +338,7 @@ fn quantity(page: &Page, i: usize, s: &Section) -> QuantitySummary {
                             se_ratio: j.se_ratio.and_then(finite),
                             covered: j.covered,
                             coverage: j.coverage,
+                            p_coverage: j.p_coverage,
                             doubted: j.doubted,
                         })
                     });

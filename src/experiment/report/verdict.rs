@@ -54,10 +54,12 @@ pub enum Verdict {
     SeTooSmall,
     /// The values spread less than the standard errors say.
     SeTooLarge,
-    /// Neither test rejects, but the method doubted a repeat's standard
-    /// error (a sample variance carried by a few samples, as of an
-    /// infinite-variance integrand or a rare event, or samples all alike):
-    /// the tests assume error bars that nothing vouches for.
+    /// The method doubted a repeat's standard error (a sample variance
+    /// carried by a few samples, as of an infinite-variance integrand or a
+    /// rare event, or samples all alike), no bias was found, and the error
+    /// bars were not found too small: neither test nor the coverage
+    /// rejected them, or the error-bar test found them too large, as a
+    /// bound is ([`Judged::in_doubt`]).
     SeInDoubt,
     /// The mean is the reference, but the method gives no standard error.
     NoSe,
@@ -102,6 +104,11 @@ pub struct Judged {
     pub coverage: Option<[f64; 2]>,
     /// What they say at the per-test level.
     pub verdict: Verdict,
+    /// The smallest over the channels of `P(X <= k)`, `X ~ Binomial(R,
+    /// 0.95)`, `k` the channel's repeats within 1.96 standard errors: how
+    /// likely so few are from honest error bars (1 where none is given).
+    /// Per channel, as the channels of one repeat share its samples.
+    pub p_coverage: f64,
     /// Repeats whose standard error the method itself doubted
     /// ([`Judged::in_doubt`]).
     pub doubted: usize,
@@ -125,7 +132,7 @@ impl Judged {
         }
         self.verdict = match self.verdict {
             Verdict::SeTooLarge => Verdict::SeInDoubt,
-            Verdict::Consistent if coverage_p(self.covered) < level => Verdict::SeTooSmall,
+            Verdict::Consistent if self.p_coverage < level => Verdict::SeTooSmall,
             Verdict::Consistent => Verdict::SeInDoubt,
             other => other,
         };
@@ -163,6 +170,7 @@ pub fn judge_budget(
         covered: [0, 0],
         coverage: None,
         verdict: Verdict::TooFewRepeats,
+        p_coverage: 1.0,
         doubted: 0,
     };
     if repeats < 2 {
@@ -179,10 +187,13 @@ pub fn judge_budget(
             out.p_bias = p;
         }
         has_se &= xs.iter().all(|(_, s)| s.is_finite());
+        let mut channel = [0, 0];
         for &(v, s) in xs.iter().filter(|(_, s)| s.is_finite()) {
-            out.covered[1] += 1;
-            out.covered[0] += usize::from((v - r).abs() <= 1.96 * s + tol);
+            channel[1] += 1;
+            channel[0] += usize::from((v - r).abs() <= 1.96 * s + tol);
         }
+        out.covered = [out.covered[0] + channel[0], out.covered[1] + channel[1]];
+        out.p_coverage = out.p_coverage.min(coverage_p(channel));
         if let Some((ratio, p)) = spread(xs) {
             let off = ratio.ln().abs();
             if out.p_se.is_none_or(|q| p < q) || (out.p_se == Some(p) && off > worst_log_ratio) {
@@ -475,20 +486,17 @@ pub fn markdown(verdicts: &[RuleVerdicts]) -> String {
          coverage is the share of repeats within 1.96 standard errors of the reference, with \
          its Wilson 95% interval (about 95% for honest error bars).\n\n"
     );
-    let in_doubt = |v: &RuleVerdicts| {
-        v.budgets
-            .iter()
-            .any(|(_, j)| j.verdict == Verdict::SeInDoubt)
-    };
+    let in_doubt = |v: &RuleVerdicts| v.budgets.iter().any(|(_, j)| j.doubted > 0);
     if verdicts.iter().any(in_doubt) {
         md.push_str(
-            "\"Not rejected, SE in doubt\": the rule itself doubted the standard error of the \
-             repeats counted beside it (a sample variance carried by a few samples, as of an \
-             infinite variance or a rare event; samples or walks all alike; an error that is a \
-             bound), and neither the tests nor the coverage reject: the error bars rest on the \
-             repeats' agreement alone. Where the rule doubted its error bars, error bars larger \
-             than the spread are in doubt too, and a coverage below what 95% error bars make \
-             likely at the level (one-sided binomial) is \"SE too small\".\n\n",
+            "Where the rule itself doubted the standard error of some repeats (counted beside \
+             the verdict: a sample variance carried by a few samples, as of an infinite variance \
+             or a rare event; samples or walks all alike; an error that is a bound), the \
+             error-bar test cannot lean on those error bars: error bars larger than the spread \
+             are \"not rejected, SE in doubt\", and where neither test rejects the coverage \
+             decides, \"SE too small\" where a channel's coverage is below what 95% error bars \
+             make likely at the level (one-sided binomial), else \"not rejected, SE in doubt\": \
+             the error bars rest on the repeats' agreement alone.\n\n",
         );
     }
     for v in verdicts {

@@ -5,7 +5,7 @@ use crate::error::SpecError;
 use crate::experiment::spec::ExperimentSpec;
 use crate::family::Family;
 
-use super::{min_budget, quantities_at};
+use super::{min_budget, quantities_at, quantity_min_budget};
 
 /// The most integrand evaluations one job may cost by its family's estimate
 /// ([`Family::cost`]): 1e11, minutes to hours at a nanosecond or more per
@@ -83,14 +83,18 @@ pub(super) fn check_cost<F: Family>(
             // blob of amplitude 1e307 collides about that often a walk):
             // lowering the budget, the advice given, could not help. (The
             // experiment's own smallest budget said so of any single budget.)
+            // Each quantity at its own minimum: the least any budget list
+            // that passes the minimums can cost.
             let least = min_budget::<F>(scene, listed, &spec.quantities);
-            let at_least: f64 = quantities_at::<F>(scene, listed, &spec.quantities, least)
-                .into_iter()
-                .map(|q| F::cost(scene, m, least, q))
+            let at_least: f64 = spec
+                .quantities
+                .iter()
+                .map(|&q| F::cost(scene, m, quantity_min_budget::<F>(scene, listed, q), q))
                 .sum();
             let advice = if at_least.is_nan() || at_least > MAX_JOB_EVALUATIONS {
                 format!(
-                    "even at budget {least} it costs about {at_least:.1e}, so this scene makes the \
+                    "even with each quantity at its smallest budget (from {least}) it costs about \
+                     {at_least:.1e}, so this scene makes the \
                      rule too dear at any budget: remove rules[{i}] or change the scene (a \
                      tracking walk through a deep or loose majorant makes many look-ups)"
                 )

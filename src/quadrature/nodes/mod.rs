@@ -83,11 +83,12 @@ pub struct ProductSum<V: Value> {
 /// With [`line_sum_par`], the only place where a deterministic rule meets
 /// the integrand.
 /// A non-finite integrand value stops the sum with an error naming the point
-/// (on one axis, at the end of the block of 256 nodes it is in). Finite
-/// values within rounding of `f64::MAX`, whose sum passes it on the way,
-/// are summed on one axis (see [`crate::sum::Lanes::total`]), the rule's
-/// own sum always: its terms are spread over four lanes, each some quarter
-/// of the sum. A companion whose weights are zero at three nodes of four
+/// (on one axis of 16 nodes or more, at the end of the block of 256 nodes it
+/// is in; below 16, at once). Finite values within rounding of `f64::MAX`,
+/// whose sum passes it on the way, are summed on one axis (see
+/// [`crate::sum::Lanes::total`]), the rule's own sum always: its terms are
+/// spread over four lanes, each some quarter of the sum (below 16 nodes,
+/// summed again at a quarter of their size). A companion whose weights are zero at three nodes of four
 /// (a composite rule's `4h` and `8h` rules) puts all its terms in one lane,
 /// whose running sum can pass `f64::MAX` where the total would not; such
 /// a sum, and in two and more dimensions any, is
