@@ -27,10 +27,10 @@
 
 use std::fmt;
 
-use statrs::distribution::{Binomial, ContinuousCDF, DiscreteCDF, Normal, StudentsT};
+use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
 
 use crate::error::QuadError;
-use crate::experiment::report::verdict::wilson;
+use crate::experiment::report::verdict::{coverage_p, wilson};
 
 use super::{Truth, check_alpha, check_count, repeat_rng, sidak};
 
@@ -535,7 +535,7 @@ fn coverage_check(c: usize, d: &[(f64, Option<f64>)], r: f64, tol: f64, level: f
         .iter()
         .filter(|(x, s)| (x - r).abs() <= 1.96 * s.unwrap_or(0.0) + tol)
         .count();
-    let p = Binomial::new(0.95, n as u64).map_or(0.0, |b| b.cdf(k as u64));
+    let p = coverage_p([k, n]);
     let [lo, hi] = wilson(k, n);
     Check {
         kind: CheckKind::Coverage,

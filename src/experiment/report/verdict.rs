@@ -142,7 +142,7 @@ impl Judged {
 
 /// `P(X <= k)` for `X ~ Binomial(n, 0.95)`, `[k, n] = covered`: how likely
 /// so few covered repeats are from honest 95% error bars (1 with none).
-fn coverage_p([k, n]: [usize; 2]) -> f64 {
+pub(crate) fn coverage_p([k, n]: [usize; 2]) -> f64 {
     use statrs::distribution::{Binomial, DiscreteCDF};
     if n == 0 {
         return 1.0;

@@ -313,11 +313,16 @@ fn scalar_line_sum<V: Value>(
     let [c, c4, c8] = companions.map(|c| c.map(|(_, sum)| sum.total()));
     let mut total = value.total();
     if !total.all_finite() {
+        // Only the channels that passed the range: a quarter of a
+        // subnormal term loses bits.
         let mut quarter = Compensated::<V>::new();
         for wy in &terms[..a.len()] {
             quarter.add(wy.map(|v| 0.25 * v));
         }
-        total = quarter.total().map(|v| 4.0 * v);
+        total = total.zip(
+            quarter.total(),
+            |t, q| if t.is_finite() { t } else { 4.0 * q },
+        );
     }
     in_range(ProductSum {
         value: total,
