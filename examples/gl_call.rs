@@ -30,8 +30,8 @@ fn main() {
         s += match which {
             "bilby" => bil.rule().integrate(a, b, |x: f64| (50.0 * x).cos()),
             "raw" => {
-                let nodes = lightquad::quadrature::gauss_legendre::unit_nodes(n).expect("nodes");
-                lightquad::quadrature::nodes::product_sum([nodes.as_ref()], |u: [f64; 1]| {
+                let nodes = lightquad::quadrature::gauss_legendre::unit_rule(n).expect("nodes");
+                lightquad::quadrature::nodes::product_sum([&*nodes], |u: [f64; 1]| {
                     Ok((50.0 * (a + h * u[0])).cos())
                 })
                 .map(|s| s.value * h)

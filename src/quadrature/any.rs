@@ -135,6 +135,12 @@ impl Rule for AnyRule {
             AnyRule::Product(r) => r.is_random(),
         }
     }
+    fn guarded(&self, dim: usize) -> bool {
+        match self {
+            AnyRule::Base(r) => r.guarded(dim),
+            AnyRule::Product(r) => r.guarded(dim),
+        }
+    }
     fn dimensions(&self) -> Dimensions {
         match self {
             AnyRule::Base(r) => r.dimensions(),

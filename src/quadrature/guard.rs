@@ -40,6 +40,9 @@ pub(super) fn try_integrate<
             ),
         ));
     }
+    if !rule.guarded(D) {
+        return rule.integrate_unguarded(n, rng, f);
+    }
     let promise = (n as u64).max(rule.evaluations(n, D) as u64);
     let mut points = replay::Log::<([f64; D], V)>::new();
     let mut draws = replay::Log::<replay::Draw>::new();

@@ -23,15 +23,22 @@ pub const MAX_BUDGET: usize = 1 << 40;
 /// Refuses a budget above [`MAX_BUDGET`]: every rule's entry points, the
 /// unguarded ones included (a trapezoid in three dimensions at `usize::MAX`
 /// ran on for 1.8e19 evaluations).
+#[inline]
 pub(crate) fn check_budget(n: usize) -> Result<(), QuadError> {
     if n > MAX_BUDGET {
-        return Err(QuadError::invalid(
-            "n",
-            n,
-            format!("a budget of at most 2^40 = {MAX_BUDGET} evaluations"),
-        ));
+        return Err(over_budget(n));
     }
     Ok(())
+}
+
+/// [`check_budget`]'s error, out of the line of every rule's call.
+#[cold]
+fn over_budget(n: usize) -> QuadError {
+    QuadError::invalid(
+        "n",
+        n,
+        format!("a budget of at most 2^40 = {MAX_BUDGET} evaluations"),
+    )
 }
 
 /// The most working memory one integral may need by its rule's own
@@ -43,6 +50,7 @@ pub(crate) fn check_budget(n: usize) -> Result<(), QuadError> {
 pub const MAX_RULE_BYTES: f64 = 32.0 * (1u64 << 30) as f64;
 
 /// The largest `m` with `m^dim <= n` (`n` itself for `dim <= 1`).
+#[inline]
 pub fn integer_root(n: usize, dim: usize) -> usize {
     if dim <= 1 {
         return n;

@@ -116,6 +116,19 @@ pub trait Rule {
         false
     }
 
+    /// Whether a pass in `dim` dimensions needs [`Rule::try_integrate`]'s
+    /// guard: true unless all the rule computes from the values is one
+    /// weighted sum, with weights that sum to 1, which it finds within the
+    /// f64 range or refuses ([`QuadError::SumOutOfRange`]), and it reports
+    /// no error estimate (an infinite error). Such a sum does not overflow
+    /// where its values do not, an exact rescaling would give it back
+    /// unchanged, and there is no error to underflow: the guard's log and
+    /// checks would cost a few-node integral more than its integrand
+    /// (Gauss–Legendre without its estimate in one dimension).
+    fn guarded(&self, _dim: usize) -> bool {
+        true
+    }
+
     /// The dimensions the rule integrates over.
     fn dimensions(&self) -> Dimensions {
         Dimensions::ANY
@@ -350,6 +363,9 @@ macro_rules! registry {
             }
             fn is_random(&self) -> bool {
                 match self { $(BaseRule::$rule(r) => r.is_random(),)+ }
+            }
+            fn guarded(&self, dim: usize) -> bool {
+                match self { $(BaseRule::$rule(r) => r.guarded(dim),)+ }
             }
             fn dimensions(&self) -> Dimensions {
                 match self { $(BaseRule::$rule(r) => r.dimensions(),)+ }

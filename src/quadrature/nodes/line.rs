@@ -277,58 +277,60 @@ pub(super) fn line_sum<V: Value>(
     in_range(sum.finish(a))
 }
 
-/// [`line_sum`] of a few nodes: one compensated running sum per weight
-/// set, `sum |w y|` and the largest term, term by term, each value checked
-/// finite as it comes. The lanes' groups and blocks cost more than a few
-/// terms: at n = 5 they were some 1000 instructions a call of fixed cost,
-/// against 440 for the five cosines of `cos(50 x)` (callgrind).
+/// [`line_sum`] of a few nodes: the values first, each checked finite
+/// as it comes, then one pass over them (a compensated running sum per
+/// weight set, `sum |w y|` and the largest term). The lanes' groups and
+/// blocks cost more than a few terms (at n = 5 some 1000 instructions a
+/// call, against 440 for the five cosines of `cos(50 x)`, by callgrind);
+/// and sums carried across the integrand's calls are stored and reloaded
+/// at each node, where the pass after them keeps them in registers.
 ///
 /// The rule's own sum is found as the lanes find it where finite terms'
 /// running sum passes `f64::MAX` on the way to a total within range (14
-/// nodes of `f64::MAX`): the terms, kept, are summed again at a quarter of
-/// their size and the total scaled back ([`crate::sum::Lanes::total`]).
+/// nodes of `f64::MAX`): summed again at a quarter of their size, the
+/// total scaled back ([`crate::sum::Lanes::total`]).
 fn scalar_line_sum<V: Value>(
     a: &UnitNodes,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<ProductSum<V>, QuadError> {
-    let mut terms = [V::zero(); LANES_FROM];
-    let mut value = Compensated::<V>::new();
-    let mut companions = [&a.companion, &a.companion4, &a.companion8]
-        .map(|w| w.as_deref().map(|w| (w, Compensated::<V>::new())));
-    let (mut magnitude, mut largest) = (V::zero(), V::zero());
-    for (i, (&u, &w)) in a.u.iter().zip(&a.w).enumerate() {
-        let y = f(u)?;
+    let mut ys = [V::zero(); LANES_FROM];
+    for (y, &u) in ys.iter_mut().zip(&a.u) {
+        *y = f(u)?;
         if !y.all_finite() {
-            return Err(non_finite(&[u], &y));
-        }
-        let wy = y.map(|v| v * w);
-        terms[i] = wy;
-        value.add(wy);
-        magnitude = magnitude.zip(wy, |m, v| m + v.abs());
-        largest = largest.zip(wy, |m, v| m.max(v.abs()));
-        for (weights, sum) in companions.iter_mut().flatten() {
-            sum.add(y.map(|v| v * weights[i]));
+            return Err(non_finite(&[u], y));
         }
     }
-    let [c, c4, c8] = companions.map(|c| c.map(|(_, sum)| sum.total()));
+    let ys = &ys[..a.len()];
+    let mut value = Compensated::<V>::new();
+    let (mut magnitude, mut largest) = (V::zero(), V::zero());
+    for (y, &w) in ys.iter().zip(&a.w) {
+        let wy = y.map(|v| v * w);
+        value.add(wy);
+        magnitude = magnitude.zip(wy, |m, v| m + v.abs());
+        // The values are finite: a comparison, not `f64::max`'s NaN case.
+        largest = largest.zip(wy, |m, v| if v.abs() > m { v.abs() } else { m });
+    }
+    // `sum scale w_i y_i`, compensated.
+    let weighted = |weights: &[f64], scale: f64| {
+        let mut sum = Compensated::<V>::new();
+        for (y, &w) in ys.iter().zip(weights) {
+            sum.add(y.map(|v| v * (scale * w)));
+        }
+        sum.total()
+    };
     let mut total = value.total();
     if !total.all_finite() {
         // Only the channels that passed the range: a quarter of a
         // subnormal term loses bits.
-        let mut quarter = Compensated::<V>::new();
-        for wy in &terms[..a.len()] {
-            quarter.add(wy.map(|v| 0.25 * v));
-        }
-        total = total.zip(
-            quarter.total(),
-            |t, q| if t.is_finite() { t } else { 4.0 * q },
-        );
+        let quarter = weighted(&a.w, 0.25);
+        total = total.zip(quarter, |t, q| if t.is_finite() { t } else { 4.0 * q });
     }
+    let companion = |weights: &Option<Vec<f64>>| weights.as_deref().map(|c| weighted(c, 1.0));
     in_range(ProductSum {
         value: total,
-        companion: c,
-        companion4: c4,
-        companion8: c8,
+        companion: companion(&a.companion),
+        companion4: companion(&a.companion4),
+        companion8: companion(&a.companion8),
         magnitude,
         largest,
         evaluations: a.len() as u64,

@@ -120,11 +120,15 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
     }
 
     if D == 1 {
-        return line_sum(axes[0], move |u| {
-            let mut p = [0.0; D];
-            p[0] = u;
-            f(p)
-        });
+        return line_sum(
+            axes[0],
+            #[inline(always)]
+            move |u| {
+                let mut p = [0.0; D];
+                p[0] = u;
+                f(p)
+            },
+        );
     }
     // D dimensions: walk the index odometer.
     let mut idx = [0usize; D];
@@ -199,27 +203,40 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
 /// pass the range). `sum |w f|` passes `f64::MAX` only by rounding (it is
 /// at most `max |f|` times the weights' sum, 1), so it is kept at
 /// `f64::MAX`: a scale of rounding, not a value.
+#[inline]
 fn in_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError> {
+    let finite = |s: Option<V>| s.is_none_or(|s| s.all_finite());
+    if sum.value.all_finite()
+        && finite(sum.companion)
+        && finite(sum.companion4)
+        && finite(sum.companion8)
+    {
+        return Ok(ProductSum {
+            magnitude: sum.magnitude.map(|m| m.min(f64::MAX)),
+            ..sum
+        });
+    }
+    out_of_range(sum)
+}
+
+/// [`in_range`]'s error, naming the first sum that is not finite.
+#[cold]
+fn out_of_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError> {
     let sums = [
         ("value", Some(sum.value)),
         ("companion", sum.companion),
         ("companion4", sum.companion4),
         ("companion8", sum.companion8),
     ];
-    match sums
+    let (name, out) = sums
         .into_iter()
         .find_map(|(name, s)| s.filter(|s| !s.all_finite()).map(|s| (name, s)))
-    {
-        None => Ok(ProductSum {
-            magnitude: sum.magnitude.map(|m| m.min(f64::MAX)),
-            ..sum
-        }),
-        Some((name, out)) => Err(QuadError::SumOutOfRange {
-            sum: name,
-            value: format!("{out:?}"),
-            largest: format!("{:?}", sum.largest),
-        }),
-    }
+        .unwrap_or(("value", sum.value));
+    Err(QuadError::SumOutOfRange {
+        sum: name,
+        value: format!("{out:?}"),
+        largest: format!("{:?}", sum.largest),
+    })
 }
 
 /// The error for a non-finite integrand value at unit-cube point `p`.
