@@ -469,6 +469,9 @@ struct Products<'a, V: Value> {
 
 impl<V: Value> KernelTask<V> for Products<'_, V> {
     type Output = ();
+    /// Inlined into the kernel's function, where the AVX pass's
+    /// intrinsics inline too (a call of its own left each intrinsic one).
+    #[inline(always)]
     fn run(self, kernel: impl Kernel<V>, _: &()) {
         match self.scale {
             Some((magnitude, largest)) => self

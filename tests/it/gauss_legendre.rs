@@ -366,3 +366,48 @@ fn node_building_blocks_and_unguarded_rules_refuse_out_of_range_input() {
         .expect_err("beyond the budget limit");
     assert!(e.to_string().contains("2^40"), "{e}");
 }
+
+/// Without its estimate in one dimension the rule runs unguarded
+/// (`Rule::guarded`): values beyond 2^500, near `f64::MAX`, and not finite
+/// give what the guarded rule gives. The closed form `int_0^1 s cos(50 u)
+/// du = s sin(50)/50`; the guarded rule's own sum at the same nodes (with
+/// its estimate on it rescales by a power of two, exactly) bit for bit.
+#[test]
+fn without_its_estimate_the_unguarded_rule_gives_the_guarded_sums() {
+    let bare = GaussLegendre {
+        error_estimate: false,
+    };
+    assert!(!bare.guarded(1) && bare.guarded(2) && GaussLegendre::default().guarded(1));
+    let mut rng = rng(1);
+    let scale = 1e300;
+    let exact = scale * 50f64.sin() / 50.0;
+    for n in [5, 15, 16, 20, 100, 127, 128, 1000] {
+        let f = |u: [f64; 1]| Ok(scale * (50.0 * u[0]).cos());
+        let lean = bare.try_integrate(n, &mut rng, f).expect("sum");
+        let guarded = GaussLegendre::default()
+            .try_integrate(n, &mut rng, f)
+            .expect("sum");
+        assert_eq!(lean.value.to_bits(), guarded.value.to_bits(), "n = {n}");
+        assert!(lean.error.is_infinite() && lean.evaluations == n as u64);
+        if n >= 100 {
+            assert!(((lean.value - exact) / exact).abs() < 1e-13, "n = {n}");
+        }
+        let max = bare
+            .try_integrate(n, &mut rng, |_: [f64; 1]| Ok(f64::MAX))
+            .expect("a sum within range");
+        assert!(
+            max.value >= f64::MAX * (1.0 - 1e-12),
+            "n = {n}: {:e}",
+            max.value
+        );
+        let nan = bare.try_integrate(n, &mut rng, |u: [f64; 1]| {
+            Ok(if u[0] > 0.5 { f64::NAN } else { 1.0 })
+        });
+        match nan {
+            Err(QuadError::NonFiniteIntegrand { point, .. }) => {
+                assert!(point[0] > 0.5, "n = {n}: {point:?}")
+            }
+            other => panic!("n = {n}: {other:?}"),
+        }
+    }
+}

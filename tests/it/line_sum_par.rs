@@ -108,8 +108,11 @@ fn all_bits(s: &ProductSum<f64>) -> Vec<u64> {
 #[test]
 fn up_to_one_span_the_bits_are_product_sums() {
     let f = |u: f64| Ok((7.0 * u).sin() - u);
-    // Around a block of 256 nodes, and the most one span holds.
-    for n in [1, 63, 64, 255, 256, 257, 1000, PAR_SPAN] {
+    // Around the few-node sums (16 and 128 nodes), a block of 256 nodes,
+    // and the most one span holds.
+    for n in [
+        1, 15, 16, 17, 20, 63, 64, 100, 127, 128, 255, 256, 257, 1000, PAR_SPAN,
+    ] {
         let gauss = unit_nodes(n).expect("nodes");
         // The trapezoid rule takes an odd number of points, at least 3.
         let trapezoid = trapezoid::unit_nodes((n - 1 + n % 2).max(3)).expect("nodes");
@@ -484,7 +487,7 @@ fn sums_of_values_near_f64_max_are_found_or_an_error_never_a_nan() {
             assert!(near_max(c), "{what}: companion {c:e}");
         }
     };
-    for n in (1..=15).chain([1000, 100_000, 1_000_000]) {
+    for n in (1..=17).chain([50, 127, 128, 1000, 100_000, 1_000_000]) {
         let nodes = unit_nodes(n).expect("nodes");
         found(
             product_sum([nodes.as_ref()], |_: [f64; 1]| Ok(f64::MAX)),
