@@ -1,10 +1,16 @@
 //! Gauss–Legendre integration at n = 1e6 with cached nodes, lightquad
 //! against `bilby` and `gauss-quad`, timed in interleaved rounds.
 //!
-//! `cargo run --release --example gl_race -- [ROUNDS] [--serial | --parallel] [--n N]`
+//! `cargo run --release --example gl_race -- [ROUNDS] [--serial | --parallel] [--n N] [--calls C]`
 //! (in any order; ROUNDS default 41; `--serial` leaves out the two
 //! parallel contenders, `--parallel` times them alone; N nodes, default
-//! 1e6, 1 to 1e7)
+//! 1e6, 1 to 1e7; C calls a timing, default 1, so that a few-node call,
+//! some 50 ns, is timed in batches well above the clock's resolution)
+//!
+//! `lightquad rule` is the same integral through [`Rule::integrate`] with
+//! the error estimate off (as the peers have none), what a user calls;
+//! `lightquad` is the sum alone (`product_sum`). Up to 100 nodes
+//! `lightquad estimate` times the rule with its estimate on too.
 //!
 //! The same integral as `cargo bench --bench quadrature -- gl_integrate`:
 //! `int_{-1}^{1} cos(50 x) dx`. On a shared machine whose speed drifts
@@ -34,8 +40,10 @@ use std::hint::black_box;
 use std::num::NonZeroUsize;
 use std::time::Instant;
 
-use lightquad::quadrature::gauss_legendre::unit_nodes;
+use lightquad::quadrature::gauss_legendre::{TABLE_MAX_ORDER, unit_nodes};
 use lightquad::quadrature::nodes::{line_sum_par, product_sum};
+use lightquad::quadrature::{GaussLegendre, Rule};
+use rand::SeedableRng;
 
 /// Nodes unless `--n` says otherwise.
 const N: usize = 1_000_000;
@@ -45,6 +53,9 @@ const MAX_N: usize = 10_000_000;
 
 /// Most rounds (some 90 ms each).
 const MAX_ROUNDS: usize = 10_000;
+
+/// Most calls a timing.
+const MAX_CALLS: usize = 10_000_000;
 
 /// `int_{-1}^{1} cos(50 x) dx = sin(50)/25` as `HI + LO`, from the Taylor
 /// series of `sin` in 60-digit decimal arithmetic (Python's `decimal`):
@@ -82,7 +93,16 @@ fn median_interval(v: &mut [f64]) -> Option<(f64, f64)> {
     Some((v[low - 1], v[high - 1]))
 }
 
-type Contender<'a> = (&'static str, Box<dyn Fn() -> f64 + 'a>);
+/// A time in milliseconds, written in ms or, below 0.01 ms, in ns.
+fn duration(ms: f64) -> String {
+    if ms >= 0.01 {
+        format!("{ms:.3} ms")
+    } else {
+        format!("{:.1} ns", ms * 1e6)
+    }
+}
+
+type Contender<'a> = (&'static str, Box<dyn FnMut() -> f64 + 'a>);
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `[ROUNDS] [--serial | --parallel]`, in either order. `--serial`:
@@ -91,6 +111,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // a two-core machine; `--parallel`: those two alone.
     let (mut rounds, mut only, mut n): (Option<usize>, Option<bool>, Option<usize>) =
         (None, None, None);
+    let mut calls: Option<usize> = None;
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         match arg.as_str() {
@@ -101,12 +122,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .ok_or("--n: expected a number of nodes after it")?;
                 n = Some(value.parse().map_err(|e| format!("--n {value:?}: {e}"))?)
             }
+            "--calls" if calls.is_none() => {
+                let value = args
+                    .next()
+                    .ok_or("--calls: expected a number of calls after it")?;
+                calls = Some(value.parse().map_err(|e| format!("--calls {value:?}: {e}"))?)
+            }
             _ if rounds.is_none() && !arg.starts_with('-') => {
                 rounds = Some(arg.parse().map_err(|e| format!("ROUNDS {arg:?}: {e}"))?)
             }
             _ => {
                 return Err(format!(
-                    "{arg:?}: expected [ROUNDS] [--serial | --parallel] [--n N]: one number, one of the two flags, one --n"
+                    "{arg:?}: expected [ROUNDS] [--serial | --parallel] [--n N] [--calls C]: one number, one of the two flags, one --n, one --calls"
                 )
                 .into());
             }
@@ -120,7 +147,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if !(1..=MAX_N).contains(&n) {
         return Err(format!("--n {n}: expected 1 to {MAX_N} nodes").into());
     }
+    let calls = calls.unwrap_or(1);
+    if !(1..=MAX_CALLS).contains(&calls) {
+        return Err(format!("--calls {calls}: expected 1 to {MAX_CALLS}").into());
+    }
     let nodes = unit_nodes(n)?;
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+    let mut rng_estimate = rand_pcg::Pcg64::seed_from_u64(1);
+    let bare = GaussLegendre {
+        error_estimate: false,
+    };
     let bil = bilby::GaussLegendre::new(n)?;
     let gq = gauss_quad::GaussLegendre::new(NonZeroUsize::new(n).ok_or("n = 0")?);
     let (a, b) = (-1.0f64, 1.0f64);
@@ -132,6 +168,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let h = b - a;
                 product_sum([nodes.as_ref()], |u: [f64; 1]| Ok(integrand(a + h * u[0])))
                     .map_or(f64::NAN, |s| s.value * h)
+            }),
+        ),
+        (
+            "lightquad rule",
+            Box::new(|| {
+                let (a, b) = (black_box(a), black_box(b));
+                let h = b - a;
+                bare.integrate(n, &mut rng, |u: [f64; 1]| integrand(a + h * u[0]))
+                    .map_or(f64::NAN, |e| e.value * h)
+            }),
+        ),
+        (
+            "lightquad estimate",
+            Box::new(|| {
+                let (a, b) = (black_box(a), black_box(b));
+                let h = b - a;
+                GaussLegendre::default()
+                    .integrate(n, &mut rng_estimate, |u: [f64; 1]| integrand(a + h * u[0]))
+                    .map_or(f64::NAN, |e| e.value * h)
             }),
         ),
         (
@@ -187,12 +242,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
     ];
     let all: Vec<&str> = contenders.iter().map(|(name, _)| *name).collect();
-    let contenders: Vec<Contender> = contenders
+    let mut contenders: Vec<Contender> = contenders
         .into_iter()
         .filter(|(name, _)| only.is_none_or(|par| name.ends_with(" par") == par))
+        .filter(|(name, _)| *name != "lightquad estimate" || n <= TABLE_MAX_ORDER)
         .collect();
     // One untimed call each: nodes and code paged in.
-    for (_, f) in &contenders {
+    for (_, f) in &mut contenders {
         black_box(f());
     }
     let k = contenders.len();
@@ -205,20 +261,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 (k - 1 - j + r) % k
             };
+            let f = &mut contenders[i].1;
             let start = Instant::now();
-            values[i] = black_box((contenders[i].1)());
-            times[i].push(start.elapsed().as_secs_f64() * 1e3);
+            for _ in 0..calls {
+                values[i] = black_box(f());
+            }
+            times[i].push(start.elapsed().as_secs_f64() * 1e3 / calls as f64);
         }
     }
-    println!("{n} nodes, {rounds} rounds");
+    println!("{n} nodes, {rounds} rounds, {calls} calls a timing");
     println!("| contender | median | least | error |");
     println!("|---|---:|---:|---:|");
     for (i, (name, _)) in contenders.iter().enumerate() {
         let mut t = times[i].clone();
         println!(
-            "| {name} | {:.3} ms | {:.3} ms | {:.1e} |",
-            quantile(&mut t, 0.5),
-            quantile(&mut t, 0.0),
+            "| {name} | {} | {} | {:.1e} |",
+            duration(quantile(&mut t, 0.5)),
+            duration(quantile(&mut t, 0.0)),
             ((values[i] - EXACT_HI) - EXACT_LO).abs()
         );
     }
@@ -227,6 +286,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("|---|---:|---:|---:|");
     let index = |name: &str| contenders.iter().position(|(n, _)| *n == name);
     for (num, den) in [
+        ("lightquad rule", "bilby"),
+        ("lightquad rule", "gauss-quad"),
+        ("lightquad rule", "lightquad"),
+        ("lightquad estimate", "lightquad rule"),
         ("lightquad", "bilby"),
         ("lightquad", "gauss-quad"),
         ("lightquad", "plain loop"),

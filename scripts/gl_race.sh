@@ -2,7 +2,7 @@
 # Runs examples/gl_race.rs in several processes and prints, for each paired
 # ratio, every process's median and the median over processes.
 #
-#   bash scripts/gl_race.sh [PROCESSES] [ROUNDS] [--serial | --parallel] [--n N]
+#   bash scripts/gl_race.sh [PROCESSES] [ROUNDS] [--serial | --parallel] [--n N] [--calls C]
 #
 # (defaults 7 processes of 201 rounds, every contender, 1e6 nodes; what
 # follows ROUNDS goes to gl_race as it is). One process's
@@ -19,7 +19,7 @@ processes=${1:-7}
 rounds=${2:-201}
 rest=("${@:3}")
 case "$processes$rounds" in
-  *[!0-9]* | '') echo "usage: $0 [PROCESSES] [ROUNDS] [--serial | --parallel] [--n N]" >&2; exit 2 ;;
+  *[!0-9]* | '') echo "usage: $0 [PROCESSES] [ROUNDS] [--serial | --parallel] [--n N] [--calls C]" >&2; exit 2 ;;
 esac
 if [ "$processes" -lt 1 ]; then
   echo "PROCESSES $processes: expected at least 1" >&2
