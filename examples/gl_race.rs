@@ -126,7 +126,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let value = args
                     .next()
                     .ok_or("--calls: expected a number of calls after it")?;
-                calls = Some(value.parse().map_err(|e| format!("--calls {value:?}: {e}"))?)
+                calls = Some(
+                    value
+                        .parse()
+                        .map_err(|e| format!("--calls {value:?}: {e}"))?,
+                )
             }
             _ if rounds.is_none() && !arg.starts_with('-') => {
                 rounds = Some(arg.parse().map_err(|e| format!("ROUNDS {arg:?}: {e}"))?)

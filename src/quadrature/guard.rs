@@ -8,8 +8,41 @@ use crate::value::Value;
 
 use super::{MAX_RULE_BYTES, Rule, check_budget, replay};
 
-/// [`Rule::try_integrate`] of `rule` (its documentation says what is
-/// guarded and how).
+/// Refuses a budget above [`super::MAX_BUDGET`] and one whose working
+/// memory ([`Rule::memory`]) would pass [`MAX_RULE_BYTES`]: G7-K15 at n =
+/// 2^40 grew to gigabytes until the machine ran out.
+#[inline]
+pub(super) fn check_limits<Q: Rule + ?Sized>(
+    rule: &Q,
+    n: usize,
+    dim: usize,
+) -> Result<(), QuadError> {
+    check_budget(n)?;
+    let bytes = rule.memory(n, dim);
+    if bytes > MAX_RULE_BYTES {
+        return Err(too_much_memory(rule.name(), n, bytes));
+    }
+    Ok(())
+}
+
+/// [`check_limits`]'s error for a rule that would need `bytes` at `n`.
+#[cold]
+fn too_much_memory(rule: &str, n: usize, bytes: f64) -> QuadError {
+    QuadError::invalid(
+        "n",
+        n,
+        format!(
+            "a budget whose working memory fits: {rule} needs about {:.0} GB at this n, at \
+             most {:.0} GB is accepted",
+            bytes / 1e9,
+            MAX_RULE_BYTES / 1e9
+        ),
+    )
+}
+
+/// [`Rule::try_integrate`] of a rule that is [`Rule::guarded`], its
+/// limits checked ([`check_limits`]); its documentation says what is
+/// guarded and how.
 pub(super) fn try_integrate<
     Q: Rule + ?Sized,
     const D: usize,
@@ -22,27 +55,6 @@ pub(super) fn try_integrate<
     rng: &mut R,
     mut f: F,
 ) -> Result<Estimate<V>, QuadError> {
-    check_budget(n)?;
-    // Working memory that grows with n (an adaptive rule's intervals, a
-    // node table): G7-K15 at n = 2^40 grew to gigabytes until the machine
-    // ran out.
-    let bytes = rule.memory(n, D);
-    if bytes > MAX_RULE_BYTES {
-        return Err(QuadError::invalid(
-            "n",
-            n,
-            format!(
-                "a budget whose working memory fits: {} needs about {:.0} GB at this n, at \
-                 most {:.0} GB is accepted",
-                rule.name(),
-                bytes / 1e9,
-                MAX_RULE_BYTES / 1e9
-            ),
-        ));
-    }
-    if !rule.guarded(D) {
-        return rule.integrate_unguarded(n, rng, f);
-    }
     let promise = (n as u64).max(rule.evaluations(n, D) as u64);
     let mut points = replay::Log::<([f64; D], V)>::new();
     let mut draws = replay::Log::<replay::Draw>::new();

@@ -663,6 +663,9 @@ impl Rule for GaussLegendre {
         self.error_estimate || dim > 1
     }
 
+    /// Without the estimate, the sum alone: small enough to inline where
+    /// it is called.
+    #[inline]
     fn integrate_unguarded<
         const D: usize,
         V: Value,
@@ -672,74 +675,86 @@ impl Rule for GaussLegendre {
         &self,
         n: usize,
         _rng: &mut R,
-        mut f: F,
+        f: F,
     ) -> Result<Estimate<V>, QuadError> {
         crate::quadrature::check_budget(n)?;
         let m = per_axis::<D>(n, 1, "n")?;
-        // The integrand reaches each sum in a closure of its own, which
-        // the sum inlines: through `&mut f` it was a call at every node
-        // (`<&mut F as FnMut>::call_mut`), and the guard's closure behind
-        // it cost the estimate 7 to 10% more instructions (callgrind).
-        #[allow(clippy::redundant_closure)]
-        let mut sum = |order: usize| {
-            product_sum([&*unit_rule(order)?; D], #[inline(always)] |u| f(u))
-        };
-        let main = sum(m)?;
-        let (error, extra) = if !self.error_estimate || m < 2 {
-            (V::zero().map(|_| f64::INFINITY), 0)
-        } else if m >= HYBRID_FROM {
-            // Q at orders m-1, m-2 and ceil(m/2) per axis.
-            let mut others = [main; 3];
-            for (q, order) in others.iter_mut().zip([m - 1, m - 2, m.div_ceil(2)]) {
-                *q = sum(order)?;
-            }
-            let error = V::from_fn(|c| {
-                let [q1, q2, qh] = others.map(|q| q.value.channel(c));
-                hybrid_estimate(
-                    m,
-                    [main.value.channel(c), q1, q2, qh],
-                    main.magnitude.channel(c),
-                )
-            });
-            (error, others.iter().map(|q| q.evaluations).sum())
-        } else {
-            let q1 = sum(m - 1)?;
-            if m >= 3 {
-                let q2 = sum(m - 2)?;
-                let error = V::from_fn(|c| {
-                    tail_estimate(
-                        main.value.channel(c),
-                        q1.value.channel(c),
-                        q2.value.channel(c),
-                    )
-                    .max(f64::EPSILON * main.magnitude.channel(c))
-                });
-                (error, q1.evaluations + q2.evaluations)
-            } else {
-                // No estimate below the rounding of the sum itself: where
-                // the rules agree exactly (a constant integrand) their
-                // difference is 0, while the sum is off by its rounding.
-                let error = V::from_fn(|c| {
-                    (main.value.channel(c) - q1.value.channel(c))
-                        .abs()
-                        .max(f64::EPSILON * main.magnitude.channel(c))
-                });
-                (error, q1.evaluations)
-            }
-        };
-        let estimate = Estimate::deterministic(main.value, error, main.evaluations + extra);
-        // Below HYBRID_FROM nodes per axis nothing checks the consecutive
-        // differences; one node carrying the sum means an unresolved
-        // feature ([`dominated`]).
-        let doubted = self.error_estimate
-            && (m < HYBRID_FROM || {
-                let max_weight = unit_rule(m)?.w.iter().copied().fold(0.0, f64::max);
-                dominated(main.largest, main.magnitude, max_weight.powi(D as i32))
-            });
-        if doubted {
-            Ok(estimate.doubted())
-        } else {
-            Ok(estimate)
+        if !self.error_estimate {
+            let sum = product_sum([&*unit_rule(m)?; D], f)?;
+            let error = V::zero().map(|_| f64::INFINITY);
+            return Ok(Estimate::deterministic(sum.value, error, sum.evaluations));
         }
+        estimated(m, f)
+    }
+}
+
+/// [`GaussLegendre`] with its error estimate, `m` nodes per axis.
+fn estimated<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
+    m: usize,
+    mut f: F,
+) -> Result<Estimate<V>, QuadError> {
+    // The integrand reaches each sum in a closure of its own, which
+    // the sum inlines: through `&mut f` it was a call at every node
+    // (`<&mut F as FnMut>::call_mut`), and the guard's closure behind
+    // it cost the estimate 7 to 10% more instructions (callgrind).
+    #[allow(clippy::redundant_closure)]
+    let mut sum = |order: usize| {
+        product_sum([&*unit_rule(order)?; D], #[inline(always)] |u| f(u))
+    };
+    let main = sum(m)?;
+    let (error, extra) = if m < 2 {
+        (V::zero().map(|_| f64::INFINITY), 0)
+    } else if m >= HYBRID_FROM {
+        // Q at orders m-1, m-2 and ceil(m/2) per axis.
+        let mut others = [main; 3];
+        for (q, order) in others.iter_mut().zip([m - 1, m - 2, m.div_ceil(2)]) {
+            *q = sum(order)?;
+        }
+        let error = V::from_fn(|c| {
+            let [q1, q2, qh] = others.map(|q| q.value.channel(c));
+            hybrid_estimate(
+                m,
+                [main.value.channel(c), q1, q2, qh],
+                main.magnitude.channel(c),
+            )
+        });
+        (error, others.iter().map(|q| q.evaluations).sum())
+    } else {
+        let q1 = sum(m - 1)?;
+        if m >= 3 {
+            let q2 = sum(m - 2)?;
+            let error = V::from_fn(|c| {
+                tail_estimate(
+                    main.value.channel(c),
+                    q1.value.channel(c),
+                    q2.value.channel(c),
+                )
+                .max(f64::EPSILON * main.magnitude.channel(c))
+            });
+            (error, q1.evaluations + q2.evaluations)
+        } else {
+            // No estimate below the rounding of the sum itself: where
+            // the rules agree exactly (a constant integrand) their
+            // difference is 0, while the sum is off by its rounding.
+            let error = V::from_fn(|c| {
+                (main.value.channel(c) - q1.value.channel(c))
+                    .abs()
+                    .max(f64::EPSILON * main.magnitude.channel(c))
+            });
+            (error, q1.evaluations)
+        }
+    };
+    let estimate = Estimate::deterministic(main.value, error, main.evaluations + extra);
+    // Below HYBRID_FROM nodes per axis nothing checks the consecutive
+    // differences; one node carrying the sum means an unresolved
+    // feature ([`dominated`]).
+    let doubted = m < HYBRID_FROM || {
+        let max_weight = unit_rule(m)?.w.iter().copied().fold(0.0, f64::max);
+        dominated(main.largest, main.magnitude, max_weight.powi(D as i32))
+    };
+    if doubted {
+        Ok(estimate.doubted())
+    } else {
+        Ok(estimate)
     }
 }
