@@ -121,10 +121,17 @@ pub trait Rule {
     /// weighted sum, with weights that sum to 1, which it finds within the
     /// f64 range or refuses ([`QuadError::SumOutOfRange`]), and it reports
     /// no error estimate (an infinite error). Such a sum does not overflow
-    /// where its values do not, an exact rescaling would give it back
-    /// unchanged, and there is no error to underflow: the guard's log and
-    /// checks would cost a few-node integral more than its integrand
-    /// (Gauss–Legendre without its estimate in one dimension).
+    /// where its values do not, and there is no error to underflow: the
+    /// guard's log and checks would cost a few-node integral more than its
+    /// integrand (Gauss–Legendre without its estimate in one dimension).
+    ///
+    /// Where the guard would have rescaled, an unguarded rule's answer can
+    /// differ from a guarded one's: values beyond `2^500` past the guard's
+    /// log give the sum, where the guard ran out of budget
+    /// ([`QuadError::RescaleOverBudget`]); a rescaling that makes small
+    /// terms subnormal rounds them, which the unguarded sum does not; and a
+    /// sum that leaves the range is [`QuadError::SumOutOfRange`], not
+    /// [`QuadError::Overflow`].
     fn guarded(&self, _dim: usize) -> bool {
         true
     }
@@ -170,7 +177,7 @@ pub trait Rule {
     }
 
     /// The rule itself, which [`Rule::try_integrate`] guards against
-    /// overflow: estimates `int_{[0,1]^D} f(u) du` with a budget of about `n`
+    /// overflow where it is [`Rule::guarded`]: estimates `int_{[0,1]^D} f(u) du` with a budget of about `n`
     /// evaluations, for an integrand that may fail: its first error stops the
     /// rule and is returned as is. `n` above [`MAX_BUDGET`] is an error here
     /// too.
@@ -219,7 +226,7 @@ pub trait Rule {
     /// ([`QuadError::RescaleOverBudget`]).
     ///
     /// A rule that is not [`Rule::guarded`] runs as it is, its limits
-    /// checked: a call that small inlines where it is made.
+    /// checked, none of the above applied.
     #[inline]
     fn try_integrate<
         const D: usize,

@@ -410,4 +410,14 @@ fn without_its_estimate_the_unguarded_rule_gives_the_guarded_sums() {
             other => panic!("n = {n}: {other:?}"),
         }
     }
+    // Values beyond 2^500 only past the guard's log of 65536 values (the
+    // guarded rule had no budget left to rescale them): the sum, `int_0^1`
+    // of 1 below 0.995 and 1e300 above, 0.005e300 to the rule's resolution
+    // of the jump.
+    let step = bare
+        .try_integrate(70_000, &mut rng, |u: [f64; 1]| {
+            Ok(if u[0] > 0.995 { 1e300 } else { 1.0 })
+        })
+        .expect("the sum");
+    assert!((step.value / 5e297 - 1.0).abs() < 1e-3, "{:e}", step.value);
 }

@@ -310,7 +310,8 @@ fn scalar_line_sum<V: Value>(
         let wy = y.map(|v| v * w);
         value.add(wy);
         magnitude = magnitude.zip(wy, |m, v| m + v.abs());
-        // The values are finite: a comparison, not `f64::max`'s NaN case.
+        // A comparison, cheaper than `f64::max`, and like it a NaN term
+        // (of a channel `all_finite` does not check) leaves `m` as it is.
         largest = largest.zip(wy, |m, v| if v.abs() > m { v.abs() } else { m });
     }
     // `sum scale w_i y_i`, compensated.
@@ -348,9 +349,10 @@ const BUFFERED_BELOW: usize = 128;
 /// value first, then one pass in the lanes. The same terms in the same
 /// lanes in the same order as [`LineSum::add_span`] (its groups are whole
 /// multiples of the lanes, and so is its block), so the same bits, the
-/// finite check included; without its setting up: `add_span` zeroes a
-/// block's buffer of 256 values and the sums of three companions, 4 KB
-/// for a scalar, as much work as 20 nodes' sums (callgrind at n = 20).
+/// finite check included. It zeroes a buffer of 128 values (1 KB for a
+/// scalar), where `add_span` zeroes a block's buffer of 256 values and the
+/// sums of three companions, 4 KB for a scalar, as much work as 20 nodes'
+/// sums (callgrind at n = 20).
 fn buffered_line_sum<V: Value>(
     a: &UnitNodes,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
@@ -362,7 +364,7 @@ fn buffered_line_sum<V: Value>(
     }
     let mut value = Lanes::new();
     let (mut magnitude, mut largest) = (LaneValues::zero(), LaneValues::zero());
-    value.add_products_scaled(ys, &a.w, &mut magnitude, &mut largest);
+    value.add_products_scaled(ys, &a.w[..a.len()], &mut magnitude, &mut largest);
     if !magnitude.all_finite()
         && let Some((u, y)) = a.u.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
     {
@@ -371,7 +373,7 @@ fn buffered_line_sum<V: Value>(
     let companion = |weights: &Option<Vec<f64>>| {
         weights.as_deref().map(|c| {
             let mut lanes = Lanes::new();
-            lanes.add_products(ys, c);
+            lanes.add_products(ys, &c[..a.len()]);
             lanes.total()
         })
     };
