@@ -68,14 +68,21 @@ pub fn integer_root(n: usize, dim: usize) -> usize {
 /// Nodes per axis for a product rule with a budget of `n` evaluations in `D`
 /// dimensions: the largest `m` with `m^D <= n`; at least `min` (else an error
 /// naming `name`).
+#[inline]
 pub fn per_axis<const D: usize>(n: usize, min: usize, name: &str) -> Result<usize, QuadError> {
     let need = min.checked_pow(D as u32).unwrap_or(usize::MAX);
     if n < need {
-        return Err(QuadError::invalid(
-            name,
-            n,
-            format!("a budget of at least {need} evaluations in {D} dimension(s)"),
-        ));
+        return Err(too_small(name, n, need, D));
     }
     Ok(integer_root(n, D).max(min))
+}
+
+/// [`per_axis`]'s error, out of the line of every rule's call.
+#[cold]
+fn too_small(name: &str, n: usize, need: usize, dim: usize) -> QuadError {
+    QuadError::invalid(
+        name,
+        n,
+        format!("a budget of at least {need} evaluations in {dim} dimension(s)"),
+    )
 }

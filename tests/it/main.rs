@@ -36,6 +36,7 @@ mod memory_estimate;
 mod mitsuba;
 mod output_safety;
 mod parallel;
+mod product_value;
 mod properties;
 mod reference_bounds;
 mod rendering_brdf;

@@ -7,12 +7,11 @@
 use wide::f64x4;
 
 use crate::error::QuadError;
-use crate::sum::{
-    Compensated, Kernel, KernelTask, LaneValues, Lanes, with_kernel, with_kernel_sharing,
-};
+use crate::sum::{Kernel, KernelTask, LaneValues, Lanes, with_kernel, with_kernel_sharing};
 use crate::value::Value;
 
-use super::{ProductSum, UnitNodes, in_range, non_finite};
+use super::short::{LANES_FROM, SHORT_BELOW, short_sum, short_value};
+use super::{ProductSum, UnitNodes, in_range, non_finite, value_in_range};
 
 /// The smallest span size of [`line_sum_par`] ([`par_span`]; the last
 /// span of an axis, and the one span of a shorter axis, can hold fewer
@@ -257,135 +256,37 @@ const _: () = assert!(BLOCK.is_multiple_of(GROUP) && GROUP.is_multiple_of(crate:
 // blocks, so its blocks are `product_sum`'s.
 const _: () = assert!(PAR_SPAN.is_power_of_two() && PAR_SPAN.is_multiple_of(BLOCK));
 
-/// Nodes from which [`line_sum`] sums in lanes; below, term by term
-/// ([`scalar_line_sum`]).
-pub const LANES_FROM: usize = 16;
-
-/// [`product_sum`] on one axis: [`LineSum::add_span`] over all its nodes;
-/// below [`BUFFERED_BELOW`] nodes [`buffered_line_sum`], below [`LANES_FROM`] [`scalar_line_sum`].
+/// [`product_sum`] on one axis: [`LineSum::add_span`] over all its nodes,
+/// or below [`SHORT_BELOW`] nodes [`short_sum`].
 ///
 /// [`product_sum`]: super::product_sum
 pub(super) fn line_sum<V: Value>(
     a: &UnitNodes,
     f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<ProductSum<V>, QuadError> {
-    if a.len() < LANES_FROM {
-        return scalar_line_sum(a, f);
-    }
-    if a.len() < BUFFERED_BELOW {
-        return buffered_line_sum(a, f);
+    if a.len() < SHORT_BELOW {
+        return short_sum(a, f);
     }
     let mut sum = LineSum::new();
     sum.add_span(a, 0..a.len(), f)?;
     in_range(sum.finish(a))
 }
 
-/// [`line_sum`] of a few nodes: the values first, each checked finite
-/// as it comes, then one pass over them (a compensated running sum per
-/// weight set, `sum |w y|` and the largest term). The lanes' groups and
-/// blocks cost more than a few terms (at n = 5 some 1000 instructions a
-/// call, against 440 for the five cosines of `cos(50 x)`, by callgrind);
-/// and sums carried across the integrand's calls are stored and reloaded
-/// at each node, where the pass after them keeps them in registers.
-///
-/// The rule's own sum is found as the lanes find it where finite terms'
-/// running sum passes `f64::MAX` on the way to a total within range (14
-/// nodes of `f64::MAX`): summed again at a quarter of their size, the
-/// total scaled back ([`crate::sum::Lanes::total`]).
-fn scalar_line_sum<V: Value>(
+/// [`line_sum`]'s `value` alone, bit for bit, and its errors but for a
+/// companion's: below [`SHORT_BELOW`] nodes without the sums only an
+/// error estimate reads ([`short_value`]), from there the whole sum (per
+/// node the scale and the largest term cost little beside the integrand).
+#[inline]
+pub(super) fn line_value<V: Value>(
     a: &UnitNodes,
-    mut f: impl FnMut(f64) -> Result<V, QuadError>,
-) -> Result<ProductSum<V>, QuadError> {
-    let mut ys = [V::zero(); LANES_FROM];
-    for (y, &u) in ys.iter_mut().zip(&a.u) {
-        *y = f(u)?;
-        if !y.all_finite() {
-            return Err(non_finite(&[u], y));
-        }
+    f: impl FnMut(f64) -> Result<V, QuadError>,
+) -> Result<V, QuadError> {
+    if a.len() < SHORT_BELOW {
+        return short_value(a, f);
     }
-    let ys = &ys[..a.len()];
-    let mut value = Compensated::<V>::new();
-    let (mut magnitude, mut largest) = (V::zero(), V::zero());
-    for (y, &w) in ys.iter().zip(&a.w) {
-        let wy = y.map(|v| v * w);
-        value.add(wy);
-        magnitude = magnitude.zip(wy, |m, v| m + v.abs());
-        // A comparison, cheaper than `f64::max`, and like it a NaN term
-        // (of a channel `all_finite` does not check) leaves `m` as it is.
-        largest = largest.zip(wy, |m, v| if v.abs() > m { v.abs() } else { m });
-    }
-    // `sum scale w_i y_i`, compensated.
-    let weighted = |weights: &[f64], scale: f64| {
-        let mut sum = Compensated::<V>::new();
-        for (y, &w) in ys.iter().zip(weights) {
-            sum.add(y.map(|v| v * (scale * w)));
-        }
-        sum.total()
-    };
-    let mut total = value.total();
-    if !total.all_finite() {
-        // Only the channels that passed the range: a quarter of a
-        // subnormal term loses bits.
-        let quarter = weighted(&a.w, 0.25);
-        total = total.zip(quarter, |t, q| if t.is_finite() { t } else { 4.0 * q });
-    }
-    let companion = |weights: &Option<Vec<f64>>| weights.as_deref().map(|c| weighted(c, 1.0));
-    in_range(ProductSum {
-        value: total,
-        companion: companion(&a.companion),
-        companion4: companion(&a.companion4),
-        companion8: companion(&a.companion8),
-        magnitude,
-        largest,
-        evaluations: a.len() as u64,
-    })
-}
-
-/// Nodes below which [`line_sum`] takes them all into one buffer before
-/// it sums them ([`buffered_line_sum`]).
-const BUFFERED_BELOW: usize = 128;
-
-/// [`line_sum`] from [`LANES_FROM`] to [`BUFFERED_BELOW`] nodes: every
-/// value first, then one pass in the lanes. The same terms in the same
-/// lanes in the same order as [`LineSum::add_span`] (its groups are whole
-/// multiples of the lanes, and so is its block), so the same bits, the
-/// finite check included. It zeroes a buffer of 128 values (1 KB for a
-/// scalar), where `add_span` zeroes a block's buffer of 256 values and the
-/// sums of three companions, 4 KB for a scalar, as much work as 20 nodes'
-/// sums (callgrind at n = 20).
-fn buffered_line_sum<V: Value>(
-    a: &UnitNodes,
-    mut f: impl FnMut(f64) -> Result<V, QuadError>,
-) -> Result<ProductSum<V>, QuadError> {
-    let mut buffer = [V::zero(); BUFFERED_BELOW];
-    let ys = &mut buffer[..a.len()];
-    for (y, &u) in ys.iter_mut().zip(&a.u) {
-        *y = f(u)?;
-    }
-    let mut value = Lanes::new();
-    let (mut magnitude, mut largest) = (LaneValues::zero(), LaneValues::zero());
-    value.add_products_scaled(ys, &a.w[..a.len()], &mut magnitude, &mut largest);
-    if !magnitude.all_finite()
-        && let Some((u, y)) = a.u.iter().zip(ys.iter()).find(|(_, y)| !y.all_finite())
-    {
-        return Err(non_finite(&[*u], y));
-    }
-    let companion = |weights: &Option<Vec<f64>>| {
-        weights.as_deref().map(|c| {
-            let mut lanes = Lanes::new();
-            lanes.add_products(ys, &c[..a.len()]);
-            lanes.total()
-        })
-    };
-    in_range(ProductSum {
-        value: value.total(),
-        companion: companion(&a.companion),
-        companion4: companion(&a.companion4),
-        companion8: companion(&a.companion8),
-        magnitude: magnitude.sum(),
-        largest: largest.max(),
-        evaluations: a.len() as u64,
-    })
+    let mut sum = LineSum::new();
+    sum.add_span(a, 0..a.len(), f)?;
+    value_in_range(sum.finish(a))
 }
 
 /// The running sums of [`product_sum`] on one axis (and of each span of

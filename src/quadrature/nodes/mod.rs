@@ -14,12 +14,13 @@ use crate::value::Value;
 mod composite;
 mod estimate;
 mod line;
+mod short;
 
 pub use composite::{CHECKED_POINTS, Composite, MAX_POINTS, coarse_weights};
 pub(crate) use estimate::ROUNDING_ULPS;
 pub use estimate::{DOMINANT_SHARE, dominated, richardson};
-use line::line_sum;
 pub use line::{PAR_SPAN, line_sum_par, par_span};
+use line::{line_sum, line_value};
 
 /// A 1-D rule on `[0, 1]`: nodes `u_i` and weights `w_i` with `sum w_i = 1`
 /// (so the rule estimates `int_0^1 f(u) du` by `sum w_i f(u_i)`), and optional
@@ -83,8 +84,9 @@ pub struct ProductSum<V: Value> {
 /// With [`line_sum_par`], the only place where a deterministic rule meets
 /// the integrand.
 /// A non-finite integrand value stops the sum with an error naming the point
-/// (on one axis of 16 nodes or more, at the end of the block of 256 nodes it
-/// is in; below 16, at once). Finite values within rounding of `f64::MAX`,
+/// (on one axis of 128 nodes or more, at the end of the block of 256 nodes
+/// it is in; below 128, after all the values; in two and more dimensions,
+/// at once). Finite values within rounding of `f64::MAX`,
 /// whose sum passes it on the way, are summed on one axis (see
 /// [`crate::sum::Lanes::total`]), the rule's own sum always: its terms are
 /// spread over four lanes, each some quarter of the sum (below 16 nodes,
@@ -94,6 +96,27 @@ pub struct ProductSum<V: Value> {
 /// a sum, and in two and more dimensions any, is
 /// [`QuadError::SumOutOfRange`] naming it, never a sum that is not finite.
 pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
+    axes: [&UnitNodes; D],
+    mut f: F,
+) -> Result<ProductSum<V>, QuadError> {
+    if D == 1 && !axes[0].is_empty() {
+        return line_sum(
+            axes[0],
+            #[inline(always)]
+            move |u| {
+                let mut p = [0.0; D];
+                p[0] = u;
+                f(p)
+            },
+        );
+    }
+    in_range(odometer_sum(axes, f)?)
+}
+
+/// [`product_sum`] of any axes, term by term in the order of an index
+/// odometer (last axis fastest), before its range is checked; `Ok` of
+/// zero sums where an axis is empty.
+fn odometer_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
     axes: [&UnitNodes; D],
     mut f: F,
 ) -> Result<ProductSum<V>, QuadError> {
@@ -119,18 +142,6 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
         });
     }
 
-    if D == 1 {
-        return line_sum(
-            axes[0],
-            #[inline(always)]
-            move |u| {
-                let mut p = [0.0; D];
-                p[0] = u;
-                f(p)
-            },
-        );
-    }
-    // D dimensions: walk the index odometer.
     let mut idx = [0usize; D];
     loop {
         let mut p = [0.0; D];
@@ -173,7 +184,7 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
         let mut d = D;
         loop {
             if d == 0 {
-                return in_range(ProductSum {
+                return Ok(ProductSum {
                     value: acc.total(),
                     companion: with_companion.then(|| acc_c.total()),
                     companion4: with_companion4.then(|| acc_c4.total()),
@@ -191,6 +202,44 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
             idx[d] = 0;
         }
     }
+}
+
+/// [`product_sum`]'s `value` alone, bit for bit, with the same errors but
+/// for a companion's (a composite rule's `4h` rule can leave the range
+/// where its own sum does not): all a rule without an error estimate
+/// reads. On one axis of fewer than 128
+/// nodes it skips the sums only an estimate reads (`sum |w y|`, the
+/// largest term, the companions), which at a few nodes a call were a
+/// large share of the call (`benches/README.md`, `gl_small`).
+///
+/// ```
+/// use lightquad::quadrature::gauss_legendre::unit_nodes;
+/// use lightquad::quadrature::nodes::{product_sum, product_value};
+///
+/// let nodes = unit_nodes(5)?;
+/// let f = |u: [f64; 1]| Ok((3.0 * u[0]).exp());
+/// let value = product_value([&*nodes], f)?;
+/// assert_eq!(value, product_sum([&*nodes], f)?.value);
+/// assert!((value - (3f64.exp() - 1.0) / 3.0).abs() < 1e-6);
+/// # Ok::<(), lightquad::error::QuadError>(())
+/// ```
+#[inline]
+pub fn product_value<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
+    axes: [&UnitNodes; D],
+    mut f: F,
+) -> Result<V, QuadError> {
+    if D == 1 && !axes[0].is_empty() {
+        return line_value(
+            axes[0],
+            #[inline(always)]
+            move |u| {
+                let mut p = [0.0; D];
+                p[0] = u;
+                f(p)
+            },
+        );
+    }
+    value_in_range(odometer_sum(axes, f)?)
 }
 
 /// `sum` with `magnitude` at most `f64::MAX`, or
@@ -217,6 +266,20 @@ fn in_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError> {
         });
     }
     out_of_range(sum)
+}
+
+/// The `value` of `sum` where it is finite ([`in_range`] of the value
+/// alone): a companion that left the range is no error of a sum that
+/// does not read it.
+#[inline]
+fn value_in_range<V: Value>(sum: ProductSum<V>) -> Result<V, QuadError> {
+    let value = ProductSum {
+        companion: None,
+        companion4: None,
+        companion8: None,
+        ..sum
+    };
+    in_range(value).map(|sum| sum.value)
 }
 
 /// [`in_range`]'s error, naming the first sum that is not finite.
