@@ -6,9 +6,9 @@
 
 use lightquad::error::QuadError;
 use lightquad::quadrature::gauss_legendre::unit_nodes;
-use lightquad::quadrature::nodes::{UnitNodes, product_sum, product_value};
+use lightquad::quadrature::nodes::{UnitNodes, line_sum_par, product_sum, product_value};
 use lightquad::quadrature::product::WithError;
-use lightquad::quadrature::trapezoid;
+use lightquad::quadrature::{simpson, trapezoid};
 use lightquad::value::{Rgb, Value};
 use rand::RngExt;
 
@@ -48,11 +48,15 @@ fn random_value(rng: &mut rand_pcg::Pcg64, scale: f64, spread: f64) -> f64 {
 /// rule's `4h` rule, all its terms in one lane), which the value alone
 /// does not form, the value is the whole sum's of the values at a quarter
 /// of their size, times 4: the same bits, a power of two being exact.
-fn same<V: Value>(nodes: &UnitNodes, values: &[V], what: &str) {
+///
+/// Returns whether a companion's sum left the range.
+fn same<V: Value>(nodes: &UnitNodes, values: &[V], what: &str) -> bool {
     let at = |u: f64| values[nodes.u.iter().position(|&x| x == u).expect("a node")];
     let value = product_value([nodes], |[u]: [f64; 1]| Ok(at(u)));
+    let mut companion_out = false;
     let whole = match product_sum([nodes], |[u]: [f64; 1]| Ok(at(u))) {
         Err(QuadError::SumOutOfRange { sum, .. }) if sum.starts_with("companion") => {
+            companion_out = true;
             product_sum([nodes], |[u]: [f64; 1]| Ok(at(u).map(|v| v / 4.0)))
                 .map(|s| s.value.map(|v| 4.0 * v))
         }
@@ -71,6 +75,7 @@ fn same<V: Value>(nodes: &UnitNodes, values: &[V], what: &str) {
         (Err(v), Err(w)) => assert_eq!(v, w, "{what}"),
         (v, w) => panic!("{what}: {v:?} against {w:?}"),
     }
+    companion_out
 }
 
 /// Random values of every size and sign, and values near `f64::MAX`
@@ -80,10 +85,17 @@ fn same<V: Value>(nodes: &UnitNodes, values: &[V], what: &str) {
 #[test]
 fn the_value_alone_is_the_whole_sums_value_bit_for_bit() {
     let mut rng = rng(55);
+    let mut companions_out = 0;
     for n in counts() {
         let gauss = unit_nodes(n).expect("nodes");
         let trapezoid = trapezoid::unit_nodes((n | 1).max(3)).expect("nodes");
-        for (nodes, rule) in [(&*gauss, "gauss"), (&trapezoid, "trapezoid")] {
+        let simpson = simpson::unit_nodes((n | 1).max(3)).expect("nodes");
+        let rules = [
+            (&*gauss, "gauss"),
+            (&trapezoid, "trapezoid"),
+            (&simpson, "simpson"),
+        ];
+        for (nodes, rule) in rules {
             let len = nodes.len();
             for (scale, spread) in [(1.0, 0.0), (1.0, 30.0), (1e300, 2.0), (f64::MAX, 1e-14)] {
                 let what = format!("{rule}, {len} nodes, scale {scale:e}");
@@ -91,12 +103,111 @@ fn the_value_alone_is_the_whole_sums_value_bit_for_bit() {
                     .map(|_| random_value(&mut rng, scale, spread))
                     .collect();
                 same(nodes, &scalars, &what);
-                same(nodes, &vec![scale; len], &format!("{what}, constant"));
+                let constant = same(nodes, &vec![scale; len], &format!("{what}, constant"));
+                companions_out += usize::from(constant);
                 let rgb: Vec<Rgb> = (0..len)
                     .map(|_| <Rgb as Value>::from_fn(|_| random_value(&mut rng, scale, spread)))
                     .collect();
                 same(nodes, &rgb, &format!("{what}, rgb"));
             }
+        }
+    }
+    // The composite rules' `4h` companions of `f64::MAX` did leave the
+    // range: the value alone was found where the whole sum was refused.
+    assert!(companions_out > 0);
+}
+
+/// Two and three axes of random values, and an empty axis: the odometer's
+/// value, bit for bit.
+#[test]
+fn on_several_axes_the_value_is_the_odometers() {
+    let mut rng = rng(57);
+    for m in [1, 2, 5, 17] {
+        let nodes = unit_nodes(m).expect("nodes");
+        let values: Vec<f64> = (0..m * m * m)
+            .map(|_| random_value(&mut rng, 1.0, 20.0))
+            .collect();
+        let index = |u: f64| nodes.u.iter().position(|&x| x == u).expect("a node");
+        let f2 = |[u, v]: [f64; 2]| Ok(values[index(u) * m + index(v)]);
+        let value = product_value([&*nodes, &*nodes], f2).expect("finite");
+        let whole = product_sum([&*nodes, &*nodes], f2).expect("finite").value;
+        assert_eq!(value.to_bits(), whole.to_bits(), "{m} x {m}");
+        let f3 = |[u, v, w]: [f64; 3]| Ok(values[(index(u) * m + index(v)) * m + index(w)]);
+        let value = product_value([&*nodes, &*nodes, &*nodes], f3).expect("finite");
+        let whole = product_sum([&*nodes, &*nodes, &*nodes], f3)
+            .expect("finite")
+            .value;
+        assert_eq!(value.to_bits(), whole.to_bits(), "{m} x {m} x {m}");
+    }
+    let empty = UnitNodes {
+        u: vec![],
+        w: vec![],
+        companion: None,
+        companion4: None,
+        companion8: None,
+    };
+    assert_eq!(product_value([&empty], |_: [f64; 1]| Ok(1.0)), Ok(0.0));
+    let nodes = unit_nodes(3).expect("nodes");
+    assert_eq!(
+        product_value([&*nodes, &empty], |_: [f64; 2]| Ok(1.0)),
+        Ok(0.0)
+    );
+}
+
+/// Weights of 1 at every node (a sum, not a rule: they add to `n`) of
+/// `f64::MAX`: the value itself leaves the range, the same
+/// `SumOutOfRange` from both sums, on every path of one axis.
+#[test]
+fn a_value_beyond_the_range_is_the_same_error() {
+    for n in [5, 20, 100, 200] {
+        let nodes = UnitNodes {
+            u: (0..n).map(|i| (i as f64 + 0.5) / n as f64).collect(),
+            w: vec![1.0; n],
+            companion: None,
+            companion4: None,
+            companion8: None,
+        };
+        let f = |_: [f64; 1]| Ok(f64::MAX);
+        let value = product_value([&nodes], f);
+        assert!(
+            matches!(value, Err(QuadError::SumOutOfRange { sum: "value", .. })),
+            "{n} nodes: {value:?}"
+        );
+        assert_eq!(
+            value,
+            product_sum([&nodes], f).map(|s| s.value),
+            "{n} nodes"
+        );
+    }
+}
+
+/// Weight sets of another length than the nodes (the fields are public):
+/// an error naming the set and its length, from both sums and the parallel
+/// one, never a panic or a sum of some of the terms.
+#[test]
+fn weights_that_do_not_match_the_nodes_are_an_error() {
+    for n in [4, 20, 200] {
+        let good = trapezoid::unit_nodes(n + 1).expect("nodes");
+        let mut short_w = good.clone();
+        short_w.w.pop();
+        let mut long_companion = good.clone();
+        long_companion
+            .companion4
+            .as_mut()
+            .expect("a 4h rule")
+            .push(0.0);
+        for (nodes, name, len) in [(&short_w, "w", n), (&long_companion, "companion4", n + 2)] {
+            let what = format!("{} nodes, {name}", n + 1);
+            let f = |_: [f64; 1]| Ok(1.0);
+            let expected = Err(QuadError::invalid(
+                name,
+                len,
+                format!("{} weights, one per node", n + 1),
+            ));
+            assert_eq!(product_value([nodes], f), expected, "{what}");
+            assert_eq!(product_sum([nodes], f).map(|s| s.value), expected, "{what}");
+            let par = line_sum_par(nodes, |_| Ok(1.0)).map(|s| s.value);
+            assert_eq!(par, expected, "{what}, parallel");
         }
     }
 }
@@ -122,13 +233,48 @@ fn values_that_are_not_finite_give_the_same_errors() {
                 .iter()
                 .map(|&e| WithError {
                     value: 1.0,
-                    error: e.abs(),
+                    error: e,
                 })
                 .collect();
             same(
                 &nodes,
                 &with_error,
                 &format!("{n} nodes, an error {bad} at {at}"),
+            );
+            // Errors of both signs, or beside a value near `f64::MAX`.
+            let mut both = with_error.clone();
+            both[rng.random_range(0..n)].error = -bad;
+            same(
+                &nodes,
+                &both,
+                &format!("{n} nodes, errors {bad} and {}", -bad),
+            );
+            let near_max: Vec<_> = with_error
+                .iter()
+                .map(|e| WithError {
+                    value: f64::MAX,
+                    error: e.error,
+                })
+                .collect();
+            same(
+                &nodes,
+                &near_max,
+                &format!("{n} nodes, f64::MAX, an error {bad}"),
+            );
+            // The integrand's own error after a value that is not finite:
+            // the first of them in the order of the nodes.
+            let failing = |[u]: [f64; 1]| {
+                let i = nodes.u.iter().position(|&x| x == u).expect("a node");
+                if i > at {
+                    Err(QuadError::invalid("f", i, "no failure"))
+                } else {
+                    Ok(values[i])
+                }
+            };
+            assert_eq!(
+                product_value([&*nodes], failing),
+                product_sum([&*nodes], failing).map(|s| s.value),
+                "{n} nodes, {bad} at {at}, then an error"
             );
         }
         let first_bad = product_value([&*nodes], |[u]: [f64; 1]| {

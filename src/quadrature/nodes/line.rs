@@ -132,6 +132,7 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     // A value of no channels has nothing to store ([`LineSum::STORED`] is
     // 0): its nodes are evaluated, and their errors found, serially; and a
     // few nodes are summed term by term, as `line_sum` sums them.
+    a.check()?;
     if V::CHANNELS == 0 || a.len() < LANES_FROM {
         return line_sum(a, f);
     }

@@ -53,6 +53,49 @@ impl UnitNodes {
     pub fn is_empty(&self) -> bool {
         self.u.is_empty()
     }
+
+    /// Checks that `w` and each companion hold one weight per node: the
+    /// fields are public, and a sum reads weight `i` beside node `i`.
+    ///
+    /// ```
+    /// use lightquad::quadrature::nodes::UnitNodes;
+    ///
+    /// let mut nodes = UnitNodes {
+    ///     u: vec![0.25, 0.75],
+    ///     w: vec![0.5, 0.5],
+    ///     companion: None,
+    ///     companion4: None,
+    ///     companion8: None,
+    /// };
+    /// assert!(nodes.check().is_ok());
+    /// nodes.w.pop();
+    /// let e = nodes.check().unwrap_err().to_string();
+    /// assert!(e.contains("`w`") && e.contains("2 weights"), "{e}");
+    /// ```
+    #[inline]
+    pub fn check(&self) -> Result<(), QuadError> {
+        let n = self.u.len();
+        let sets = [
+            ("w", Some(&self.w)),
+            ("companion", self.companion.as_ref()),
+            ("companion4", self.companion4.as_ref()),
+            ("companion8", self.companion8.as_ref()),
+        ];
+        for (name, weights) in sets {
+            if let Some(weights) = weights
+                && weights.len() != n
+            {
+                return Err(weights_per_node(name, weights.len(), n));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// [`UnitNodes::check`]'s error: `len` weights in `name` for `n` nodes.
+#[cold]
+fn weights_per_node(name: &str, len: usize, n: usize) -> QuadError {
+    QuadError::invalid(name, len, format!("{n} weights, one per node"))
 }
 
 /// The result of one pass over a tensor-product node set.
@@ -83,10 +126,11 @@ pub struct ProductSum<V: Value> {
 ///
 /// With [`line_sum_par`], the only place where a deterministic rule meets
 /// the integrand.
-/// A non-finite integrand value stops the sum with an error naming the point
-/// (on one axis of 128 nodes or more, at the end of the block of 256 nodes
-/// it is in; below 128, after all the values; in two and more dimensions,
-/// at once). Finite values within rounding of `f64::MAX`,
+/// A non-finite integrand value is an error naming the point, found on one
+/// axis of 128 nodes or more at the end of the block of 256 nodes it is in
+/// (the sum stops there), below 128 once every value is in, and in two and
+/// more dimensions at once. Weight sets of another length than the nodes
+/// are an error ([`UnitNodes::check`]). Finite values within rounding of `f64::MAX`,
 /// whose sum passes it on the way, are summed on one axis (see
 /// [`crate::sum::Lanes::total`]), the rule's own sum always: its terms are
 /// spread over four lanes, each some quarter of the sum (below 16 nodes,
@@ -99,6 +143,9 @@ pub fn product_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Qua
     axes: [&UnitNodes; D],
     mut f: F,
 ) -> Result<ProductSum<V>, QuadError> {
+    for a in axes {
+        a.check()?;
+    }
     if D == 1 && !axes[0].is_empty() {
         return line_sum(
             axes[0],
@@ -228,6 +275,9 @@ pub fn product_value<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Q
     axes: [&UnitNodes; D],
     mut f: F,
 ) -> Result<V, QuadError> {
+    for a in axes {
+        a.check()?;
+    }
     if D == 1 && !axes[0].is_empty() {
         return line_value(
             axes[0],
