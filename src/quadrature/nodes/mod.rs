@@ -70,7 +70,7 @@ impl UnitNodes {
     /// assert!(nodes.check().is_ok());
     /// nodes.w.pop();
     /// let e = nodes.check().unwrap_err().to_string();
-    /// assert!(e.contains("`w`") && e.contains("2 weights"), "{e}");
+    /// assert_eq!(e, "invalid w = 1: expected 2 weights, one per node");
     /// ```
     #[inline]
     pub fn check(&self) -> Result<(), QuadError> {
