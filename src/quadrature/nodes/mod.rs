@@ -75,27 +75,34 @@ impl UnitNodes {
     #[inline]
     pub fn check(&self) -> Result<(), QuadError> {
         let n = self.u.len();
+        let other = |set: &Option<Vec<f64>>| set.as_ref().is_some_and(|w| w.len() != n);
+        if self.w.len() != n
+            || other(&self.companion)
+            || other(&self.companion4)
+            || other(&self.companion8)
+        {
+            return Err(self.weights_per_node());
+        }
+        Ok(())
+    }
+
+    /// [`UnitNodes::check`]'s error, naming the first weight set of another
+    /// length than the nodes.
+    #[cold]
+    fn weights_per_node(&self) -> QuadError {
         let sets = [
             ("w", Some(&self.w)),
             ("companion", self.companion.as_ref()),
             ("companion4", self.companion4.as_ref()),
             ("companion8", self.companion8.as_ref()),
         ];
-        for (name, weights) in sets {
-            if let Some(weights) = weights
-                && weights.len() != n
-            {
-                return Err(weights_per_node(name, weights.len(), n));
-            }
-        }
-        Ok(())
+        let n = self.u.len();
+        let (name, len) = sets
+            .into_iter()
+            .find_map(|(name, w)| w.filter(|w| w.len() != n).map(|w| (name, w.len())))
+            .unwrap_or(("w", self.w.len()));
+        QuadError::invalid(name, len, format!("{n} weights, one per node"))
     }
-}
-
-/// [`UnitNodes::check`]'s error: `len` weights in `name` for `n` nodes.
-#[cold]
-fn weights_per_node(name: &str, len: usize, n: usize) -> QuadError {
-    QuadError::invalid(name, len, format!("{n} weights, one per node"))
 }
 
 /// The result of one pass over a tensor-product node set.

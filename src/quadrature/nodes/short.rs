@@ -131,6 +131,7 @@ fn finite_or<V: Value>(
 
 /// [`finite_or`]'s way out, off the line of the sum.
 #[cold]
+#[inline(never)]
 fn whole_value<V: Value>(
     whole: impl FnOnce() -> Result<ProductSum<V>, QuadError>,
 ) -> Result<V, QuadError> {
@@ -153,11 +154,14 @@ fn first_non_finite<V: Value>(a: &UnitNodes, ys: &[V]) -> Result<(), QuadError> 
 /// running sum passes `f64::MAX` on the way to a total within range (14
 /// nodes of `f64::MAX`): summed again at a quarter of their size, the
 /// total scaled back ([`crate::sum::Lanes::total`]).
+#[inline(always)]
 fn few_sum<V: Value>(a: &UnitNodes, ys: &[V]) -> Result<ProductSum<V>, QuadError> {
-    first_non_finite(a, ys)?;
     let mut value = Compensated::<V>::new();
     let (mut magnitude, mut largest) = (V::zero(), V::zero());
-    for (y, &w) in ys.iter().zip(&a.w) {
+    for (y, (&w, &u)) in ys.iter().zip(a.w.iter().zip(&a.u)) {
+        if !y.all_finite() {
+            return Err(non_finite(&[u], y));
+        }
         let wy = y.map(|v| v * w);
         value.add(wy);
         magnitude = magnitude.zip(wy, |m, v| m + v.abs());
