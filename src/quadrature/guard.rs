@@ -40,6 +40,29 @@ fn too_much_memory(rule: &str, n: usize, bytes: f64) -> QuadError {
     )
 }
 
+/// [`Rule::try_integrate`] as every rule has it: its limits checked
+/// ([`check_limits`]), then guarded where [`Rule::guarded`].
+#[inline]
+pub(crate) fn checked<
+    Q: Rule + ?Sized,
+    const D: usize,
+    V: Value,
+    R: rand::Rng + ?Sized,
+    F: FnMut([f64; D]) -> Result<V, QuadError>,
+>(
+    rule: &Q,
+    n: usize,
+    rng: &mut R,
+    f: F,
+) -> Result<Estimate<V>, QuadError> {
+    check_limits(rule, n, D)?;
+    if rule.guarded(D) {
+        try_integrate(rule, n, rng, f)
+    } else {
+        rule.integrate_unguarded(n, rng, f)
+    }
+}
+
 /// [`Rule::try_integrate`] of a rule that is [`Rule::guarded`], its
 /// limits checked ([`check_limits`]); its documentation says what is
 /// guarded and how.

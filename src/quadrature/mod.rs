@@ -239,12 +239,7 @@ pub trait Rule {
         rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
-        guard::check_limits(self, n, D)?;
-        if self.guarded(D) {
-            guard::try_integrate(self, n, rng, f)
-        } else {
-            self.integrate_unguarded(n, rng, f)
-        }
+        guard::checked(self, n, rng, f)
     }
 
     /// [`Rule::try_integrate`] for an integrand that cannot fail. The

@@ -59,6 +59,7 @@ mod testing_api;
 mod testing_light;
 mod tracking_cost;
 mod tracking_diagnostic;
+mod unit_table;
 mod verdicts;
 mod volume;
 mod volume_emission;

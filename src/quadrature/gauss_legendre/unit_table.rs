@@ -1,0 +1,112 @@
+//! Every tabulated Gauss–Legendre rule mapped to `[0, 1]`, built at compile
+//! time, and the rule's value on one such axis without its estimate.
+//!
+//! A few nodes a call is the common case in a renderer (a few nodes per
+//! ray segment, per pixel, per light). There the rule reads its nodes and
+//! weights from this table, with no cache to look up and no set to check,
+//! and adds each term to one running sum as the integrand's call returns,
+//! as bilby and gauss-quad do: at 5 nodes of `cos(50 x)` a compensated sum
+//! cost a tenth of the call's time and the buffer of values beside it more
+//! (`examples/gl_race.rs`, `benches/README.md`, `gl_small`).
+//!
+//! The running sum's rounding is at most `(m - 1) u sum |w f|` with
+//! `u = 2^-53` (Higham's `gamma_(m-1)`) beside the terms' own `u/2` each,
+//! so at most `99 u` of the terms' magnitude at the largest order here;
+//! larger orders, and every sum the error estimate reads, are compensated.
+
+use crate::error::QuadError;
+use crate::quadrature::nodes::product_value;
+use crate::value::Value;
+
+use super::{TABLE_MAX_ORDER, small_table, unit_rule};
+
+/// Nodes of all tabulated rules one after another, `sum_{n <= 100} n`.
+const UNIT_LEN: usize = TABLE_MAX_ORDER * (TABLE_MAX_ORDER + 1) / 2;
+
+/// Every tabulated rule on `[0, 1]` as `[node, weight]` pairs, nodes
+/// ascending, order n from `n (n - 1) / 2`.
+static UNIT: [[f64; 2]; UNIT_LEN] = unit_mirrored();
+
+/// The pairs of order n at index n (none at 0).
+static RULES: [&[[f64; 2]]; TABLE_MAX_ORDER + 1] = rules();
+
+/// The tabulated half rules mirrored into full rules on `[0, 1]`, as
+/// `computed_unit_nodes` maps them: entry `i < n/2` of order n is row
+/// `k = i + 1` at `u = (1 - x_k)/2`, from the tabulated `1 - x_k` (full
+/// relative precision near 0), entry `i >= n/2` is row `k = n - i` at
+/// `u = (1 + x_k)/2`; each weight is `w_k / 2`.
+const fn unit_mirrored() -> [[f64; 2]; UNIT_LEN] {
+    let mut out = [[0.0; 2]; UNIT_LEN];
+    let mut n = 1;
+    while n <= TABLE_MAX_ORDER {
+        let (start, half) = (n * (n - 1) / 2, n * n / 4);
+        let mut i = 0;
+        while i < n {
+            let lower = i < n / 2;
+            let k = if lower { i + 1 } else { n - i };
+            let [x, one_minus_x, w] = small_table::HALF_NODES[half + k - 1];
+            let u = if lower {
+                0.5 * one_minus_x
+            } else {
+                0.5 * (1.0 + x)
+            };
+            out[start + i] = [u, 0.5 * w];
+            i += 1;
+        }
+        n += 1;
+    }
+    out
+}
+
+/// [`UNIT`] cut into its orders.
+const fn rules() -> [&'static [[f64; 2]]; TABLE_MAX_ORDER + 1] {
+    let mut out: [&[[f64; 2]]; TABLE_MAX_ORDER + 1] = [&[]; TABLE_MAX_ORDER + 1];
+    let mut rest: &'static [[f64; 2]] = &UNIT;
+    let mut n = 1;
+    while n <= TABLE_MAX_ORDER {
+        let (rule, tail) = rest.split_at(n);
+        out[n] = rule;
+        rest = tail;
+        n += 1;
+    }
+    out
+}
+
+/// The tabulated rule of order `n` on `[0, 1]` as `[node, weight]` pairs,
+/// nodes ascending; empty outside `1..=TABLE_MAX_ORDER`.
+pub fn unit_table(n: usize) -> &'static [[f64; 2]] {
+    RULES.get(n).copied().unwrap_or(&[])
+}
+
+/// `sum_i w_i f(u_i)` over the tabulated rule of order `m` in
+/// `1..=TABLE_MAX_ORDER` (the caller checks it) on the first axis of
+/// `[0, 1]^D`, `D = 1`: one running sum in the order of the nodes. A sum
+/// that is not finite is taken again by [`product_value`], which names the
+/// point whose value is not finite, finds a total within range, or names
+/// the sum out of range; the integrand is called a second time there.
+#[inline(always)]
+pub(super) fn tabulated_value<const D: usize, V: Value, F>(m: usize, mut f: F) -> Result<V, QuadError>
+where
+    F: FnMut([f64; D]) -> Result<V, QuadError>,
+{
+    let mut sum = V::zero();
+    for &[u, w] in RULES[m] {
+        let mut p = [0.0; D];
+        p[0] = u;
+        sum = sum.zip(f(p)?, |s, y| s + y * w);
+    }
+    if sum.all_finite() {
+        return Ok(sum);
+    }
+    again(m, f)
+}
+
+/// [`tabulated_value`]'s way out, off the line of the sum.
+#[cold]
+#[inline(never)]
+fn again<const D: usize, V: Value, F>(m: usize, f: F) -> Result<V, QuadError>
+where
+    F: FnMut([f64; D]) -> Result<V, QuadError>,
+{
+    product_value([&*unit_rule(m)?; D], f)
+}
