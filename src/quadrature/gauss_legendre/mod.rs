@@ -631,6 +631,27 @@ impl Default for GaussLegendre {
     }
 }
 
+impl GaussLegendre {
+    /// Whether a budget of `n` is one axis of a tabulated order without
+    /// the estimate, which [`tabulated_line`] sums.
+    #[inline(always)]
+    fn tabulated_line<const D: usize>(&self, n: usize) -> bool {
+        D == 1 && !self.error_estimate && (1..=TABLE_MAX_ORDER).contains(&n)
+    }
+}
+
+/// [`GaussLegendre`] without its estimate on one axis of a tabulated
+/// order `m` ([`unit_table::tabulated_value`]).
+#[inline(always)]
+fn tabulated_line<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
+    m: usize,
+    f: F,
+) -> Result<Estimate<V>, QuadError> {
+    let value = unit_table::tabulated_value(m, f)?;
+    let error = V::zero().map(|_| f64::INFINITY);
+    Ok(Estimate::deterministic(value, error, m as u64))
+}
+
 impl Rule for GaussLegendre {
     fn name(&self) -> &'static str {
         "gauss-legendre"
@@ -686,8 +707,8 @@ impl Rule for GaussLegendre {
         rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
-        if D == 1 && !self.error_estimate && n <= TABLE_MAX_ORDER {
-            return self.integrate_unguarded(n, rng, f);
+        if self.tabulated_line::<D>(n) {
+            return tabulated_line(n, f);
         }
         super::guard::checked(self, n, rng, f)
     }
@@ -708,14 +729,13 @@ impl Rule for GaussLegendre {
         _rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
+        if self.tabulated_line::<D>(n) {
+            return tabulated_line(n, f);
+        }
         crate::quadrature::check_budget(n)?;
         let m = per_axis::<D>(n, 1, "n")?;
         if !self.error_estimate {
-            let value = if D == 1 && m <= TABLE_MAX_ORDER {
-                unit_table::tabulated_value(m, f)?
-            } else {
-                product_value([&*unit_rule(m)?; D], f)?
-            };
+            let value = product_value([&*unit_rule(m)?; D], f)?;
             let error = V::zero().map(|_| f64::INFINITY);
             let evaluations = (m as u64).pow(D as u32);
             return Ok(Estimate::deterministic(value, error, evaluations));
