@@ -226,7 +226,9 @@ pub trait Rule {
     /// ([`QuadError::RescaleOverBudget`]).
     ///
     /// A rule that is not [`Rule::guarded`] runs as it is, its limits
-    /// checked, none of the above applied.
+    /// checked, none of the above applied. A rule may answer a call that no
+    /// limit can refuse before it checks them (Gauss–Legendre without its
+    /// estimate on one axis of at most 100 nodes).
     #[inline]
     fn try_integrate<
         const D: usize,

@@ -372,9 +372,10 @@ fn node_building_blocks_and_unguarded_rules_refuse_out_of_range_input() {
 /// give what the guarded rule gives. The closed form `int_0^1 s cos(50 u)
 /// du = s sin(50)/50`; the guarded rule's own sum at the same nodes (with
 /// its estimate on it rescales by a power of two, exactly): bit for bit
-/// past the tabulated orders, whose one running sum is within its rounding
-/// bound `(m - 1) u sum |w f|` of that compensated sum (Higham's
-/// `gamma_(m-1)`; `sum |w f| <= s` here).
+/// past the tabulated orders, whose one running sum is within `m u sum
+/// |w f|` of that compensated sum, `u = 2^-53`: its own `gamma_(m-1) sum
+/// |w f|` from the terms' exact sum and the compensated sum's `u |sum|`
+/// to first order (`sum |w f| <= s` here).
 #[test]
 fn without_its_estimate_the_unguarded_rule_gives_the_guarded_sums() {
     let bare = GaussLegendre {

@@ -606,9 +606,9 @@ fn algebraic(m: f64, d2: f64, halving: f64) -> f64 {
 /// it there) and where one node dominates the sum ([`dominated`]: a feature
 /// narrower than the node spacing, which no difference of rules bounds).
 ///
-/// Every sum is compensated but one: without the estimate, one axis of a
+/// Its sums are compensated but one: without the estimate, one axis of a
 /// tabulated order (at most [`TABLE_MAX_ORDER`] nodes) is one running sum,
-/// as the peers sum it, within `(m - 1) u sum |w f|` of the compensated
+/// as the peers sum it, within `gamma_(m-1) sum |w f|` of the terms' exact
 /// sum ([`unit_table`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -635,7 +635,7 @@ impl GaussLegendre {
     /// Whether a budget of `n` is one axis of a tabulated order without
     /// the estimate, which [`tabulated_line`] sums.
     #[inline(always)]
-    fn tabulated_line<const D: usize>(&self, n: usize) -> bool {
+    fn is_tabulated_line<const D: usize>(&self, n: usize) -> bool {
         D == 1 && !self.error_estimate && (1..=TABLE_MAX_ORDER).contains(&n)
     }
 }
@@ -645,11 +645,24 @@ impl GaussLegendre {
 #[inline(always)]
 fn tabulated_line<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
     m: usize,
-    f: F,
+    mut f: F,
 ) -> Result<Estimate<V>, QuadError> {
-    let value = unit_table::tabulated_value(m, f)?;
-    let error = V::zero().map(|_| f64::INFINITY);
-    Ok(Estimate::deterministic(value, error, m as u64))
+    let (value, evaluations) = unit_table::tabulated_value(
+        m,
+        #[inline(always)]
+        |u| {
+            let mut p = [0.0; D];
+            p[0] = u;
+            f(p)
+        },
+    )?;
+    Ok(without_estimate(value, evaluations))
+}
+
+/// The rule's value without its estimate: its error unknown, infinite.
+#[inline(always)]
+fn without_estimate<V: Value>(value: V, evaluations: u64) -> Estimate<V> {
+    Estimate::deterministic(value, V::zero().map(|_| f64::INFINITY), evaluations)
 }
 
 impl Rule for GaussLegendre {
@@ -707,7 +720,7 @@ impl Rule for GaussLegendre {
         rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
-        if self.tabulated_line::<D>(n) {
+        if self.is_tabulated_line::<D>(n) {
             return tabulated_line(n, f);
         }
         super::guard::checked(self, n, rng, f)
@@ -729,16 +742,14 @@ impl Rule for GaussLegendre {
         _rng: &mut R,
         f: F,
     ) -> Result<Estimate<V>, QuadError> {
-        if self.tabulated_line::<D>(n) {
+        if self.is_tabulated_line::<D>(n) {
             return tabulated_line(n, f);
         }
         crate::quadrature::check_budget(n)?;
         let m = per_axis::<D>(n, 1, "n")?;
         if !self.error_estimate {
             let value = product_value([&*unit_rule(m)?; D], f)?;
-            let error = V::zero().map(|_| f64::INFINITY);
-            let evaluations = (m as u64).pow(D as u32);
-            return Ok(Estimate::deterministic(value, error, evaluations));
+            return Ok(without_estimate(value, (m as u64).pow(D as u32)));
         }
         estimated(m, f)
     }

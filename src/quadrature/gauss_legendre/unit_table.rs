@@ -1,18 +1,19 @@
 //! Every tabulated Gauss–Legendre rule mapped to `[0, 1]`, built at compile
 //! time, and the rule's value on one such axis without its estimate.
 //!
-//! A few nodes a call is the common case in a renderer (a few nodes per
-//! ray segment, per pixel, per light). There the rule reads its nodes and
-//! weights from this table, with no cache to look up and no set to check,
-//! and adds each term to one running sum as the integrand's call returns,
-//! as bilby and gauss-quad do: at 5 nodes of `cos(50 x)` a compensated sum
-//! cost a tenth of the call's time and the buffer of values beside it more
-//! (`examples/gl_race.rs`, `benches/README.md`, `gl_small`).
+//! There the rule without its estimate reads its nodes and weights with
+//! no cache to look up and no set to check, and adds each term to one
+//! running sum as the integrand's call returns, as bilby and gauss-quad
+//! do: what a compensated sum would cost at a few nodes is in
+//! `benches/README.md` (`gl_small`, the tabulated line).
 //!
-//! The running sum's rounding is at most `(m - 1) u sum |w f|` with
-//! `u = 2^-53` (Higham's `gamma_(m-1)`) beside the terms' own `u/2` each,
-//! so at most `99 u` of the terms' magnitude at the largest order here;
-//! larger orders, and every sum the error estimate reads, are compensated.
+//! Each term `w f` is rounded once, within `u = 2^-53` of itself, and the
+//! running sum of the m terms is within `gamma_(m-1) sum |w f|` of their
+//! exact sum, `gamma_k = k u / (1 - k u)` (Higham, *Accuracy and Stability
+//! of Numerical Algorithms*, 2nd ed., section 4.2): at most about `99 u` of
+//! the terms' magnitude at the largest order here, where a compensated sum
+//! is within about `u |sum|`. Larger orders, and every sum the error
+//! estimate reads, are compensated.
 
 use crate::error::QuadError;
 use crate::quadrature::nodes::product_value;
@@ -79,24 +80,22 @@ pub fn unit_table(n: usize) -> &'static [[f64; 2]] {
 }
 
 /// `sum_i w_i f(u_i)` over the tabulated rule of order `m` in
-/// `1..=TABLE_MAX_ORDER` (the caller checks it) on the first axis of
-/// `[0, 1]^D`, `D = 1`: one running sum in the order of the nodes. A sum
-/// that is not finite is taken again by [`product_value`], which names the
-/// point whose value is not finite, finds a total within range, or names
-/// the sum out of range; the integrand is called a second time there.
+/// `1..=TABLE_MAX_ORDER` (the caller checks it) on `[0, 1]`, one running
+/// sum in the order of the nodes, with the evaluations it spent. A sum that
+/// is not finite is taken again by [`product_value`], which calls `f` at
+/// every node a second time (counted) and names the point whose value is
+/// not finite, finds a total within range, or names the sum out of range.
 #[inline(always)]
-pub(super) fn tabulated_value<const D: usize, V: Value, F>(m: usize, mut f: F) -> Result<V, QuadError>
-where
-    F: FnMut([f64; D]) -> Result<V, QuadError>,
-{
+pub(super) fn tabulated_value<V: Value>(
+    m: usize,
+    mut f: impl FnMut(f64) -> Result<V, QuadError>,
+) -> Result<(V, u64), QuadError> {
     let mut sum = V::zero();
     for &[u, w] in RULES[m] {
-        let mut p = [0.0; D];
-        p[0] = u;
-        sum = sum.zip(f(p)?, |s, y| s + y * w);
+        sum = sum.zip(f(u)?, |s, y| s + y * w);
     }
     if sum.all_finite() {
-        return Ok(sum);
+        return Ok((sum, m as u64));
     }
     again(m, f)
 }
@@ -104,9 +103,10 @@ where
 /// [`tabulated_value`]'s way out, off the line of the sum.
 #[cold]
 #[inline(never)]
-fn again<const D: usize, V: Value, F>(m: usize, f: F) -> Result<V, QuadError>
-where
-    F: FnMut([f64; D]) -> Result<V, QuadError>,
-{
-    product_value([&*unit_rule(m)?; D], f)
+fn again<V: Value>(
+    m: usize,
+    mut f: impl FnMut(f64) -> Result<V, QuadError>,
+) -> Result<(V, u64), QuadError> {
+    let value = product_value([&*unit_rule(m)?], |u: [f64; 1]| f(u[0]))?;
+    Ok((value, 2 * m as u64))
 }
