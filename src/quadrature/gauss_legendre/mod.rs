@@ -647,14 +647,16 @@ fn tabulated_line<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, Quad
     m: usize,
     mut f: F,
 ) -> Result<Estimate<V>, QuadError> {
-    let (value, evaluations) = unit_table::tabulated_value(
+    let mut evaluations = 0;
+    let value = unit_table::tabulated_value(
         m,
         #[inline(always)]
-        |u| {
+        move |u| {
             let mut p = [0.0; D];
             p[0] = u;
             f(p)
         },
+        &mut evaluations,
     )?;
     Ok(without_estimate(value, evaluations))
 }

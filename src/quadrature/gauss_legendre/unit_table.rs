@@ -81,22 +81,25 @@ pub fn unit_table(n: usize) -> &'static [[f64; 2]] {
 
 /// `sum_i w_i f(u_i)` over the tabulated rule of order `m` in
 /// `1..=TABLE_MAX_ORDER` (the caller checks it) on `[0, 1]`, one running
-/// sum in the order of the nodes, with the evaluations it spent. A sum that
-/// is not finite is taken again by [`product_value`], which calls `f` at
-/// every node a second time (counted) and names the point whose value is
-/// not finite, finds a total within range, or names the sum out of range.
+/// sum in the order of the nodes; `evaluations` counts the calls of `f`. A
+/// sum that is not finite is taken again by [`product_value`], which calls
+/// `f` at every node a second time and names the point whose value is not
+/// finite, finds a total within range, or names the sum out of range.
 #[inline(always)]
 pub(super) fn tabulated_value<V: Value>(
     m: usize,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
-) -> Result<(V, u64), QuadError> {
+    evaluations: &mut u64,
+) -> Result<V, QuadError> {
     let mut sum = V::zero();
     for &[u, w] in RULES[m] {
         sum = sum.zip(f(u)?, |s, y| s + y * w);
     }
+    *evaluations = m as u64;
     if sum.all_finite() {
-        return Ok((sum, m as u64));
+        return Ok(sum);
     }
+    *evaluations += m as u64;
     again(m, f)
 }
 
@@ -106,7 +109,6 @@ pub(super) fn tabulated_value<V: Value>(
 fn again<V: Value>(
     m: usize,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
-) -> Result<(V, u64), QuadError> {
-    let value = product_value([&*unit_rule(m)?], |u: [f64; 1]| f(u[0]))?;
-    Ok((value, 2 * m as u64))
+) -> Result<V, QuadError> {
+    product_value([&*unit_rule(m)?], |u: [f64; 1]| f(u[0]))
 }
