@@ -676,12 +676,13 @@ impl Rule for GaussLegendre {
         "Gauss–Legendre of any order 1..=1e8 (product rule in D > 1); error estimate from the tail of Q_m - Q_(m-1), Q_(m-1) - Q_(m-2), checked against Q_m - Q_(m/2) from m = 16"
     }
 
-    /// The m-node table per axis and the companion rule's beside it while
-    /// the estimate is computed: 56 bytes a node, from 552 MB of peak
-    /// resident memory measured at m = 1e7.
+    /// The m-node table per axis (a node and a weight, 16 bytes a node),
+    /// and with the estimate the companion rules' beside it: 56 bytes a
+    /// node, from 552 MB of peak resident memory measured at m = 1e7.
     #[inline]
     fn memory(&self, n: usize, dim: usize) -> f64 {
-        56.0 * integer_root(n, dim) as f64
+        let per_node = if self.error_estimate { 56.0 } else { 16.0 };
+        per_node * integer_root(n, dim) as f64
     }
 
     /// `m^D` nodes, and for the estimate `(m-1)^D + (m-2)^D` more, and
