@@ -102,20 +102,17 @@ const FULL_LEN: usize = TABLE_MAX_ORDER * (TABLE_MAX_ORDER + 1);
 /// the half table.
 static FULL: [f64; FULL_LEN] = mirrored();
 
-/// The tabulated half rules mirrored into full rules ascending in x: entry
-/// `i < n/2` of order n is row `k = i + 1` (its node negated: `-x_k`), entry
-/// `i >= n/2` is row `k = n - i` (the middle row of an odd rule at
-/// `i = n/2`); the weights follow the nodes in the same order.
+/// The tabulated half rules mirrored into full rules ascending in x
+/// ([`mirrored_row`]; the middle row of an odd rule at `i = n/2`); the
+/// weights follow the nodes in the same order.
 const fn mirrored() -> [f64; FULL_LEN] {
     let mut out = [0.0; FULL_LEN];
     let mut n = 1;
     while n <= TABLE_MAX_ORDER {
-        let (start, half) = (n * (n - 1), n * n / 4);
+        let start = n * (n - 1);
         let mut i = 0;
         while i < n {
-            let lower = i < n / 2;
-            let k = if lower { i + 1 } else { n - i };
-            let [x, _, w] = small_table::HALF_NODES[half + k - 1];
+            let ([x, _, w], lower) = mirrored_row(n, i);
             out[start + i] = if lower { -x } else { x };
             out[start + n + i] = w;
             i += 1;
@@ -123,6 +120,15 @@ const fn mirrored() -> [f64; FULL_LEN] {
         n += 1;
     }
     out
+}
+
+/// Entry `i` of the tabulated rule of order `n` ascending in x: its half
+/// table row `[x_k, 1 - x_k, w_k]` and whether it is in the lower half
+/// (`i < n/2`, row `k = i + 1`, at `-x_k`; else row `k = n - i`).
+const fn mirrored_row(n: usize, i: usize) -> ([f64; 3], bool) {
+    let lower = i < n / 2;
+    let k = if lower { i + 1 } else { n - i };
+    (small_table::HALF_NODES[n * n / 4 + k - 1], lower)
 }
 
 /// The tabulated rule of order `n <= TABLE_MAX_ORDER` in full (nodes

@@ -19,7 +19,7 @@ use crate::error::QuadError;
 use crate::quadrature::nodes::product_value;
 use crate::value::Value;
 
-use super::{TABLE_MAX_ORDER, small_table, unit_rule};
+use super::{TABLE_MAX_ORDER, mirrored_row, unit_rule};
 
 /// Nodes of all tabulated rules one after another, `sum_{n <= 100} n`.
 const UNIT_LEN: usize = TABLE_MAX_ORDER * (TABLE_MAX_ORDER + 1) / 2;
@@ -31,21 +31,19 @@ static UNIT: [[f64; 2]; UNIT_LEN] = unit_mirrored();
 /// The pairs of order n at index n (none at 0).
 static RULES: [&[[f64; 2]]; TABLE_MAX_ORDER + 1] = rules();
 
-/// The tabulated half rules mirrored into full rules on `[0, 1]`, as
-/// `computed_unit_nodes` maps them: entry `i < n/2` of order n is row
-/// `k = i + 1` at `u = (1 - x_k)/2`, from the tabulated `1 - x_k` (full
-/// relative precision near 0), entry `i >= n/2` is row `k = n - i` at
-/// `u = (1 + x_k)/2`; each weight is `w_k / 2`.
+/// The tabulated half rules mirrored into full rules on `[0, 1]`
+/// (`mirrored_row`), as `computed_unit_nodes` maps them: a lower-half
+/// entry at `u = (1 - x_k)/2`, from the tabulated `1 - x_k` (full relative
+/// precision near 0), an upper one at `u = (1 + x_k)/2`; each weight is
+/// `w_k / 2`.
 const fn unit_mirrored() -> [[f64; 2]; UNIT_LEN] {
     let mut out = [[0.0; 2]; UNIT_LEN];
     let mut n = 1;
     while n <= TABLE_MAX_ORDER {
-        let (start, half) = (n * (n - 1) / 2, n * n / 4);
+        let start = n * (n - 1) / 2;
         let mut i = 0;
         while i < n {
-            let lower = i < n / 2;
-            let k = if lower { i + 1 } else { n - i };
-            let [x, one_minus_x, w] = small_table::HALF_NODES[half + k - 1];
+            let ([x, one_minus_x, w], lower) = mirrored_row(n, i);
             let u = if lower {
                 0.5 * one_minus_x
             } else {
