@@ -732,7 +732,7 @@ impl Rule for GaussLegendre {
         if self.is_tabulated_line::<D>(n) {
             return tabulated_line(n, f);
         }
-        super::guard::checked(self, n, rng, f)
+        beyond_the_table(self, n, rng, f)
     }
 
     /// Without the estimate, the sum alone: small enough to inline where
@@ -754,14 +754,49 @@ impl Rule for GaussLegendre {
         if self.is_tabulated_line::<D>(n) {
             return tabulated_line(n, f);
         }
-        crate::quadrature::check_budget(n)?;
-        let m = per_axis::<D>(n, 1, "n")?;
-        if !self.error_estimate {
-            let value = product_value([&*unit_rule(m)?; D], f)?;
-            return Ok(without_estimate(value, (m as u64).pow(D as u32)));
-        }
-        estimated(m, f)
+        unguarded_beyond_the_table(self.error_estimate, n, f)
     }
+}
+
+/// [`GaussLegendre::try_integrate`] past one tabulated axis without the
+/// estimate: the limits, the guard, the rule. Out of line, so that the
+/// tabulated line's caller keeps a frame of its own size: inlined, this
+/// path's buffers gave it a frame of some 5 KB, probed and aligned at
+/// every call.
+#[inline(never)]
+fn beyond_the_table<
+    const D: usize,
+    V: Value,
+    R: rand::Rng + ?Sized,
+    F: FnMut([f64; D]) -> Result<V, QuadError>,
+>(
+    rule: &GaussLegendre,
+    n: usize,
+    rng: &mut R,
+    f: F,
+) -> Result<Estimate<V>, QuadError> {
+    super::guard::checked(rule, n, rng, f)
+}
+
+/// [`GaussLegendre::integrate_unguarded`] past one tabulated axis without
+/// the estimate, out of line as [`beyond_the_table`] is.
+#[inline(never)]
+fn unguarded_beyond_the_table<
+    const D: usize,
+    V: Value,
+    F: FnMut([f64; D]) -> Result<V, QuadError>,
+>(
+    error_estimate: bool,
+    n: usize,
+    f: F,
+) -> Result<Estimate<V>, QuadError> {
+    crate::quadrature::check_budget(n)?;
+    let m = per_axis::<D>(n, 1, "n")?;
+    if !error_estimate {
+        let value = product_value([&*unit_rule(m)?; D], f)?;
+        return Ok(without_estimate(value, (m as u64).pow(D as u32)));
+    }
+    estimated(m, f)
 }
 
 /// [`GaussLegendre`] with its error estimate, `m` nodes per axis.
