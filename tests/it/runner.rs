@@ -140,6 +140,11 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
         "an integer in 1..=100000000",
     );
     rejected(
+        &VALID.replace("[4, 16, 64]", "[4, 16, 4]"),
+        "budgets[2]",
+        "4 repeats budgets[0]: give each budget once",
+    );
+    rejected(
         &VALID.replace("\"kappa\": 2.0", "\"kappa\": -2.0"),
         "scene.medium.kappa",
         "a finite density >= 0",

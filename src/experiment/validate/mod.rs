@@ -394,11 +394,15 @@ fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
                 "an empty list: give at least one budget",
             ));
         }
-        Budgets::List(list) => list
-            .iter()
-            .enumerate()
-            .map(|(i, &n)| check(format!("budgets[{i}]"), n))
-            .collect::<Result<Vec<_>, _>>()?,
+        Budgets::List(list) => {
+            let out = list
+                .iter()
+                .enumerate()
+                .map(|(i, &n)| check(format!("budgets[{i}]"), n))
+                .collect::<Result<Vec<_>, _>>()?;
+            once_each(&out)?;
+            out
+        }
         Budgets::Range(r) => {
             let from = check("budgets.from".into(), r.from)?;
             let to = check("budgets.to".into(), r.to)?;
@@ -414,6 +418,20 @@ fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
     out.sort_unstable();
     out.dedup();
     Ok(out)
+}
+
+/// Every budget of a list given once: a repeated one would run once and
+/// be reported once, not as often as it was listed.
+fn once_each(list: &[usize]) -> Result<(), SpecError> {
+    for (i, n) in list.iter().enumerate() {
+        if let Some(first) = list[..i].iter().position(|m| m == n) {
+            return Err(SpecError::at(
+                format!("budgets[{i}]"),
+                format!("{n} repeats budgets[{first}]: give each budget once"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `from, from * factor, ... <= to`, each at least one above the last (so
