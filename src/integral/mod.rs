@@ -94,7 +94,18 @@ impl Built {
                  cos(theta), or \"uniform\"",
             ));
         }
-        Ok(self.integrand_at::<V>(&values)?.map(|v| v * jacobian))
+        self.weighted(self.integrand_at::<V>(&values)?, jacobian, &values)
+    }
+
+    /// The integrand's finite value `f` at `values` times the Jacobian;
+    /// an error naming the point where the product passes the f64 range.
+    #[inline]
+    fn weighted<V: Value>(&self, f: V, jacobian: f64, values: &[f64]) -> Result<V, QuadError> {
+        let product = f.map(|v| v * jacobian);
+        if !product.all_finite() {
+            return Err(self.out_of_range(values, f, jacobian));
+        }
+        Ok(product)
     }
 
     /// The integrand at the variables' `values`; a non-finite value is an
@@ -120,6 +131,33 @@ impl Built {
     /// The error for a non-finite integrand value `f` at `values`.
     #[cold]
     fn not_finite<V: Value>(&self, values: &[f64], f: V) -> QuadError {
+        QuadError::invalid(
+            "integrand",
+            format!("{} at {}", channels(f), self.point(values)),
+            "a finite value at every point the rules evaluate (closed rules evaluate the \
+             domain's ends and edges)",
+        )
+    }
+
+    /// The error for a finite integrand value `f` at `values` whose
+    /// product with the domain's `jacobian` is beyond the f64 range.
+    #[cold]
+    fn out_of_range<V: Value>(&self, values: &[f64], f: V, jacobian: f64) -> QuadError {
+        QuadError::invalid(
+            "integrand",
+            format!(
+                "{} at {}, times the domain's Jacobian {}, is beyond the f64 range",
+                channels(f),
+                self.point(values),
+                readable_number(jacobian)
+            ),
+            "values whose product with the domain's Jacobian (its measure per unit of the \
+             unit cube) is at most 1.8e308 in magnitude: scale the integrand down",
+        )
+    }
+
+    /// The point `values` in the domain's variables, as `x = 1, y = 2`.
+    fn point(&self, values: &[f64]) -> String {
         let at: Vec<String> = self
             .variables
             .iter()
@@ -127,13 +165,7 @@ impl Built {
             .take(self.region.coordinates())
             .map(|(name, v)| format!("{name} = {}", readable_number(*v)))
             .collect();
-        let channels: Vec<String> = (0..V::CHANNELS).map(|c| f.channel(c).to_string()).collect();
-        QuadError::invalid(
-            "integrand",
-            format!("{} at {}", channels.join(", "), at.join(", ")),
-            "a finite value at every point the rules evaluate (closed rules evaluate the \
-             domain's ends and edges)",
-        )
+        at.join(", ")
     }
 
     /// `int f d mu` with `rule` at budget `n`.
@@ -171,7 +203,9 @@ impl Built {
             let est = rule.try_integrate(n, rng, |u: [f64; 1]| {
                 let mut values = [0.0; MAX_VARIABLES];
                 match region::interval_point(piece, u[0], &mut values) {
-                    Some(jacobian) => Ok(self.integrand_at::<V>(&values)?.map(|v| v * jacobian)),
+                    Some(jacobian) => {
+                        self.weighted(self.integrand_at::<V>(&values)?, jacobian, &values)
+                    }
                     None => Ok(V::zero()),
                 }
             })?;
@@ -188,6 +222,14 @@ impl Built {
             _ => 1,
         }
     }
+}
+
+/// The channels of `f`, comma-separated.
+fn channels<V: Value>(f: V) -> String {
+    let each: Vec<String> = (0..V::CHANNELS)
+        .map(|c| readable_number(f.channel(c)))
+        .collect();
+    each.join(", ")
 }
 
 /// `v` as a person reads it: plain digits from 1e-4 to 1e15, else with an exponent.

@@ -442,6 +442,28 @@ fn a_non_finite_point_fails_its_job_with_the_point_named() {
         "the trapezoid's job names the point: {results}"
     );
     assert_eq!(failed.len(), 1, "the trapezoid's job alone fails");
+    // The failed row counts nothing and times nothing: no 0 evaluations,
+    // no NaN seconds, in the report, its page or its summary.
+    let report = std::fs::read_to_string(dir.join("rep/nan/report.md")).expect("report");
+    let row = report
+        .lines()
+        .find(|l| l.starts_with("| trapezoid | 64 |"))
+        .expect("the trapezoid's row");
+    assert!(
+        row.starts_with("| trapezoid | 64 | — | — | — | — | — | — | failed: "),
+        "{row}"
+    );
+    let page = std::fs::read_to_string(dir.join("rep/nan/index.html")).expect("page");
+    assert!(!page.contains("NaN"), "NaN on the page");
+    let summary: Json = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("rep/nan/summary.json")).expect("summary"),
+    )
+    .expect("json");
+    let trapezoid = summary.to_string();
+    assert!(
+        trapezoid.contains("\"evaluations\":null") && trapezoid.contains("\"evaluations\":149.0"),
+        "the failed row's evaluations null, Gauss–Legendre's 8^2 + 7^2 + 6^2: {trapezoid}"
+    );
     // Gauss–Legendre's nodes are inside: its job ran, near -3/2 (8 x 8 nodes on a log).
     let gl = results
         .lines()
@@ -452,4 +474,40 @@ fn a_non_finite_point_fails_its_job_with_the_point_named() {
         .as_f64()
         .expect("a value");
     close("gauss-legendre log(x) y", value, -1.5, 2e-2);
+}
+
+#[test]
+fn a_value_whose_product_with_the_jacobian_passes_the_range_is_named_as_such() {
+    // 1.7e308 on [-1, 1]: the unit cube's Jacobian 2 takes it past
+    // f64::MAX (1.797e308), and the integral, 3.4e308, is past it too.
+    let scene = |integrand: &str| {
+        built(json!({"domain": {"type": "interval", "a": -1, "b": 1}, "integrand": integrand}))
+            .unwrap_or_else(|e| panic!("{integrand}: {e}"))
+    };
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    for rule in ["gauss-legendre", "trapezoid"] {
+        let err = Integral::evaluate(
+            &scene("1.7e308"),
+            &Method::Rule(AnyRule::by_name(rule).expect("rule")),
+            16,
+            &mut rng,
+            &[Quantity::Integral],
+        )
+        .expect_err("past the range");
+        let text = err.to_string();
+        assert!(
+            text.contains("1.7e308 at x = ")
+                && text.contains("times the domain's Jacobian 2, is beyond the f64 range"),
+            "{rule}: {text}"
+        );
+        assert!(!text.contains("returned inf"), "{rule}: {text}");
+    }
+    // 8.9e307 times 2 is within the range: the integral, 1.78e308.
+    let m = integrate(
+        json!({"type": "interval", "a": -1, "b": 1}),
+        "8.9e307",
+        "gauss-legendre",
+        16,
+    );
+    close("8.9e307 on [-1, 1]", m.value[0], 1.78e308, 1e-15);
 }

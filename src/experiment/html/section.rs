@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 
 use crate::experiment::markdown::escape;
-use crate::experiment::report::{Page, Row, RowFlag, Section, cell, label, show_value};
+use crate::experiment::report::{Page, Row, RowFlag, Section, cell, count_cell, label, show_value};
 use crate::family::Flag;
 
 use super::page::q_anchor;
@@ -243,8 +243,8 @@ fn row(page: &Page, r: &Row, multi: bool, display: bool) -> String {
         num_cell(&show_value(&r.value), value),
         num_cell(&cell(r.rel_error), r.rel_error),
         num_cell(&cell(r.rel_estimate), r.rel_estimate),
-        num_cell(&format!("{:.0}", r.evaluations), r.evaluations),
-        num_cell(&format!("{:.2e}", r.seconds), r.seconds),
+        num_cell(&count_cell(r.evaluations), r.evaluations),
+        num_cell(&cell(r.seconds), r.seconds),
         escape(&crate::experiment::report::interval_cell(r.time.as_ref())),
         escape(&flags.join("; "))
     )

@@ -71,8 +71,8 @@ pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIED, ranked, ranks, tied};
 pub use rows::{FLAG_LEGEND, Row, RowFlag, rows};
 pub use section::not_run;
 pub use section::{
-    Fit, Section, cell, display_line, extra_columns, label, off_cell, over_budget, sections,
-    show_value, skipped,
+    Fit, Section, cell, count_cell, display_line, extra_columns, label, off_cell, over_budget,
+    sections, show_value, skipped,
 };
 pub use summary::{
     ExperimentSummary, FlagSummary, QuantitySummary, ReferenceSummary, ReportSummary, RowSummary,

@@ -10,8 +10,8 @@ use super::findings::findings;
 use super::ranking::Summary;
 use super::rows::{FLAG_LEGEND, Row, RowFlag};
 use super::section::{
-    cell, display_line, extra_columns, label, not_run, off_cell, over_budget, sections, show_value,
-    skipped,
+    cell, count_cell, display_line, extra_columns, label, not_run, off_cell, over_budget, sections,
+    show_value, skipped,
 };
 use super::summary::{ExperimentSummary, ReportSummary, experiment_summary};
 use crate::experiment::reference::crosscheck_markdown;
@@ -136,7 +136,8 @@ interval). Where a target is not reached and the slope against evaluations is an
 a quarter of itself (its 95% interval), the extrapolation is where that line reaches the target, its time scaled from the largest budget's \
 in proportion to the evaluations: an estimate, not a measurement.";
 
-/// A time's interval as a cell: `1.1e-6 to 1.3e-6 (96%)`.
+/// A time's interval as a cell: `1.1e-6 to 1.3e-6 (96%)`; "—" where
+/// no time was read (every job of the row failed).
 pub fn interval_cell(t: Option<&TimeInterval>) -> String {
     match t {
         Some(t) if t.samples > 1 => format!(
@@ -145,7 +146,8 @@ pub fn interval_cell(t: Option<&TimeInterval>) -> String {
             t.high,
             100.0 * t.confidence
         ),
-        _ => "— (one reading)".into(),
+        Some(_) => "— (one reading)".into(),
+        None => "—".into(),
     }
 }
 
@@ -340,10 +342,10 @@ fn table(page: &Page, rows: &[Row], display: Option<&Display>) -> String {
         }
         let _ = writeln!(
             md,
-            " {} | {:.0} | {:.2e} | {} | {} |",
+            " {} | {} | {} | {} | {} |",
             cell(r.rel_estimate),
-            r.evaluations,
-            r.seconds,
+            count_cell(r.evaluations),
+            cell(r.seconds),
             interval_cell(r.time.as_ref()),
             flags.join("; ")
         );

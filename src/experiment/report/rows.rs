@@ -105,9 +105,11 @@ pub struct Row {
     /// whose displayed value differs from the reference's (0: more work does
     /// not change what a person sees, against this reference).
     pub display_off: Option<f64>,
-    /// Mean evaluations.
+    /// Mean evaluations (NaN where every job of the row failed: none were
+    /// counted).
     pub evaluations: f64,
-    /// Lower median wall time per call, seconds: `time`'s median.
+    /// Lower median wall time per call, seconds: `time`'s median (NaN
+    /// where every job of the row failed).
     pub seconds: f64,
     /// The median's confidence interval over the repeats' times (None: no
     /// time was read).
@@ -234,7 +236,7 @@ fn row(
             rel_estimate: f64::NAN,
             max_error: f64::NAN,
             display_off: None,
-            evaluations: 0.0,
+            evaluations: f64::NAN,
             seconds,
             time,
             flags,

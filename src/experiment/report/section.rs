@@ -24,6 +24,15 @@ pub fn cell(x: f64) -> String {
     }
 }
 
+/// A mean count for a table cell, or "—" where none was counted (NaN).
+pub fn count_cell(x: f64) -> String {
+    if x.is_nan() {
+        "—".into()
+    } else {
+        format!("{x:.0}")
+    }
+}
+
 /// A value for a table cell: the number, or the root mean square of the
 /// channels with their count.
 pub fn show_value(v: &[f64]) -> String {

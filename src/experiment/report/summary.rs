@@ -154,8 +154,8 @@ pub struct RowSummary {
     pub rel_estimate: Option<f64>,
     /// The largest error of any channel in any repeat, same scale.
     pub max_error: Option<f64>,
-    /// Mean evaluations.
-    pub evaluations: f64,
+    /// Mean evaluations (null where every job of the row failed).
+    pub evaluations: Option<f64>,
     /// Median time per call with the median's confidence interval.
     pub seconds: Option<TimeInterval>,
     /// What the row's figures can be trusted for.
@@ -264,7 +264,7 @@ impl From<&Row> for RowSummary {
             rel_error: finite(r.rel_error),
             rel_estimate: finite(r.rel_estimate),
             max_error: finite(r.max_error),
-            evaluations: r.evaluations,
+            evaluations: finite(r.evaluations),
             seconds: r.time,
             flags: r
                 .flags
