@@ -128,6 +128,53 @@ impl QuadError {
             accepted: short_numbers(&accepted.into()),
         }
     }
+
+    /// The error for an integrand's finite `value` at the point `at` whose
+    /// product with its domain's `jacobian` is not finite: past the f64
+    /// range, or a Jacobian that is itself infinite (the map of an
+    /// infinite end, within about 1e-154 of it).
+    #[cold]
+    pub fn times_jacobian<V: crate::value::Value>(value: V, jacobian: f64, at: String) -> Self {
+        let value = channels(value);
+        let jacobian_text = readable_number(jacobian);
+        if jacobian.is_finite() {
+            QuadError::invalid(
+                "integrand",
+                format!(
+                    "{value} at {at}, times the domain's Jacobian {jacobian_text}, is beyond \
+                     the f64 range"
+                ),
+                "values whose product with the domain's Jacobian (its measure per unit of the \
+                 unit cube) is at most 1.8e308 in magnitude: scale the integrand down",
+            )
+        } else {
+            QuadError::invalid(
+                "integrand",
+                format!("{value} at {at}, where the domain's Jacobian is {jacobian_text}"),
+                "points where the domain's Jacobian is finite: the map of an infinite end \
+                 overflows within about 1e-154 of it, where a rule that splits that deep \
+                 evaluates; give the interval a finite end there",
+            )
+        }
+    }
+}
+
+/// The channels of `value` as a person reads them, comma-separated.
+pub fn channels<V: crate::value::Value>(value: V) -> String {
+    let each: Vec<String> = (0..V::CHANNELS)
+        .map(|c| readable_number(value.channel(c)))
+        .collect();
+    each.join(", ")
+}
+
+/// `v` as a person reads it: plain digits from 1e-4 to 1e15, else with an
+/// exponent (`1.7e308`, not 309 digits).
+pub fn readable_number(v: f64) -> String {
+    if v == 0.0 || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
 }
 
 /// The most characters of a user's value (a name, a string, a key, a file's

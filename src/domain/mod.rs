@@ -168,6 +168,27 @@ where
 {
     rule.try_integrate(n, rng, |u: [f64; D]| {
         let (p, jacobian) = domain.map(u);
-        Ok(g(p)?.map(|v| v * jacobian))
+        times_jacobian(g(p)?, jacobian, u)
     })
+}
+
+/// `value` times the domain's `jacobian` at the unit-cube point `u`; where
+/// the product is not finite while `value` is, an error naming both
+/// ([`QuadError::times_jacobian`]). A value that is not finite itself is
+/// passed on, for the rule to name at its point.
+#[inline]
+fn times_jacobian<const D: usize, V: Value>(
+    value: V,
+    jacobian: f64,
+    u: [f64; D],
+) -> Result<V, QuadError> {
+    let product = value.map(|v| v * jacobian);
+    if product.all_finite() || !value.all_finite() {
+        return Ok(product);
+    }
+    Err(QuadError::times_jacobian(
+        value,
+        jacobian,
+        format!("unit-cube point {u:?}"),
+    ))
 }

@@ -98,12 +98,13 @@ impl Built {
     }
 
     /// The integrand's finite value `f` at `values` times the Jacobian;
-    /// an error naming the point where the product passes the f64 range.
+    /// where the product is not finite, an error naming the point
+    /// ([`QuadError::times_jacobian`]).
     #[inline]
     fn weighted<V: Value>(&self, f: V, jacobian: f64, values: &[f64]) -> Result<V, QuadError> {
         let product = f.map(|v| v * jacobian);
         if !product.all_finite() {
-            return Err(self.out_of_range(values, f, jacobian));
+            return Err(QuadError::times_jacobian(f, jacobian, self.point(values)));
         }
         Ok(product)
     }
@@ -133,26 +134,9 @@ impl Built {
     fn not_finite<V: Value>(&self, values: &[f64], f: V) -> QuadError {
         QuadError::invalid(
             "integrand",
-            format!("{} at {}", channels(f), self.point(values)),
+            format!("{} at {}", crate::error::channels(f), self.point(values)),
             "a finite value at every point the rules evaluate (closed rules evaluate the \
              domain's ends and edges)",
-        )
-    }
-
-    /// The error for a finite integrand value `f` at `values` whose
-    /// product with the domain's `jacobian` is beyond the f64 range.
-    #[cold]
-    fn out_of_range<V: Value>(&self, values: &[f64], f: V, jacobian: f64) -> QuadError {
-        QuadError::invalid(
-            "integrand",
-            format!(
-                "{} at {}, times the domain's Jacobian {}, is beyond the f64 range",
-                channels(f),
-                self.point(values),
-                readable_number(jacobian)
-            ),
-            "values whose product with the domain's Jacobian (its measure per unit of the \
-             unit cube) is at most 1.8e308 in magnitude: scale the integrand down",
         )
     }
 
@@ -163,7 +147,7 @@ impl Built {
             .iter()
             .zip(values)
             .take(self.region.coordinates())
-            .map(|(name, v)| format!("{name} = {}", readable_number(*v)))
+            .map(|(name, v)| format!("{name} = {}", crate::error::readable_number(*v)))
             .collect();
         at.join(", ")
     }
@@ -221,23 +205,6 @@ impl Built {
             Region::Interval(pieces) => pieces.len(),
             _ => 1,
         }
-    }
-}
-
-/// The channels of `f`, comma-separated.
-fn channels<V: Value>(f: V) -> String {
-    let each: Vec<String> = (0..V::CHANNELS)
-        .map(|c| readable_number(f.channel(c)))
-        .collect();
-    each.join(", ")
-}
-
-/// `v` as a person reads it: plain digits from 1e-4 to 1e15, else with an exponent.
-fn readable_number(v: f64) -> String {
-    if v == 0.0 || (1e-4..1e15).contains(&v.abs()) {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
     }
 }
 

@@ -480,27 +480,38 @@ fn a_non_finite_point_fails_its_job_with_the_point_named() {
 fn a_value_whose_product_with_the_jacobian_passes_the_range_is_named_as_such() {
     // 1.7e308 on [-1, 1]: the unit cube's Jacobian 2 takes it past
     // f64::MAX (1.797e308), and the integral, 3.4e308, is past it too.
-    let scene = |integrand: &str| {
-        built(json!({"domain": {"type": "interval", "a": -1, "b": 1}, "integrand": integrand}))
-            .unwrap_or_else(|e| panic!("{integrand}: {e}"))
-    };
+    // The segment's own map applies its length (the domain's Jacobian)
+    // to what the integrand returns; the interval's is the family's.
     let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
-    for rule in ["gauss-legendre", "trapezoid"] {
-        let err = Integral::evaluate(
-            &scene("1.7e308"),
-            &Method::Rule(AnyRule::by_name(rule).expect("rule")),
-            16,
-            &mut rng,
-            &[Quantity::Integral],
-        )
-        .expect_err("past the range");
-        let text = err.to_string();
-        assert!(
-            text.contains("1.7e308 at x = ")
-                && text.contains("times the domain's Jacobian 2, is beyond the f64 range"),
-            "{rule}: {text}"
-        );
-        assert!(!text.contains("returned inf"), "{rule}: {text}");
+    for (domain, integrand, said) in [
+        ("interval", json!("1.7e308"), "1.7e308 at x = "),
+        ("segment", json!("1.7e308"), "1.7e308 at unit-cube point ["),
+        (
+            "segment",
+            json!(["1", "1e308", "2"]),
+            "1, 1e308, 2 at unit-cube point [",
+        ),
+    ] {
+        let scene =
+            built(json!({"domain": {"type": domain, "a": -1, "b": 1}, "integrand": integrand}))
+                .unwrap_or_else(|e| panic!("{integrand}: {e}"));
+        for rule in ["gauss-legendre", "trapezoid"] {
+            let err = Integral::evaluate(
+                &scene,
+                &Method::Rule(AnyRule::by_name(rule).expect("rule")),
+                16,
+                &mut rng,
+                &[Quantity::Integral],
+            )
+            .expect_err("past the range");
+            let text = err.to_string();
+            assert!(
+                text.contains(said)
+                    && text.contains("times the domain's Jacobian 2, is beyond the f64 range"),
+                "{domain} {rule}: {text}"
+            );
+            assert!(!text.contains("returned"), "{domain} {rule}: {text}");
+        }
     }
     // 8.9e307 times 2 is within the range: the integral, 1.78e308.
     let m = integrate(

@@ -423,11 +423,12 @@ fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
 /// Every budget of a list given once: a repeated one would run once and
 /// be reported once, not as often as it was listed.
 fn once_each(list: &[usize]) -> Result<(), SpecError> {
-    for (i, n) in list.iter().enumerate() {
-        if let Some(first) = list[..i].iter().position(|m| m == n) {
+    let mut first = std::collections::HashMap::with_capacity(list.len());
+    for (i, &n) in list.iter().enumerate() {
+        if let Some(j) = first.insert(n, i) {
             return Err(SpecError::at(
                 format!("budgets[{i}]"),
-                format!("{n} repeats budgets[{first}]: give each budget once"),
+                format!("{n} repeats budgets[{j}]: give each budget once"),
             ));
         }
     }

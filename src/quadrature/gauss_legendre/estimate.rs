@@ -172,7 +172,7 @@ fn algebraic(m: f64, d2: f64, halving: f64) -> f64 {
     halving / (hi.exp2() - 1.0)
 }
 
-/// [`GaussLegendre`] with its error estimate, `m` nodes per axis.
+/// [`GaussLegendre`](super::GaussLegendre) with its error estimate, `m` nodes per axis.
 pub(super) fn estimated<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadError>>(
     m: usize,
     mut f: F,
