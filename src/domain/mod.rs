@@ -168,27 +168,23 @@ where
 {
     rule.try_integrate(n, rng, |u: [f64; D]| {
         let (p, jacobian) = domain.map(u);
-        times_jacobian(g(p)?, jacobian, u)
+        times_jacobian(g(p)?, jacobian, || format!("unit-cube point {u:?}"))
     })
 }
 
-/// `value` times the domain's `jacobian` at the unit-cube point `u`; where
-/// the product is not finite while `value` is, an error naming both
+/// `value` times the domain's `jacobian`; where the product is not finite
+/// while `value` is, an error naming both and the point `at()`
 /// ([`QuadError::times_jacobian`]). A value that is not finite itself is
 /// passed on, for the rule to name at its point.
 #[inline]
-fn times_jacobian<const D: usize, V: Value>(
+pub(crate) fn times_jacobian<V: Value>(
     value: V,
     jacobian: f64,
-    u: [f64; D],
+    at: impl FnOnce() -> String,
 ) -> Result<V, QuadError> {
     let product = value.map(|v| v * jacobian);
     if product.all_finite() || !value.all_finite() {
         return Ok(product);
     }
-    Err(QuadError::times_jacobian(
-        value,
-        jacobian,
-        format!("unit-cube point {u:?}"),
-    ))
+    Err(QuadError::times_jacobian(value, jacobian, at()))
 }

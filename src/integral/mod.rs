@@ -98,15 +98,11 @@ impl Built {
     }
 
     /// The integrand's finite value `f` at `values` times the Jacobian;
-    /// where the product is not finite, an error naming the point
-    /// ([`QuadError::times_jacobian`]).
+    /// where the product is not finite, an error naming the point in the
+    /// domain's variables ([`crate::domain::times_jacobian`]).
     #[inline]
     fn weighted<V: Value>(&self, f: V, jacobian: f64, values: &[f64]) -> Result<V, QuadError> {
-        let product = f.map(|v| v * jacobian);
-        if !product.all_finite() {
-            return Err(QuadError::times_jacobian(f, jacobian, self.point(values)));
-        }
-        Ok(product)
+        crate::domain::times_jacobian(f, jacobian, || self.point(values))
     }
 
     /// The integrand at the variables' `values`; a non-finite value is an

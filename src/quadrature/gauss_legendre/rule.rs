@@ -150,10 +150,10 @@ impl Rule for GaussLegendre {
         beyond_the_table(self, n, rng, f)
     }
 
-    /// Without the estimate, the sum alone: small enough to inline where
-    /// it is called. One axis of a tabulated order is summed as the calls
-    /// return ([`unit_table`]: one running sum, not compensated), every
-    /// other in [`product_value`].
+    /// One axis of a tabulated order without the estimate is summed here
+    /// as the calls return ([`unit_table`]: one running sum, not
+    /// compensated), inlined where it is called; every other budget out of
+    /// line, so that its buffers stay out of the caller's frame.
     #[inline]
     fn integrate_unguarded<
         const D: usize,
