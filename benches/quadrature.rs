@@ -11,7 +11,10 @@
 //!   (as a run-time interval), `*/const` with constant bounds, and `*/par`
 //!   on every core (lightquad's `line_sum_par`, gauss-quad's `par_integrate`).
 //! - `gl_small/*`: the same integral with n = 5 .. 100 nodes, one call per
-//!   iteration: the fixed cost of a call, against the peers' cached rules.
+//!   iteration: the fixed cost of a call, against the peers' cached rules;
+//!   `lightquad` is `Rule::integrate` (its order looked up at every call),
+//!   `lightquad/fixed` a `FixedOrder` prepared once, as the peers' rules are,
+//!   `lightquad/estimate` the rule with its error estimate.
 //! - `sum_overhead/*`: the shared compensated summation against a bare loop
 //!   that only evaluates the integrand at the same nodes, n = 1e3 .. 1e6.
 
@@ -182,6 +185,12 @@ fn gl_small(c: &mut Criterion) {
                 })
             });
         }
+        let Ok(fixed) = lightquad::quadrature::gauss_legendre::FixedOrder::new(n) else {
+            return;
+        };
+        g.bench_with_input(BenchmarkId::new("lightquad/fixed", n), &n, |bench, _| {
+            bench.iter(|| fixed.integrate(black_box(a), black_box(b), integrand))
+        });
         let Ok(bil) = bilby::GaussLegendre::new(n) else {
             return;
         };

@@ -5,11 +5,13 @@
 //!
 //! `cargo run --release --example gl_call -- N MODE CALLS`, MODE one of
 //! `bare` (`Rule::integrate` without the error estimate), `estimate` (with
-//! it), `raw` (`product_sum` alone, no guard), `bilby` (its cached rule).
+//! it), `raw` (`product_sum` alone, no guard), `fixed` (a `FixedOrder`
+//! prepared once), `bilby` (its cached rule).
 //! Instructions per call: the difference of the counts at CALLS and at 0,
 //! over CALLS (`benches/README.md`, `gl_small`).
 use std::hint::black_box;
 
+use lightquad::quadrature::gauss_legendre::FixedOrder;
 use lightquad::quadrature::{GaussLegendre, Rule};
 use rand::SeedableRng;
 
@@ -24,11 +26,15 @@ fn main() {
     };
     let mut s = 0.0;
     let bil = bilby::GaussLegendre::new(n).expect("bilby");
+    let fixed = FixedOrder::new(n).expect("an order in range");
     for _ in 0..calls {
         let (a, b) = (black_box(-1.0f64), black_box(1.0f64));
         let h = b - a;
         s += match which {
             "bilby" => bil.rule().integrate(a, b, |x: f64| (50.0 * x).cos()),
+            "fixed" => fixed
+                .integrate(a, b, |x: f64| (50.0 * x).cos())
+                .unwrap_or(0.0),
             "raw" => {
                 let nodes = lightquad::quadrature::gauss_legendre::unit_rule(n).expect("nodes");
                 lightquad::quadrature::nodes::product_sum([&*nodes], |u: [f64; 1]| {

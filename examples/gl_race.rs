@@ -40,7 +40,7 @@ use std::hint::black_box;
 use std::num::NonZeroUsize;
 use std::time::Instant;
 
-use lightquad::quadrature::gauss_legendre::{TABLE_MAX_ORDER, unit_nodes};
+use lightquad::quadrature::gauss_legendre::{FixedOrder, TABLE_MAX_ORDER, unit_nodes};
 use lightquad::quadrature::nodes::{line_sum_par, product_sum};
 use lightquad::quadrature::{GaussLegendre, Rule};
 use rand::SeedableRng;
@@ -161,6 +161,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let bare = GaussLegendre {
         error_estimate: false,
     };
+    let fixed = FixedOrder::new(n)?;
     let bil = bilby::GaussLegendre::new(n)?;
     let gq = gauss_quad::GaussLegendre::new(NonZeroUsize::new(n).ok_or("n = 0")?);
     let (a, b) = (-1.0f64, 1.0f64);
@@ -181,6 +182,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let h = b - a;
                 bare.integrate(n, &mut rng, |u: [f64; 1]| integrand(a + h * u[0]))
                     .map_or(f64::NAN, |e| e.value * h)
+            }),
+        ),
+        (
+            "lightquad fixed",
+            Box::new(|| {
+                fixed
+                    .integrate(black_box(a), black_box(b), integrand)
+                    .unwrap_or(f64::NAN)
             }),
         ),
         (
@@ -293,6 +302,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("lightquad rule", "bilby"),
         ("lightquad rule", "gauss-quad"),
         ("lightquad rule", "lightquad"),
+        ("lightquad fixed", "bilby"),
+        ("lightquad fixed", "gauss-quad"),
+        ("lightquad fixed", "lightquad rule"),
         ("lightquad estimate", "lightquad rule"),
         ("lightquad", "bilby"),
         ("lightquad", "gauss-quad"),

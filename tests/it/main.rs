@@ -21,6 +21,7 @@ mod exchange_exact;
 mod exchange_family;
 mod external;
 mod family_plugin;
+mod fixed_order;
 mod furnace_family;
 mod gauss_legendre;
 mod gauss_legendre_peers;

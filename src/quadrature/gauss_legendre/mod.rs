@@ -21,6 +21,7 @@ pub mod bessel;
 pub mod bogaert;
 mod double_double;
 mod estimate;
+mod fixed;
 pub mod lanes;
 pub mod newton;
 pub mod small_table;
@@ -29,6 +30,7 @@ mod trig;
 pub mod unit_table;
 
 pub use estimate::{HYBRID_FROM, hybrid_estimate};
+pub use fixed::FixedOrder;
 pub use rule::GaussLegendre;
 
 use std::borrow::Cow;

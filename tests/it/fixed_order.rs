@@ -1,0 +1,213 @@
+//! [`FixedOrder`], Gauss–Legendre of one order prepared once: its values
+//! against closed forms on both sides of the compiled-in table, its nodes
+//! inside the interval, and every way a call fails.
+
+use lightquad::QuadError;
+use lightquad::quadrature::gauss_legendre::{FixedOrder, MAX_ORDER, TABLE_MAX_ORDER};
+use lightquad::value::Rgb;
+use proptest::prelude::*;
+
+fn rule(n: usize) -> FixedOrder {
+    FixedOrder::new(n).expect("an order in range")
+}
+
+/// `int_a^b (x - c)^k dx = ((b - c)^(k+1) - (a - c)^(k+1)) / (k + 1)`:
+/// exact for every degree `k <= 2n - 1`, to rounding, on tabulated and
+/// computed orders, forward and reversed.
+#[test]
+fn polynomials_up_to_degree_2n_minus_1_are_exact() {
+    let (a, b, c): (f64, f64, f64) = (-0.5, 2.0, 0.75);
+    for n in [1, 2, 3, 5, 10, 37, 64, 99, 100, 101, 128, 1000] {
+        let fixed = rule(n);
+        assert_eq!(fixed.order(), n);
+        for k in [0, n, 2 * n - 1] {
+            let exact =
+                ((b - c).powi(k as i32 + 1) - (a - c).powi(k as i32 + 1)) / (k as f64 + 1.0);
+            // The terms' magnitude bounds the rounding: `int |x - c|^k`.
+            let scale = ((b - c).abs().powi(k as i32 + 1) + (a - c).abs().powi(k as i32 + 1))
+                / (k as f64 + 1.0);
+            let f = |x: f64| (x - c).powi(k as i32);
+            let forward = fixed.integrate(a, b, f).expect("finite");
+            let backward = fixed.integrate(b, a, f).expect("finite");
+            let tolerance = 1e-13 * scale;
+            assert!(
+                (forward - exact).abs() <= tolerance,
+                "n = {n}, k = {k}: {forward} against {exact}"
+            );
+            assert!(
+                (backward + exact).abs() <= tolerance,
+                "n = {n}, k = {k}: {backward} against {}",
+                -exact
+            );
+        }
+    }
+}
+
+/// `int_{-1}^{1} cos(50 x) dx = sin(50)/25`, the benchmarks' integral: not
+/// resolved at 5 nodes; from 100 on, within rounding of the nodes and the
+/// sum. Each `x` is within `delta` of its exact node (the table's are
+/// correctly rounded, half an ulp; the computed ones within a few ulps:
+/// 4 assumed), and `a + h u` adds two roundings, so the values move by at
+/// most `max |f'| (delta + 2u) (b - a)`, `f' <= 50`; the running sum adds
+/// `99 u sum |w f| (b - a)` (about 1.4e-14), the compensated sum a few `u`.
+#[test]
+fn the_benchmark_integral_converges_on_both_sides_of_the_table() {
+    let exact = 50f64.sin() / 25.0;
+    let f = |x: f64| (50.0 * x).cos();
+    let at = |n: usize| rule(n).integrate(-1.0, 1.0, f).expect("finite");
+    assert!((at(5) - exact).abs() > 0.1);
+    let u = f64::EPSILON / 2.0;
+    let nodes = |delta: f64| 50.0 * (delta + 2.0 * u) * 2.0;
+    let error = (at(100) - exact).abs();
+    assert!(
+        error < nodes(u) + 99.0 * u * 1.3,
+        "n = 100: error {error:e}"
+    );
+    for n in [101, 1000, 100_000] {
+        let error = (at(n) - exact).abs();
+        assert!(
+            error < nodes(4.0 * u) + 4.0 * u * 1.3,
+            "n = {n}: error {error:e}"
+        );
+    }
+}
+
+/// Each channel of an RGB integrand is its own integral.
+#[test]
+fn rgb_channels_integrate_apart() {
+    for n in [12, 300] {
+        let value = rule(n)
+            .integrate(0.0, 1.0, |x: f64| Rgb::new(1.0, 2.0 * x, (3.0 * x).exp()))
+            .expect("finite");
+        assert!((value.x - 1.0).abs() < 1e-15, "n = {n}: {value:?}");
+        assert!((value.y - 1.0).abs() < 1e-15, "n = {n}: {value:?}");
+        assert!(
+            (value.z - (3f64.exp() - 1.0) / 3.0).abs() < 1e-12,
+            "n = {n}: {value:?}"
+        );
+    }
+}
+
+/// Orders outside `1..=MAX_ORDER` are refused, naming `n`.
+#[test]
+fn orders_out_of_range_are_refused() {
+    for n in [0, MAX_ORDER + 1] {
+        let message = FixedOrder::new(n).expect_err("out of range").to_string();
+        assert!(message.contains(&format!("n = {n}")), "{message}");
+        assert!(message.contains("1..="), "{message}");
+    }
+}
+
+/// A value that is not finite is named with its node, whatever the order;
+/// the integrand is then called a second time at every node.
+#[test]
+fn a_value_that_is_not_finite_is_named_at_its_node() {
+    for n in [5, 101] {
+        let mut calls = 0;
+        let err = rule(n)
+            .integrate(-1.0, 1.0, |x: f64| {
+                calls += 1;
+                1.0 / x
+            })
+            .expect_err("1/0 at the middle node");
+        let message = err.to_string();
+        assert!(message.contains("inf at x = 0"), "n = {n}: {message}");
+        assert!(message.contains("[-1, 1]"), "n = {n}: {message}");
+        let expected_calls = if n <= TABLE_MAX_ORDER {
+            n + n / 2 + 1
+        } else {
+            n / 2 + 1
+        };
+        assert_eq!(calls, expected_calls, "n = {n}");
+    }
+    let message = rule(4)
+        .integrate(0.0, 1.0, |x: f64| if x > 0.5 { f64::NAN } else { x })
+        .expect_err("NaN above 1/2")
+        .to_string();
+    assert!(message.contains("NaN at x = 0.6"), "{message}");
+}
+
+/// Ends and lengths that are not finite are named; an integrand's own
+/// error is returned as it is, at its first call.
+#[test]
+fn ends_that_are_not_finite_and_integrand_errors_are_named() {
+    for n in [3, 200] {
+        let fixed = rule(n);
+        for (a, b, field) in [
+            (f64::NAN, 1.0, "a = NaN"),
+            (0.0, f64::INFINITY, "b = inf"),
+            (-1e308, 1e308, "distance from a = -1e308"),
+        ] {
+            let message = fixed
+                .integrate(a, b, |_: f64| 1.0)
+                .expect_err("not a finite interval")
+                .to_string();
+            assert!(message.contains(field), "n = {n}, [{a}, {b}]: {message}");
+        }
+        let mut calls = 0;
+        let err = fixed.try_integrate(0.0, 1.0, |x: f64| {
+            calls += 1;
+            if x >= 0.5 {
+                Err(QuadError::invalid("x", x, "below 0.5"))
+            } else {
+                Ok(x)
+            }
+        });
+        assert!(
+            matches!(err, Err(QuadError::InvalidParameter { ref name, .. }) if name == "x"),
+            "n = {n}: {err:?}"
+        );
+        assert_eq!(calls, n / 2 + 1, "n = {n}");
+    }
+}
+
+/// An integral of `f64::MAX` over a unit length is `f64::MAX`, found
+/// where a running sum passes the range; over a length of 4 it is beyond
+/// the range, and said so.
+#[test]
+fn integrals_at_the_edge_of_the_range() {
+    for n in [5, 64, 100, 150] {
+        let fixed = rule(n);
+        let max = fixed
+            .integrate(0.0, 1.0, |_: f64| f64::MAX)
+            .expect("within range");
+        assert!(
+            max.is_finite() && max >= f64::MAX * (1.0 - 1e-13),
+            "n = {n}: {max}"
+        );
+        let message = fixed
+            .integrate(0.0, 4.0, |_: f64| 1e308)
+            .expect_err("4e308")
+            .to_string();
+        assert!(
+            message.contains("beyond the f64 range") && message.contains("times the length 4"),
+            "n = {n}: {message}"
+        );
+    }
+}
+
+proptest! {
+    /// Every node the integrand sees lies in `[min(a, b), max(a, b)]`,
+    /// also where the interval spans a few ulps of its ends or nearly the
+    /// whole f64 range.
+    #[test]
+    fn every_node_lies_inside_the_interval(
+        a in prop_oneof![-1e300f64..1e300, -10f64..10.0],
+        relative_width in -17f64..0.5,
+        reversed in any::<bool>(),
+        n in prop::sample::select(vec![1usize, 2, 5, 17, 64, 100, 101, 257]),
+    ) {
+        // From a few ulps of `a` to three times its magnitude.
+        let b = a + a.abs().max(1e-300) * 10f64.powf(relative_width);
+        let (a, b) = if reversed { (b, a) } else { (a, b) };
+        let (lo, hi) = (a.min(b), a.max(b));
+        let mut outside = None;
+        let _ = rule(n).integrate(a, b, |x: f64| {
+            if !(lo <= x && x <= hi) {
+                outside = Some(x);
+            }
+            0.0
+        });
+        prop_assert!(outside.is_none(), "n = {}, [{}, {}]: node {:?}", n, a, b, outside);
+    }
+}
