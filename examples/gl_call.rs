@@ -34,7 +34,7 @@ fn main() {
             "bilby" => bil.rule().integrate(a, b, |x: f64| (50.0 * x).cos()),
             "fixed" => fixed
                 .integrate(a, b, |x: f64| (50.0 * x).cos())
-                .unwrap_or(0.0),
+                .unwrap_or(f64::NAN),
             "raw" => {
                 let nodes = lightquad::quadrature::gauss_legendre::unit_rule(n).expect("nodes");
                 lightquad::quadrature::nodes::product_sum([&*nodes], |u: [f64; 1]| {

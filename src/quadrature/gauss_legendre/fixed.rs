@@ -8,25 +8,11 @@
 //! its order up at every call, since the budget is an argument; this type
 //! looks it up once, so that a call is the sum alone and its one check.
 //! It has no error estimate (the rule with `error_estimate: true` has).
-//!
-//! ```
-//! use lightquad::quadrature::gauss_legendre::FixedOrder;
-//!
-//! // Five nodes are exact for polynomials up to degree 9.
-//! let rule = FixedOrder::new(5)?;
-//! let integral = rule.integrate(0.0, 2.0, |x: f64| x.powi(9))?;
-//! assert!((integral - 2f64.powi(10) / 10.0).abs() < 1e-12);
-//!
-//! // A value that is not finite is named with its node, never returned.
-//! let err = rule.integrate(-1.0, 1.0, |x: f64| 1.0 / x).unwrap_err();
-//! assert!(err.to_string().contains("at x = 0"), "{err}");
-//! # Ok::<(), lightquad::QuadError>(())
-//! ```
 
 use std::sync::Arc;
 
 use super::unit_table::{running_sum, unit_table};
-use super::{TABLE_MAX_ORDER, check_order, unit_nodes};
+use super::{TABLE_MAX_ORDER, check_order, unit_nodes, unit_rule};
 use crate::error::{QuadError, channels, readable_number};
 use crate::quadrature::nodes::{UnitNodes, product_value};
 use crate::value::Value;
@@ -44,22 +30,45 @@ use crate::value::Value;
 /// first node whose value is not finite, an end that is not finite, or the
 /// integral beyond the f64 range (in the table, after taking the integrand
 /// again at every node by the compensated sum).
-#[derive(Debug, Clone)]
+///
+/// ```
+/// use lightquad::quadrature::gauss_legendre::FixedOrder;
+///
+/// // Five nodes are exact for polynomials up to degree 9.
+/// let rule = FixedOrder::new(5)?;
+/// let integral = rule.integrate(0.0, 2.0, |x: f64| x.powi(9))?;
+/// assert!((integral - 2f64.powi(10) / 10.0).abs() < 1e-12);
+///
+/// // A value that is not finite is named with its node, never returned.
+/// let err = rule.integrate(-1.0, 1.0, |x: f64| 1.0 / x).unwrap_err();
+/// assert!(err.to_string().contains("at x = 0"), "{err}");
+/// # Ok::<(), lightquad::QuadError>(())
+/// ```
+#[derive(Clone)]
 pub struct FixedOrder {
     /// The compiled-in rule, `[u, w]` pairs on `[0, 1]`, for `n <=`
-    /// [`TABLE_MAX_ORDER`]; empty above. Not an enum with `computed`:
-    /// the loop's own test of an empty slice is then the only one a call
-    /// makes (an enum's test cost some 1% of a five-node call).
+    /// [`TABLE_MAX_ORDER`]; empty above, so that the loop's own test of an
+    /// empty slice is the only test of the kind of rule a call makes.
     table: &'static [[f64; 2]],
     /// The computed rule from the shared cache ([`unit_nodes`]) above
     /// [`TABLE_MAX_ORDER`] nodes.
     computed: Option<Arc<UnitNodes>>,
 }
 
+/// The order alone: the nodes are 2e6 numbers at 1e6 nodes.
+impl std::fmt::Debug for FixedOrder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FixedOrder")
+            .field("order", &self.order())
+            .finish()
+    }
+}
+
 impl FixedOrder {
     /// The rule of `n` nodes, `n` in `1..=MAX_ORDER`; above
     /// [`TABLE_MAX_ORDER`] its nodes are computed here (some 4 ms at
-    /// 1e6 nodes) or taken from the shared cache.
+    /// 1e6 nodes: `benches/README.md`, `gl_nodes`) or taken from the shared
+    /// cache.
     pub fn new(n: usize) -> Result<Self, QuadError> {
         check_order(n)?;
         if n <= TABLE_MAX_ORDER {
@@ -114,9 +123,12 @@ impl FixedOrder {
         }
         // Every node is at least 1.4e-4 of the length from either end
         // (n <= 100), so `a + (b - a) u` stays inside [a, b] through its
-        // roundings; an end or a length that is not finite makes the
-        // product with `b - a` not finite.
+        // roundings. An end that is not finite makes `b - a` not finite
+        // too: then no node is taken, and the compensated path names it.
         let h = b - a;
+        if !h.is_finite() {
+            return retabulated(table.len(), &[a, b], f);
+        }
         let value = running_sum(table, |u| f(a + h * u))?.map(|s| s * h);
         if value.all_finite() {
             return Ok(value);
@@ -143,9 +155,9 @@ impl FixedOrder {
 /// [`compensated`] on the tabulated rule of order `n`, whose running sum
 /// came out not finite. Out of line, so that the tabulated call keeps a
 /// frame of its own size and nothing but the order and the ends live past
-/// its loop. The ends come by reference: the loop then reads the lower end
-/// from memory rather than reloading it and the length into registers
-/// after every call (at 50 nodes 1.0008 against 1.0000 of bilby's time).
+/// its loop. The ends come by reference, which keeps them in memory, where
+/// the loop reads the lower end (`benches/README.md`, `gl_small`, fifth
+/// session).
 #[cold]
 #[inline(never)]
 fn retabulated<V: Value>(
@@ -153,50 +165,59 @@ fn retabulated<V: Value>(
     [a, b]: &[f64; 2],
     f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<V, QuadError> {
-    compensated(&*unit_nodes(n)?, *a, *b, f)
+    compensated(&*unit_rule(n)?, *a, *b, f)
 }
 
-/// The integral on `nodes` by a compensated sum ([`product_value`]), on
-/// `[lo, hi]` with `lo <= hi` (a reversed interval's integral negated):
-/// `x = lo + s u`, the scale `s` the length `h = hi - lo` or, where the
-/// last node would round past `hi` (computed nodes come within 1e-16 of
-/// 1), the largest below it that keeps it at `hi` at most; rounding is
-/// monotone, so every node is then inside. The integral is `h` times the
-/// mean. One test a call: a select at every node or a map from each end
-/// (`hi - h (1 - u)` above the middle) cost some 2% and 5% of a call at
-/// 1e6 nodes of `cos(50 x)` (`benches/README.md`, the fifth session).
+/// The integral on `nodes` by a compensated sum ([`product_value`]):
+/// `x = a + s u`, the scale `s` the signed length `h = b - a` or, where
+/// the last node would round past `b` (only near [`MAX_ORDER`](super::MAX_ORDER)
+/// do nodes come within an ulp of 1), the nearest to it that keeps that
+/// node at `b`; rounding is monotone, so every node is then inside. The
+/// integral is `h` times the mean. On a tabulated order `s = h`: the nodes
+/// of the running sum it takes again.
 fn compensated<V: Value>(
     nodes: &UnitNodes,
     a: f64,
     b: f64,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<V, QuadError> {
-    finite_length(a, b)?;
-    let (lo, hi, sign) = if a <= b { (a, b, 1.0) } else { (b, a, -1.0) };
-    let h = hi - lo;
-    let last = nodes.u.last().copied().unwrap_or(0.0);
-    let mut s = h;
-    while lo + s * last > hi {
-        s = s.next_down();
-    }
-    let x_at = move |u: f64| lo + s * u;
+    let h = finite_length(a, b)?;
+    let s = scale_within(a, b, nodes.u.last().copied().unwrap_or(0.0));
+    let x_at = move |u: f64| a + s * u;
     let mean = product_value([nodes], move |u: [f64; 1]| f(x_at(u[0])))
-        .map_err(|e| named_at_x(e, x_at, lo, hi))?;
-    let value = mean.map(|m| sign * (m * h));
+        .map_err(|e| named_at_x(e, x_at, a.min(b), a.max(b)))?;
+    let value = mean.map(|m| m * h);
     if value.all_finite() {
         return Ok(value);
     }
     Err(QuadError::invalid(
         "integrand",
         format!(
-            "its mean {} over [{}, {}], times the length {}, is beyond the f64 range",
+            "its mean {} over [{}, {}], times b - a = {}, is beyond the f64 range",
             channels(mean),
             readable_number(a),
             readable_number(b),
-            readable_number(b - a)
+            readable_number(h)
         ),
         "an integral at most 1.8e308 in magnitude: scale the integrand down",
     ))
+}
+
+/// The scale `s` nearest `b - a` (finite) with `a + s last` not past `b`
+/// for the largest node `last` of `[0, 1]`: `b - a` itself unless that
+/// node rounds past `b`; at `s = 0` the node is `a`, so the search ends.
+fn scale_within(a: f64, b: f64, last: f64) -> f64 {
+    let mut s = b - a;
+    if s >= 0.0 {
+        while a + s * last > b {
+            s = s.next_down();
+        }
+    } else {
+        while a + s * last < b {
+            s = s.next_up();
+        }
+    }
+    s
 }
 
 /// [`product_value`]'s error for a value that is not finite, at a node
@@ -238,4 +259,26 @@ fn finite_length(a: f64, b: f64) -> Result<f64, QuadError> {
             readable_number(a)
         ),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::scale_within;
+
+    /// `b - a` rounds up where the ends differ in sign and magnitude:
+    /// `0.75 + (2^53 - 1)` is `2^53`, so a node at 1 would land at 1,
+    /// past `b = 0.75`; the scale then steps down to `2^53 - 1`, the node
+    /// to 0. Reversed, the same from above; and `b - a` itself elsewhere.
+    #[test]
+    fn the_scale_keeps_the_last_node_inside() {
+        let a = -(2f64.powi(53) - 1.0);
+        let s = scale_within(a, 0.75, 1.0);
+        assert_eq!(s, 2f64.powi(53) - 1.0);
+        assert!(a + s <= 0.75);
+        let s = scale_within(-a, -0.75, 1.0);
+        assert_eq!(s, -(2f64.powi(53) - 1.0));
+        assert!(-a + s >= -0.75);
+        assert_eq!(scale_within(0.1, 0.3, 1.0 - f64::EPSILON / 2.0), 0.3 - 0.1);
+        assert_eq!(scale_within(2.0, -1.0, 0.9), -3.0);
+    }
 }

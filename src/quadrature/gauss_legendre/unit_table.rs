@@ -99,13 +99,10 @@ pub(super) fn tabulated_value<V: Value>(
 }
 
 /// `sum_i w_i f(u_i)` over `pairs` (`[u_i, w_i]`), one running sum in
-/// their order, unchecked: within `gamma_(m-1) sum |w f|` of the terms'
-/// exact sum where it is finite (module doc).
-///
-/// The loop runs by index, as the peers' loops do: LLVM then unrolls it by
-/// two with the odd node last, where the slice iterator's loop took the
-/// odd node first and was some 1% slower at five nodes (`benches/README.md`,
-/// the fifth session).
+/// their order, unchecked: within `gamma_(k-1) sum |w f|` of the terms'
+/// exact sum where it is finite, `k = pairs.len()` (module doc). By index,
+/// as the peers' loops run: unrolled by two with the odd node last
+/// (`benches/README.md`, `gl_small`, fifth session).
 #[inline(always)]
 pub(super) fn running_sum<V: Value>(
     pairs: &[[f64; 2]],
