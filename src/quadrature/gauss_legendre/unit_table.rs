@@ -100,11 +100,57 @@ pub(super) fn tabulated_value<V: Value>(
 
 /// `sum_i w_i f(u_i)` over `pairs` (`[u_i, w_i]`), one running sum in
 /// their order, unchecked: within `gamma_(k-1) sum |w f|` of the terms'
-/// exact sum where it is finite, `k = pairs.len()` (module doc). By index,
-/// as the peers' loops run: unrolled by two with the odd node last
-/// (`benches/README.md`, `gl_small`, fifth session).
+/// exact sum where it is finite, `k = pairs.len()` (module doc). Up to
+/// [`STRAIGHT_UP_TO`] pairs, straight-line code of that order
+/// ([`straight_sum`]); above, a loop by index, as the peers' loops run,
+/// unrolled by two with the odd node last (`benches/README.md`,
+/// `gl_small`, fifth and sixth sessions).
 #[inline(always)]
 pub(super) fn running_sum<V: Value>(
+    pairs: &[[f64; 2]],
+    f: impl FnMut(f64) -> Result<V, QuadError>,
+) -> Result<V, QuadError> {
+    // One arm an order: a jump on the length, then its calls one after
+    // the other, with no loop counter between them.
+    macro_rules! by_order {
+        ($($k:literal)*) => {
+            match pairs.len() {
+                $($k => match <&[[f64; 2]; $k]>::try_from(pairs) {
+                    Ok(order) => straight_sum(order, f),
+                    Err(_) => looped_sum(pairs, f),
+                },)*
+                k => {
+                    debug_assert!(k == 0 || k > STRAIGHT_UP_TO, "order {k} has no arm");
+                    looped_sum(pairs, f)
+                }
+            }
+        };
+    }
+    by_order!(1 2 3 4 5 6 7 8)
+}
+
+/// Orders summed by [`straight_sum`]: the few nodes a renderer takes per
+/// ray segment, pixel or light. Each order's arm holds its own copy of the
+/// integrand's code, 36 in all, and only the order in use runs.
+pub(super) const STRAIGHT_UP_TO: usize = 8;
+
+/// [`running_sum`] over an order known when compiled: a loop of `K`
+/// steps, which the compiler unrolls into `K` calls in a row.
+#[inline(always)]
+fn straight_sum<const K: usize, V: Value>(
+    pairs: &[[f64; 2]; K],
+    mut f: impl FnMut(f64) -> Result<V, QuadError>,
+) -> Result<V, QuadError> {
+    let mut sum = V::zero();
+    for &[u, w] in pairs {
+        sum = sum.zip(f(u)?, |s, y| s + y * w);
+    }
+    Ok(sum)
+}
+
+/// [`running_sum`] above [`STRAIGHT_UP_TO`] pairs.
+#[inline(always)]
+fn looped_sum<V: Value>(
     pairs: &[[f64; 2]],
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<V, QuadError> {
