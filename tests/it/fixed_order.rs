@@ -186,6 +186,41 @@ fn ends_that_are_not_finite_and_integrand_errors_are_named() {
     }
 }
 
+/// An integrand's own error is its own even where it is the kind the sum
+/// raises for a value that is not finite: returned as it is, not told
+/// again at a node, in the table (also where the running sum came out
+/// not finite and the compensated sum takes the nodes again) and above.
+#[test]
+fn an_integrands_own_error_is_not_renamed() {
+    let own = || QuadError::NonFiniteIntegrand {
+        point: vec![7.0],
+        value: "the integrand's own".into(),
+    };
+    let is_own = |e: &QuadError| {
+        matches!(e, QuadError::NonFiniteIntegrand { point, value }
+            if point == &[7.0] && value == "the integrand's own")
+    };
+    for n in [3, 200] {
+        let err = rule(n)
+            .try_integrate(0.0, 1.0, |x: f64| if x >= 0.5 { Err(own()) } else { Ok(x) })
+            .expect_err("its error");
+        assert!(is_own(&err), "n = {n}: {err:?}");
+    }
+    // Infinite at the first pass's last node, its own error at the second.
+    let mut calls = 0;
+    let err = rule(3)
+        .try_integrate(0.0, 1.0, |_: f64| {
+            calls += 1;
+            match calls {
+                3 => Ok(f64::INFINITY),
+                4.. => Err(own()),
+                _ => Ok(1.0),
+            }
+        })
+        .expect_err("its error on the second pass");
+    assert!(is_own(&err), "{err:?}");
+}
+
 /// An integral of `f64::MAX` over a unit length is `f64::MAX`, found
 /// where a running sum passes the range; over a length of 4 it is beyond
 /// the range, and said so.

@@ -184,8 +184,20 @@ fn compensated<V: Value>(
     let h = finite_length(a, b)?;
     let s = scale_within(a, b, nodes.u.last().copied().unwrap_or(0.0));
     let x_at = move |u: f64| a + s * u;
-    let mean = product_value([nodes], move |u: [f64; 1]| f(x_at(u[0])))
-        .map_err(|e| named_at_x(e, x_at, a.min(b), a.max(b)))?;
+    // The integrand's own error goes back as it is; only the sum's own
+    // (a value not finite at a node of [0, 1]) is told at its x.
+    let mut own = None;
+    let mean = product_value([nodes], |u: [f64; 1]| {
+        f(x_at(u[0])).map_err(|e| {
+            own = Some(e);
+            // Stops the sum; the error returned is `own`.
+            QuadError::invalid("integrand", "its own error", "")
+        })
+    });
+    if let Some(error) = own {
+        return Err(error);
+    }
+    let mean = mean.map_err(|e| named_at_x(e, x_at, a.min(b), a.max(b)))?;
     let value = mean.map(|m| m * h);
     if value.all_finite() {
         return Ok(value);

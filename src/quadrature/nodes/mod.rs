@@ -363,6 +363,6 @@ fn out_of_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError
 pub fn non_finite<V: Value>(p: &[f64], y: &V) -> QuadError {
     QuadError::NonFiniteIntegrand {
         point: p.to_vec(),
-        value: format!("{y:?}"),
+        value: crate::error::channels(*y),
     }
 }
