@@ -227,7 +227,7 @@ pub fn mis_sample<V: Value, B: Brdf, G: rand::Rng + ?Sized>(
     if !score.all_finite() {
         return Err(QuadError::NonFiniteIntegrand {
             point: vec![],
-            value: format!("{score:?}"),
+            value: crate::error::channels(score),
         });
     }
     Ok((score, evaluations))

@@ -518,6 +518,70 @@ fn an_integrand_error_propagates_through_every_rule() {
     }
 }
 
+/// An integrand's own error comes back unchanged even where it is of a
+/// kind the rules raise themselves (a sum out of range, a value not
+/// finite), which the guard reads to decide on a scaled pass.
+#[test]
+fn an_integrands_own_error_of_the_rules_own_kinds_comes_back_unchanged() {
+    let mut rules: Vec<AnyRule> = lightquad::quadrature::BaseRule::defaults()
+        .into_iter()
+        .map(AnyRule::from)
+        .collect();
+    rules.push(AnyRule::by_name("product(gauss-legendre,stratified)").expect("known"));
+    let own_errors = [
+        QuadError::SumOutOfRange {
+            sum: "value",
+            value: "the integrand's own".into(),
+            largest: "1".into(),
+        },
+        QuadError::NonFiniteIntegrand {
+            point: vec![7.0],
+            value: "the integrand's own".into(),
+        },
+    ];
+    for rule in rules {
+        let dim2 = rule.name() == "product" || rule.dimensions().min > 1;
+        for own in &own_errors {
+            for fail_at in [0usize, 5] {
+                let mut calls = 0usize;
+                let mut f = |u: f64| {
+                    calls += 1;
+                    if calls > fail_at {
+                        Err(own.clone())
+                    } else {
+                        Ok(u)
+                    }
+                };
+                let e = if dim2 {
+                    rule.try_integrate(256, &mut rng(1), |u: [f64; 2]| f(u[0] * u[1]))
+                } else {
+                    rule.try_integrate(256, &mut rng(1), |u: [f64; 1]| f(u[0]))
+                }
+                .expect_err("the integrand failed");
+                assert_eq!(&e, own, "{}, failing after {fail_at} calls", rule.name());
+            }
+        }
+    }
+}
+
+/// A value that is not finite in one channel, beside a channel the guard
+/// scales (3e300 is past 2^500), is told as the integrand returned it,
+/// not as the scaled pass saw it.
+#[test]
+fn a_value_not_finite_is_told_as_the_integrand_returned_it() {
+    for name in ["gauss-legendre", "gauss-kronrod", "simpson"] {
+        let rule = AnyRule::by_name(name).expect("known");
+        let e = rule
+            .try_integrate(256, &mut rng(1), |u: [f64; 1]| {
+                let y = if u[0] > 0.9 { f64::NAN } else { 1.0 };
+                Ok(Rgb::new(0.25, y, 3e300))
+            })
+            .expect_err("NaN above 0.9");
+        let message = e.to_string();
+        assert!(message.contains("0.25, NaN, 3e300"), "{name}: {message}");
+    }
+}
+
 /// Adaptive Gauss–Kronrod spends at most its budget: a bisection costs two
 /// new G7-K15 panels (30 evaluations), and it stops before exceeding `n`
 /// (it spent about 2n when it counted pieces instead).

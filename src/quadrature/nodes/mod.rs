@@ -354,8 +354,8 @@ fn out_of_range<V: Value>(sum: ProductSum<V>) -> Result<ProductSum<V>, QuadError
         .unwrap_or(("value", sum.value));
     Err(QuadError::SumOutOfRange {
         sum: name,
-        value: format!("{out:?}"),
-        largest: format!("{:?}", sum.largest),
+        value: crate::error::channels(out),
+        largest: crate::error::channels(sum.largest),
     })
 }
 
