@@ -46,6 +46,38 @@ fn polynomials_up_to_degree_2n_minus_1_are_exact() {
     }
 }
 
+/// Up to 100 nodes the sum is one running sum in the order of the nodes,
+/// as documented: on `[0, 1]` (`x = u`, `b - a = 1` exactly) `FixedOrder`
+/// and the rule without its estimate give the bits of a plain loop over
+/// the public table, `s += f(u) w`, at every order, those summed in a row
+/// (1 to 8) and those summed by a loop. The integrand's terms differ in
+/// magnitude by some 1e16, so another order of the sum, or a compensated
+/// one, would change the last bits.
+#[test]
+fn the_running_sum_is_the_plain_loops_bits_at_every_tabulated_order() {
+    use lightquad::quadrature::gauss_legendre::unit_table::unit_table;
+    use lightquad::quadrature::{GaussLegendre, Rule};
+    use rand::SeedableRng;
+    let f = |x: f64| 1e16 * (1e3 * x).sin() + 1.0 / (x + 1e-3);
+    let without_estimate = GaussLegendre {
+        error_estimate: false,
+    };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(1);
+    for n in 1..=TABLE_MAX_ORDER {
+        let mut plain = 0.0;
+        for &[u, w] in unit_table(n) {
+            plain += f(u) * w;
+        }
+        let fixed = rule(n).integrate(0.0, 1.0, f).expect("finite");
+        let by_rule = without_estimate
+            .integrate(n, &mut rng, |u: [f64; 1]| f(u[0]))
+            .expect("finite")
+            .value;
+        assert_eq!(fixed.to_bits(), plain.to_bits(), "n = {n}: FixedOrder");
+        assert_eq!(by_rule.to_bits(), plain.to_bits(), "n = {n}: the rule");
+    }
+}
+
 /// `int_{-1}^{1} cos(50 x) dx = sin(50)/25`, the benchmarks' integral: not
 /// resolved at 5 nodes; from 100 on, within rounding of the nodes and the
 /// sum. Each `x` is within `delta` of its exact node (the table's are
@@ -188,8 +220,9 @@ fn ends_that_are_not_finite_and_integrand_errors_are_named() {
 
 /// An integrand's own error is its own even where it is the kind the sum
 /// raises for a value that is not finite: returned as it is, not told
-/// again at a node, in the table (also where the running sum came out
-/// not finite and the compensated sum takes the nodes again) and above.
+/// again at a node, in the table (the running sum returns it at once; the
+/// compensated sum, where the running sum came out not finite and takes
+/// the nodes again, the last case) and above (the compensated sum).
 #[test]
 fn an_integrands_own_error_is_not_renamed() {
     let own = || QuadError::NonFiniteIntegrand {

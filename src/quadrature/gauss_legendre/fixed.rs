@@ -47,8 +47,8 @@ use crate::value::Value;
 #[derive(Clone)]
 pub struct FixedOrder {
     /// The compiled-in rule, `[u, w]` pairs on `[0, 1]`, for `n <=`
-    /// [`TABLE_MAX_ORDER`]; empty above, so that the loop's own test of an
-    /// empty slice is the only test of the kind of rule a call makes.
+    /// [`TABLE_MAX_ORDER`]; empty above, so that a test of its length is
+    /// the only test of the kind of rule a call makes.
     table: &'static [[f64; 2]],
     /// The computed rule from the shared cache ([`unit_nodes`]) above
     /// [`TABLE_MAX_ORDER`] nodes.
@@ -155,8 +155,8 @@ impl FixedOrder {
 /// [`compensated`] on the tabulated rule of order `n`, whose running sum
 /// came out not finite. Out of line, so that the tabulated call keeps a
 /// frame of its own size and nothing but the order and the ends live past
-/// its loop. The ends come by reference, which keeps them in memory, where
-/// the loop reads the lower end (`benches/README.md`, `gl_small`, fifth
+/// its sum. The ends come by reference, which keeps them in memory, where
+/// the sum reads the lower end (`benches/README.md`, `gl_small`, fifth
 /// session).
 #[cold]
 #[inline(never)]
@@ -174,7 +174,10 @@ fn retabulated<V: Value>(
 /// do nodes come within an ulp of 1), the nearest to it that keeps that
 /// node at `b`; rounding is monotone, so every node is then inside. The
 /// integral is `h` times the mean. On a tabulated order `s = h`: the nodes
-/// of the running sum it takes again.
+/// of the running sum it takes again. The integrand's own error comes back
+/// as it is: on one axis [`product_value`] stops at the first error `f`
+/// returns, which is kept aside and returned in place of the one that
+/// stopped the sum.
 fn compensated<V: Value>(
     nodes: &UnitNodes,
     a: f64,

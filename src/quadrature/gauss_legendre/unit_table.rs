@@ -101,41 +101,46 @@ pub(super) fn tabulated_value<V: Value>(
 /// `sum_i w_i f(u_i)` over `pairs` (`[u_i, w_i]`), one running sum in
 /// their order, unchecked: within `gamma_(k-1) sum |w f|` of the terms'
 /// exact sum where it is finite, `k = pairs.len()` (module doc). Up to
-/// [`STRAIGHT_UP_TO`] pairs, straight-line code of that order
-/// ([`straight_sum`]); above, a loop by index, as the peers' loops run,
-/// unrolled by two with the odd node last (`benches/README.md`,
-/// `gl_small`, fifth and sixth sessions).
+/// [`STRAIGHT_UP_TO`] pairs, one arm an order ([`straight_sum`]); above,
+/// a loop by index, as the peers' loops run (`benches/README.md`,
+/// `gl_small`, fifth and sixth sessions). Both add the same terms in the
+/// same order, so the arms change no bit of a value.
 #[inline(always)]
 pub(super) fn running_sum<V: Value>(
     pairs: &[[f64; 2]],
     f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<V, QuadError> {
-    // One arm an order: a jump on the length, then its calls one after
-    // the other, with no loop counter between them.
+    // A jump on the length, then that order's calls one after another,
+    // with no loop counter between them. Each arm's conversion holds by
+    // the arm's own length (its `Err` is never taken).
     macro_rules! by_order {
-        ($($k:literal)*) => {
+        ($($k:literal)*) => {{
+            const _: () = assert!(
+                [$($k),*].len() == STRAIGHT_UP_TO && [$($k),*][STRAIGHT_UP_TO - 1] == STRAIGHT_UP_TO,
+                "one arm for each order 1..=STRAIGHT_UP_TO"
+            );
             match pairs.len() {
                 $($k => match <&[[f64; 2]; $k]>::try_from(pairs) {
                     Ok(order) => straight_sum(order, f),
                     Err(_) => looped_sum(pairs, f),
                 },)*
-                k => {
-                    debug_assert!(k == 0 || k > STRAIGHT_UP_TO, "order {k} has no arm");
-                    looped_sum(pairs, f)
-                }
+                _ => looped_sum(pairs, f),
             }
-        };
+        }};
     }
     by_order!(1 2 3 4 5 6 7 8)
 }
 
-/// Orders summed by [`straight_sum`]: the few nodes a renderer takes per
-/// ray segment, pixel or light. Each order's arm holds its own copy of the
-/// integrand's code, 36 in all, and only the order in use runs.
-pub(super) const STRAIGHT_UP_TO: usize = 8;
+/// Orders summed by [`straight_sum`]. Each order's arm is compiled with
+/// the integrand inlined at each of its calls where the compiler inlines
+/// it (a large integrand may be called instead): 36 copies per integrand
+/// and call site, on `FixedOrder` and on the rule's tabulated line alike,
+/// and nested integrals multiply them. Only the order in use runs. The
+/// command-line binary grew by 1.8% (`benches/README.md`, sixth session).
+const STRAIGHT_UP_TO: usize = 8;
 
 /// [`running_sum`] over an order known when compiled: a loop of `K`
-/// steps, which the compiler unrolls into `K` calls in a row.
+/// steps, which an optimized build unrolls into `K` calls in a row.
 #[inline(always)]
 fn straight_sum<const K: usize, V: Value>(
     pairs: &[[f64; 2]; K],
