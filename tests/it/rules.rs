@@ -475,34 +475,53 @@ fn product_names_and_dimensions_are_checked() {
     assert!(e.to_string().contains("dimension 1"), "{e}");
 }
 
-/// An integrand's error stops every rule at once and comes back unchanged:
-/// no later node is evaluated (products included, the error raised inside
-/// the inner rule).
-#[test]
-fn an_integrand_error_propagates_through_every_rule() {
+/// Every default rule, and a product over an inner rule.
+fn every_rule_and_a_product() -> Vec<AnyRule> {
     let mut rules: Vec<AnyRule> = lightquad::quadrature::BaseRule::defaults()
         .into_iter()
         .map(AnyRule::from)
         .collect();
     rules.push(AnyRule::by_name("product(gauss-legendre,stratified)").expect("known"));
-    for rule in rules {
-        let dim2 = rule.name() == "product" || rule.dimensions().min > 1;
+    rules
+}
+
+/// `rule` at a budget of 256 on an integrand that returns `error` from
+/// its call `fail_at + 1` on (in two dimensions for a product or a rule
+/// that needs them): the rule's error and the integrand's calls.
+fn failing_after(
+    rule: &AnyRule,
+    fail_at: usize,
+    error: impl Fn(f64) -> QuadError,
+) -> (QuadError, usize) {
+    let dim2 = rule.name() == "product" || rule.dimensions().min > 1;
+    let mut calls = 0usize;
+    let mut f = |u: f64| {
+        calls += 1;
+        if calls > fail_at {
+            Err(error(u))
+        } else {
+            Ok(u)
+        }
+    };
+    let e = if dim2 {
+        rule.try_integrate(256, &mut rng(1), |u: [f64; 2]| f(u[0] * u[1]))
+    } else {
+        rule.try_integrate(256, &mut rng(1), |u: [f64; 1]| f(u[0]))
+    }
+    .expect_err("the integrand failed");
+    (e, calls)
+}
+
+/// An integrand's error stops every rule at once and comes back unchanged:
+/// no later node is evaluated (products included, the error raised inside
+/// the inner rule).
+#[test]
+fn an_integrand_error_propagates_through_every_rule() {
+    for rule in every_rule_and_a_product() {
         for fail_at in [0usize, 5] {
-            let mut calls = 0usize;
-            let mut f = |u: f64| {
-                calls += 1;
-                if calls > fail_at {
-                    Err(QuadError::invalid("density", u, "a test failure"))
-                } else {
-                    Ok(u)
-                }
-            };
-            let e = if dim2 {
-                rule.try_integrate(256, &mut rng(1), |u: [f64; 2]| f(u[0] * u[1]))
-            } else {
-                rule.try_integrate(256, &mut rng(1), |u: [f64; 1]| f(u[0]))
-            }
-            .expect_err("the integrand failed");
+            let (e, calls) = failing_after(&rule, fail_at, |u| {
+                QuadError::invalid("density", u, "a test failure")
+            });
             assert!(
                 e.to_string().contains("a test failure"),
                 "{}: {e}",
@@ -523,11 +542,6 @@ fn an_integrand_error_propagates_through_every_rule() {
 /// finite), which the guard reads to decide on a scaled pass.
 #[test]
 fn an_integrands_own_error_of_the_rules_own_kinds_comes_back_unchanged() {
-    let mut rules: Vec<AnyRule> = lightquad::quadrature::BaseRule::defaults()
-        .into_iter()
-        .map(AnyRule::from)
-        .collect();
-    rules.push(AnyRule::by_name("product(gauss-legendre,stratified)").expect("known"));
     let own_errors = [
         QuadError::SumOutOfRange {
             sum: "value",
@@ -539,25 +553,10 @@ fn an_integrands_own_error_of_the_rules_own_kinds_comes_back_unchanged() {
             value: "the integrand's own".into(),
         },
     ];
-    for rule in rules {
-        let dim2 = rule.name() == "product" || rule.dimensions().min > 1;
+    for rule in every_rule_and_a_product() {
         for own in &own_errors {
             for fail_at in [0usize, 5] {
-                let mut calls = 0usize;
-                let mut f = |u: f64| {
-                    calls += 1;
-                    if calls > fail_at {
-                        Err(own.clone())
-                    } else {
-                        Ok(u)
-                    }
-                };
-                let e = if dim2 {
-                    rule.try_integrate(256, &mut rng(1), |u: [f64; 2]| f(u[0] * u[1]))
-                } else {
-                    rule.try_integrate(256, &mut rng(1), |u: [f64; 1]| f(u[0]))
-                }
-                .expect_err("the integrand failed");
+                let (e, _) = failing_after(&rule, fail_at, |_| own.clone());
                 assert_eq!(&e, own, "{}, failing after {fail_at} calls", rule.name());
             }
         }
