@@ -6,7 +6,7 @@
 //! `cargo run --release --example gl_call -- N MODE CALLS`, MODE one of
 //! `bare` (`Rule::integrate` without the error estimate), `estimate` (with
 //! it), `raw` (`product_sum` alone, no guard), `fixed` (a `FixedOrder`
-//! prepared once), `bilby` (its cached rule).
+//! prepared once), `bilby` (its cached rule), `gauss-quad` (its rule).
 //! Instructions per call: the difference of the counts at CALLS and at 0,
 //! over CALLS (`benches/README.md`, `gl_small`).
 use std::hint::black_box;
@@ -24,30 +24,46 @@ fn main() {
     let rule = GaussLegendre {
         error_estimate: which == "estimate",
     };
-    let mut s = 0.0;
     let bil = bilby::GaussLegendre::new(n).expect("bilby");
     let fixed = FixedOrder::new(n).expect("an order in range");
-    for _ in 0..calls {
-        let (a, b) = (black_box(-1.0f64), black_box(1.0f64));
-        let h = b - a;
-        s += match which {
-            "bilby" => bil.rule().integrate(a, b, |x: f64| (50.0 * x).cos()),
-            "fixed" => fixed
+    let gq = gauss_quad::GaussLegendre::new(std::num::NonZeroUsize::new(n).expect("n >= 1"));
+    // The mode is chosen once, outside the loop: a string compared at
+    // every call would count as the call's own.
+    let s = match which {
+        "bilby" => calls_of(calls, |a, b| {
+            bil.rule().integrate(a, b, |x: f64| (50.0 * x).cos())
+        }),
+        "gauss-quad" => calls_of(calls, |a, b| gq.integrate(a, b, |x: f64| (50.0 * x).cos())),
+        "fixed" => calls_of(calls, |a, b| {
+            fixed
                 .integrate(a, b, |x: f64| (50.0 * x).cos())
-                .unwrap_or(f64::NAN),
-            "raw" => {
-                let nodes = lightquad::quadrature::gauss_legendre::unit_rule(n).expect("nodes");
-                lightquad::quadrature::nodes::product_sum([&*nodes], |u: [f64; 1]| {
-                    Ok((50.0 * (a + h * u[0])).cos())
-                })
-                .map(|s| s.value * h)
-                .unwrap_or(0.0)
-            }
-            _ => rule
-                .integrate(n, &mut rng, |u: [f64; 1]| (50.0 * (a + h * u[0])).cos())
+                .unwrap_or(f64::NAN)
+        }),
+        "raw" => calls_of(calls, |a, b| {
+            let h = b - a;
+            let nodes = lightquad::quadrature::gauss_legendre::unit_rule(n).expect("nodes");
+            lightquad::quadrature::nodes::product_sum([&*nodes], |u: [f64; 1]| {
+                Ok((50.0 * (a + h * u[0])).cos())
+            })
+            .map(|s| s.value * h)
+            .unwrap_or(0.0)
+        }),
+        _ => calls_of(calls, |a, b| {
+            let h = b - a;
+            rule.integrate(n, &mut rng, |u: [f64; 1]| (50.0 * (a + h * u[0])).cos())
                 .map(|e| e.value * h)
-                .unwrap_or(0.0),
-        };
-    }
+                .unwrap_or(0.0)
+        }),
+    };
     println!("{s}");
+}
+
+/// The sum of `calls` calls of `integral` on `[-1, 1]`, the ends unknown
+/// to the compiler.
+fn calls_of(calls: usize, mut integral: impl FnMut(f64, f64) -> f64) -> f64 {
+    let mut s = 0.0;
+    for _ in 0..calls {
+        s += integral(black_box(-1.0), black_box(1.0));
+    }
+    s
 }
