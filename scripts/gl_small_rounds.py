@@ -2,9 +2,11 @@
 """Criterion's `gl_small` bench in rounds, the contenders side by side.
 
     python3 scripts/gl_small_rounds.py [ROUNDS] [--n N ...] [--raw FILE]
+    python3 scripts/gl_small_rounds.py --from FILE [FILE ...]
 
 (default 7 rounds, n = 5, 10, 20, 50, 100; `--raw` writes every round's
-medians as JSON, from which each printed figure can be taken again). Criterion times the contenders
+medians as JSON; `--from` runs nothing and reports the rounds of such
+files together). Criterion times the contenders
 of a group one after another, so that a minute in which the shared machine
 is busy falls on one contender and not its peers: one run of the bench
 moved a contender's median by a third from one run to the next
@@ -22,6 +24,7 @@ baseline under `target/criterion` is read or changed.
 
 import argparse
 import json
+import math
 import os
 import re
 import statistics
@@ -134,8 +137,37 @@ def git_head():
     return head.stdout.strip() + ("+" if dirty.returncode else "")
 
 
-def print_report(rounds, ns):
-    print(f"Commit {git_head()}. Criterion medians in ns, median over {len(rounds)} rounds:\n")
+def median_interval(values):
+    """A 95% interval of the median, from the order statistics: the `j`-th
+    lowest and highest of `k` values, `j` the largest with `P(B < j) <=
+    0.025`, `B` binomial (k, 1/2); free of any distribution. Below 6 values
+    no such `j` exists, and the interval is all of them."""
+    k = len(values)
+    ordered = sorted(values)
+    below, j = 0.0, 0
+    while True:
+        below += math.comb(k, j) / 2**k
+        if below > 0.025:
+            break
+        j += 1
+    j = max(j, 1)
+    return ordered[j - 1], ordered[k - j]
+
+
+def read_raw(paths):
+    """The rounds of `--raw` files, and what they were measured on."""
+    rounds, sources = [], []
+    for path in paths:
+        with open(path) as f:
+            raw = json.load(f)
+        sources.append(f"{Path(path).name} ({raw['commit']}, {len(raw['rounds'])} rounds)")
+        for r in raw["rounds"]:
+            rounds.append({(e["contender"], e["n"]): e["median_ns"] for e in r})
+    return rounds, ", ".join(sources)
+
+
+def print_report(rounds, ns, source):
+    print(f"{source}. Criterion medians in ns, median over {len(rounds)} rounds:\n")
     labels = list(CONTENDERS.values())
     print("| n | " + " | ".join(labels) + " |")
     print("|---:|" + "---:|" * len(labels))
@@ -143,13 +175,17 @@ def print_report(rounds, ns):
         cells = [statistics.median(t[(c, n)] for t in rounds) for c in labels]
         print(f"| {n} | " + " | ".join(f"{c:.1f}" for c in cells) + " |")
     print("\nRatios within each round against the faster peer (the lower median over rounds), median over rounds:\n")
-    print("| n | ratio | median | rounds below 1 | each round |")
-    print("|---:|---|---:|---:|---|")
+    print("| n | ratio | median | 95% interval of the median | rounds below 1 | each round |")
+    print("|---:|---|---:|---|---:|---|")
     for n, per in ratio_rows(rounds, ns):
         for name, values in per.items():
             below = sum(v < 1 for v in values)
+            lo, hi = median_interval(values)
             each = " ".join(f"{v:.3f}" for v in values)
-            print(f"| {n} | {name} | {statistics.median(values):.4f} | {below} of {len(values)} | {each} |")
+            print(
+                f"| {n} | {name} | {statistics.median(values):.4f} | {lo:.3f} to {hi:.3f} "
+                f"| {below} of {len(values)} | {each} |"
+            )
 
 
 def main():
@@ -157,7 +193,18 @@ def main():
     parser.add_argument("rounds", nargs="?", type=int, default=7)
     parser.add_argument("--n", type=int, nargs="+", default=list(BENCH_NS))
     parser.add_argument("--raw", help="write every round's medians here, as JSON")
+    parser.add_argument("--from", dest="sources", nargs="+", help="report these --raw files' rounds, run nothing")
     args = parser.parse_args()
+    if args.sources:
+        try:
+            rounds, source = read_raw(args.sources)
+            ns = [n for n in args.n if all((c, n) in t for t in rounds for c in CONTENDERS.values())]
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            parser.error(f"--from: {e!r}: expected files written by --raw")
+        if not rounds or not ns:
+            parser.error("--from: no round holds every contender at any of the n asked for")
+        print_report(rounds, ns, source)
+        return
     if args.rounds < 1:
         parser.error(f"ROUNDS {args.rounds}: expected at least 1")
     bad = [n for n in args.n if n not in BENCH_NS]
@@ -173,7 +220,7 @@ def main():
             print(f"round {r + 1} of {args.rounds} done", file=sys.stderr)
     if args.raw:
         write_raw(args.raw, rounds, binary)
-    print_report(rounds, args.n)
+    print_report(rounds, args.n, f"Commit {git_head()}")
 
 
 if __name__ == "__main__":
