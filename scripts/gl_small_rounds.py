@@ -138,19 +138,20 @@ def git_head():
 
 
 def median_interval(values):
-    """A 95% interval of the median, from the order statistics: the `j`-th
-    lowest and highest of `k` values, `j` the largest with `P(B < j) <=
-    0.025`, `B` binomial (k, 1/2); free of any distribution. Below 6 values
-    no such `j` exists, and the interval is all of them."""
+    """An interval holding the median with at least 95% confidence, from
+    the order statistics, free of any distribution: the `j`-th lowest and
+    highest of `k` values, `j` the largest with `P(B < j) <= 0.025`, `B`
+    binomial (k, 1/2). It covers more than 95% where no `j` gives 95%
+    exactly (98.8% at 11 rounds, 96.5% at 33); `None` below 6 values,
+    where even the least and the largest cover less."""
     k = len(values)
     ordered = sorted(values)
     below, j = 0.0, 0
-    while True:
+    while below + math.comb(k, j) / 2**k <= 0.025:
         below += math.comb(k, j) / 2**k
-        if below > 0.025:
-            break
         j += 1
-    j = max(j, 1)
+    if j == 0:
+        return None
     return ordered[j - 1], ordered[k - j]
 
 
@@ -175,15 +176,16 @@ def print_report(rounds, ns, source):
         cells = [statistics.median(t[(c, n)] for t in rounds) for c in labels]
         print(f"| {n} | " + " | ".join(f"{c:.1f}" for c in cells) + " |")
     print("\nRatios within each round against the faster peer (the lower median over rounds), median over rounds:\n")
-    print("| n | ratio | median | 95% interval of the median | rounds below 1 | each round |")
+    print("| n | ratio | median | interval of the median (95% or more) | rounds below 1 | each round |")
     print("|---:|---|---:|---|---:|---|")
     for n, per in ratio_rows(rounds, ns):
         for name, values in per.items():
             below = sum(v < 1 for v in values)
-            lo, hi = median_interval(values)
+            interval = median_interval(values)
+            within = "– (under 6 rounds)" if interval is None else "{:.3f} to {:.3f}".format(*interval)
             each = " ".join(f"{v:.3f}" for v in values)
             print(
-                f"| {n} | {name} | {statistics.median(values):.4f} | {lo:.3f} to {hi:.3f} "
+                f"| {n} | {name} | {statistics.median(values):.4f} | {within} "
                 f"| {below} of {len(values)} | {each} |"
             )
 
