@@ -2,31 +2,38 @@
 """Criterion's `gl_small` bench in rounds, the contenders side by side.
 
     python3 scripts/gl_small_rounds.py [ROUNDS] [--n N ...] [--raw FILE]
-    python3 scripts/gl_small_rounds.py --from FILE [FILE ...]
+    python3 scripts/gl_small_rounds.py --from FILE [FILE ...] [--n N ...]
 
 (default 7 rounds, n = 5, 10, 20, 50, 100; `--raw` writes every round's
-medians as JSON; `--from` runs nothing and reports the rounds of such
-files together). Criterion times the contenders
-of a group one after another, so that a minute in which the shared machine
-is busy falls on one contender and not its peers: one run of the bench
-moved a contender's median by a third from one run to the next
-(`benches/README.md`, `gl_small`, sixth session). Here each round runs the
-bench binary once for each n and contender, filtered to that one benchmark
-(criterion's own sampling, warm-up and median, unchanged), the contenders
-in an order rotated from round to round. Each round's ratios are taken
-between medians measured within seconds of each other; the figure for a
-ratio is their median over the rounds, printed with every round's value.
+medians as JSON, again after each round, to a file that must not exist yet;
+`--from` runs nothing and reports the rounds of such files together).
 
-The bench binary is built first (`cargo bench --no-run`); its criterion
-output goes to a temporary directory (`CRITERION_HOME`), so that no saved
-baseline under `target/criterion` is read or changed.
+Criterion times the contenders of a group one after another, so that a
+minute in which the shared machine is busy falls on one contender and not
+its peers: one run of the bench moved a contender's median by a third from
+one run to the next (`benches/README.md`, `gl_small`, sixth session). Here
+each round runs the bench binary once for each n and contender, filtered to
+that one benchmark (criterion's own sampling, warm-up and median,
+unchanged), the contenders in an order rotated from round to round. Each
+round's ratios are taken between medians measured within seconds of each
+other; the figure for a ratio is their median over the rounds, printed with
+an interval of that median and every round's value.
+
+The bench binary is built first (`cargo bench --no-run`) and copied, so that
+a rebuild during the run changes nothing measured; its criterion output goes
+to a temporary directory (`CRITERION_HOME`), so that no saved baseline under
+`target/criterion` is read or changed. One run at a time: a second waits
+for nothing and stops with an error, since two would time each other.
 """
 
 import argparse
+import fcntl
 import json
 import math
 import os
 import re
+import shutil
+import signal
 import statistics
 import subprocess
 import sys
@@ -44,50 +51,98 @@ CONTENDERS = {
     "bilby": "bilby",
     "gauss-quad": "gauss-quad",
 }
+LABELS = tuple(CONTENDERS.values())
 PEERS = ("bilby", "gauss-quad")
 # The orders the bench times.
 BENCH_NS = (5, 10, 20, 50, 100)
+MAX_ROUNDS = 1000
+# What the binary is built from, as build.rs counts it, and the bench.
+SOURCES = ["src", "docs", "build.rs", "Cargo.toml", "Cargo.lock", "experiments", "reference/values", "benches/quadrature.rs"]
 
 
-def bench_binary():
-    """Builds the `quadrature` bench and returns its executable."""
+class Stop(Exception):
+    """A run stopped by a signal (SIGINT, SIGTERM)."""
+
+
+def stop_on_signal(signum, _frame):
+    raise Stop(signal.Signals(signum).name)
+
+
+def git(*args):
+    """git's output, or None where git or the command fails."""
+    try:
+        done = subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True)
+    except OSError:
+        return None
+    return done.stdout if done.returncode == 0 else None
+
+
+def source_stamp():
+    """The commit measured, `+` where the sources differ from it (untracked
+    files included); `unknown` outside a checkout of this repository (as
+    build.rs tells it: build.rs tracked by the repository around it)."""
+    if git("ls-files", "--error-unmatch", "build.rs") is None:
+        return "unknown (not a git checkout of lightquad)"
+    head = git("rev-parse", "--short", "HEAD")
+    changes = git("--no-optional-locks", "status", "--porcelain", "--", *SOURCES)
+    if head is None:
+        return "unknown (no commit)"
+    return head.strip() + ("" if changes == "" else "+")
+
+
+def bench_binary(folder):
+    """Builds the `quadrature` bench, copies its executable into `folder`
+    and returns the copy."""
     built = subprocess.run(
-        ["cargo", "bench", "--bench", "quadrature", "--no-run"],
+        ["cargo", "bench", "--bench", "quadrature", "--no-run", "--message-format=json"],
         cwd=ROOT,
         capture_output=True,
         text=True,
     )
     sys.stderr.write(built.stderr)
-    found = re.search(r"\((target/release/deps/quadrature-[0-9a-f]+)\)", built.stderr)
-    if built.returncode != 0 or not found:
-        sys.exit("could not build the quadrature bench (cargo bench --no-run)")
-    return ROOT / found.group(1)
+    executables = []
+    for line in built.stdout.splitlines():
+        try:
+            message = json.loads(line)
+        except ValueError:
+            continue
+        if message.get("reason") == "compiler-artifact" and message.get("target", {}).get("name") == "quadrature":
+            executables.append(message.get("executable"))
+    executables = [e for e in executables if e]
+    if built.returncode != 0 or not executables:
+        raise SystemExit("could not build the quadrature bench (cargo bench --bench quadrature --no-run)")
+    copy = Path(folder) / Path(executables[-1]).name
+    shutil.copy2(executables[-1], copy)
+    return copy
 
 
 def median_ns(binary, home, name, n):
     """Criterion's median for `gl_small/<name>/<n>`, in ns, from one run."""
+    estimates = Path(home) / "gl_small" / name.replace("/", "_") / str(n) / "new" / "estimates.json"
+    estimates.unlink(missing_ok=True)
     filter_ = "^" + re.escape(f"gl_small/{name}/{n}") + "$"
-    env = dict(os.environ, CRITERION_HOME=str(home))
     run = subprocess.run(
         [str(binary), "--bench", "--noplot", filter_],
         cwd=ROOT,
-        env=env,
+        env=dict(os.environ, CRITERION_HOME=str(home)),
         capture_output=True,
         text=True,
     )
     if run.returncode != 0:
-        sys.exit(f"gl_small/{name}/{n} failed:\n{run.stderr}")
-    path = Path(home) / "gl_small" / name.replace("/", "_") / str(n) / "new" / "estimates.json"
-    with open(path) as f:
-        return json.load(f)["median"]["point_estimate"]
+        raise SystemExit(f"gl_small/{name}/{n} failed:\n{run.stderr}")
+    try:
+        with open(estimates) as f:
+            return json.load(f)["median"]["point_estimate"]
+    except (OSError, ValueError, KeyError) as e:
+        raise SystemExit(f"gl_small/{name}/{n}: no median from criterion ({e}): is the benchmark still named so in benches/quadrature.rs?")
 
 
 def one_round(binary, home, ns, r):
     """Every contender at every n; the order rotated by the round `r`."""
     names = list(CONTENDERS)
     times = {}
-    for n in ns:
-        k = (r + ns.index(n)) % len(names)
+    for i, n in enumerate(ns):
+        k = (r + i) % len(names)
         for name in names[k:] + names[:k]:
             times[(CONTENDERS[name], n)] = median_ns(binary, home, name, n)
     return times
@@ -100,7 +155,7 @@ def faster_peer(rounds, n):
 
 
 def ratio_rows(rounds, ns):
-    """Per n, each ratio's median over the rounds and every round's value."""
+    """Per n, each ratio's values over the rounds."""
     rows = []
     for n in ns:
         peer = faster_peer(rounds, n)
@@ -114,27 +169,20 @@ def ratio_rows(rounds, ns):
     return rows
 
 
-def write_raw(path, rounds, binary):
-    """Every round's medians, written whole or not at all."""
+def write_raw(path, rounds, stamp, binary):
+    """Every round's medians so far, written whole or not at all."""
     raw = {
-        "commit": git_head(),
+        "commit": stamp,
         "binary": binary.name,
-        "rounds": [
-            [{"contender": c, "n": n, "median_ns": t} for (c, n), t in r.items()]
-            for r in rounds
-        ],
+        "rounds": [[{"contender": c, "n": n, "median_ns": t} for (c, n), t in r.items()] for r in rounds],
     }
-    path = Path(path)
     partial = path.with_name(path.name + ".partial")
-    partial.write_text(json.dumps(raw, indent=1) + "\n")
-    partial.replace(path)
-
-
-def git_head():
-    """The commit measured, with `+` where the work tree differs from it."""
-    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
-    dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", "src", "benches/*.rs", "Cargo.toml", "Cargo.lock"], cwd=ROOT)
-    return head.stdout.strip() + ("+" if dirty.returncode else "")
+    try:
+        partial.write_text(json.dumps(raw, indent=1) + "\n")
+        partial.replace(path)
+    except OSError as e:
+        partial.unlink(missing_ok=True)
+        raise SystemExit(f"--raw {path}: could not write it ({e.strerror})")
 
 
 def median_interval(values):
@@ -156,24 +204,53 @@ def median_interval(values):
 
 
 def read_raw(paths):
-    """The rounds of `--raw` files, and what they were measured on."""
+    """The rounds of `--raw` files, each checked, and what they hold."""
     rounds, sources = [], []
     for path in paths:
-        with open(path) as f:
-            raw = json.load(f)
-        sources.append(f"{Path(path).name} ({raw['commit']}, {len(raw['rounds'])} rounds)")
-        for r in raw["rounds"]:
-            rounds.append({(e["contender"], e["n"]): e["median_ns"] for e in r})
-    return rounds, ", ".join(sources)
+        try:
+            with open(path) as f:
+                raw = json.load(f)
+        except (OSError, ValueError) as e:
+            raise SystemExit(f"--from {path}: not a readable JSON file ({e})")
+        if not isinstance(raw, dict) or not isinstance(raw.get("rounds"), list) or not raw["rounds"]:
+            raise SystemExit(f"--from {path}: expected a file written by --raw, an object with a list of rounds")
+        for i, r in enumerate(raw["rounds"]):
+            rounds.append(checked_round(path, i, r))
+        sources.append(f"{path} ({raw.get('commit', 'unknown')}, {plural(len(raw['rounds']), 'round')})")
+    return rounds, "; ".join(sources)
+
+
+def checked_round(path, i, entries):
+    """One round of a `--raw` file: each (contender, n) once, its median a
+    finite positive number of ns."""
+    where = f"--from {path}: rounds[{i}]"
+    if not isinstance(entries, list):
+        raise SystemExit(f"{where}: expected a list of medians")
+    times = {}
+    for e in entries:
+        if not isinstance(e, dict):
+            raise SystemExit(f"{where}: {e!r}: expected {{contender, n, median_ns}}")
+        key, t = (e.get("contender"), e.get("n")), e.get("median_ns")
+        if key[0] not in LABELS or key[1] not in BENCH_NS:
+            raise SystemExit(f"{where}: contender {key[0]!r} at n = {key[1]!r}: expected one of {', '.join(LABELS)} at n in {BENCH_NS}")
+        if key in times:
+            raise SystemExit(f"{where}: {key[0]} at n = {key[1]} twice")
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
+            raise SystemExit(f"{where}: {key[0]} at n = {key[1]}: median_ns = {t!r}; expected a finite number above 0")
+        times[key] = float(t)
+    return times
+
+
+def plural(k, word):
+    return f"{k} {word}" + ("" if k == 1 else "s")
 
 
 def print_report(rounds, ns, source):
-    print(f"{source}. Criterion medians in ns, median over {len(rounds)} rounds:\n")
-    labels = list(CONTENDERS.values())
-    print("| n | " + " | ".join(labels) + " |")
-    print("|---:|" + "---:|" * len(labels))
+    print(f"{source}. Criterion medians in ns, median over {plural(len(rounds), 'round')}:\n")
+    print("| n | " + " | ".join(LABELS) + " |")
+    print("|---:|" + "---:|" * len(LABELS))
     for n in ns:
-        cells = [statistics.median(t[(c, n)] for t in rounds) for c in labels]
+        cells = [statistics.median(t[(c, n)] for t in rounds) for c in LABELS]
         print(f"| {n} | " + " | ".join(f"{c:.1f}" for c in cells) + " |")
     print("\nRatios within each round against the faster peer (the lower median over rounds), median over rounds:\n")
     print("| n | ratio | median | interval of the median (95% or more) | rounds below 1 | each round |")
@@ -184,45 +261,89 @@ def print_report(rounds, ns, source):
             interval = median_interval(values)
             within = "– (under 6 rounds)" if interval is None else "{:.3f} to {:.3f}".format(*interval)
             each = " ".join(f"{v:.3f}" for v in values)
-            print(
-                f"| {n} | {name} | {statistics.median(values):.4f} | {within} "
-                f"| {below} of {len(values)} | {each} |"
-            )
+            print(f"| {n} | {name} | {statistics.median(values):.4f} | {within} | {below} of {len(values)} | {each} |")
+
+
+def arguments():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument("rounds", nargs="?", type=int, help=f"rounds to run, 1 to {MAX_ROUNDS} (default 7)")
+    parser.add_argument("--n", type=int, nargs="+", help="the orders, of 5 10 20 50 100 (default all)")
+    parser.add_argument("--raw", help="write every round's medians here, as JSON (a new file)")
+    parser.add_argument("--from", dest="sources", nargs="+", help="report these --raw files' rounds, run nothing")
+    args = parser.parse_args()
+    if args.n is not None:
+        bad = [n for n in args.n if n not in BENCH_NS]
+        if bad:
+            parser.error(f"--n {' '.join(map(str, bad))}: the bench times n = 5, 10, 20, 50 and 100")
+        if len(set(args.n)) != len(args.n):
+            parser.error(f"--n {' '.join(map(str, args.n))}: each n once")
+    if args.sources:
+        if args.rounds is not None or args.raw is not None:
+            parser.error("--from runs nothing: ROUNDS and --raw are for a run")
+        same = {Path(p).resolve() for p in args.sources}
+        if len(same) != len(args.sources):
+            parser.error(f"--from {' '.join(args.sources)}: a file named twice")
+        return args
+    args.rounds = 7 if args.rounds is None else args.rounds
+    if not 1 <= args.rounds <= MAX_ROUNDS:
+        parser.error(f"ROUNDS {args.rounds}: expected 1 to {MAX_ROUNDS}")
+    if args.raw is not None:
+        raw = Path(args.raw)
+        if args.raw == "" or raw.exists() or not raw.resolve().parent.is_dir():
+            parser.error(f"--raw {args.raw!r}: expected a new file's path in a folder that exists")
+        if not os.access(raw.resolve().parent, os.W_OK):
+            parser.error(f"--raw {args.raw}: its folder is not writable")
+    return args
+
+
+def report_saved(args):
+    rounds, source = read_raw(args.sources)
+    ns = list(args.n or BENCH_NS)
+    missing = [n for n in ns if any((c, n) not in t for t in rounds for c in LABELS)]
+    if args.n and missing:
+        raise SystemExit(f"--n {' '.join(map(str, missing))}: not every round of the files holds every contender there")
+    ns = [n for n in ns if n not in missing]
+    if not ns:
+        raise SystemExit("--from: no n at which every round holds every contender")
+    if missing:
+        print(f"left out n = {', '.join(map(str, missing))}: not in every round", file=sys.stderr)
+    print_report(rounds, ns, source)
+
+
+def run(args):
+    stamp = source_stamp()
+    raw = Path(args.raw) if args.raw else None
+    ns = list(args.n or BENCH_NS)
+    lock = open(ROOT / "target" / "gl_small_rounds.lock", "w") if (ROOT / "target").is_dir() else None
+    if lock is not None:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise SystemExit("another gl_small_rounds run is under way here: two at once would time each other")
+    rounds = []
+    with tempfile.TemporaryDirectory(prefix="gl_small_rounds.") as home:
+        binary = bench_binary(home)
+        try:
+            for r in range(args.rounds):
+                rounds.append(one_round(binary, home, ns, r))
+                if raw:
+                    write_raw(raw, rounds, stamp, binary)
+                print(f"round {r + 1} of {args.rounds} done", file=sys.stderr)
+        except Stop as e:
+            saved = f"; {plural(len(rounds), 'round')} in {raw}" if raw and rounds else ""
+            raise SystemExit(f"stopped by {e} after {plural(len(rounds), 'round')}{saved}")
+    print_report(rounds, ns, f"Commit {stamp}")
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("rounds", nargs="?", type=int, default=7)
-    parser.add_argument("--n", type=int, nargs="+", default=list(BENCH_NS))
-    parser.add_argument("--raw", help="write every round's medians here, as JSON")
-    parser.add_argument("--from", dest="sources", nargs="+", help="report these --raw files' rounds, run nothing")
-    args = parser.parse_args()
+    signal.signal(signal.SIGINT, stop_on_signal)
+    signal.signal(signal.SIGTERM, stop_on_signal)
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+    args = arguments()
     if args.sources:
-        try:
-            rounds, source = read_raw(args.sources)
-            ns = [n for n in args.n if all((c, n) in t for t in rounds for c in CONTENDERS.values())]
-        except (OSError, ValueError, KeyError, TypeError) as e:
-            parser.error(f"--from: {e!r}: expected files written by --raw")
-        if not rounds or not ns:
-            parser.error("--from: no round holds every contender at any of the n asked for")
-        print_report(rounds, ns, source)
-        return
-    if args.rounds < 1:
-        parser.error(f"ROUNDS {args.rounds}: expected at least 1")
-    bad = [n for n in args.n if n not in BENCH_NS]
-    if bad:
-        parser.error(f"--n {bad}: the bench times n = 5, 10, 20, 50 and 100")
-    if args.raw and not Path(args.raw).resolve().parent.is_dir():
-        parser.error(f"--raw {args.raw}: its folder does not exist")
-    binary = bench_binary()
-    rounds = []
-    with tempfile.TemporaryDirectory() as home:
-        for r in range(args.rounds):
-            rounds.append(one_round(binary, home, args.n, r))
-            print(f"round {r + 1} of {args.rounds} done", file=sys.stderr)
-    if args.raw:
-        write_raw(args.raw, rounds, binary)
-    print_report(rounds, args.n, f"Commit {git_head()}")
+        report_saved(args)
+    else:
+        run(args)
 
 
 if __name__ == "__main__":
