@@ -60,12 +60,35 @@ MAX_ROUNDS = 1000
 SOURCES = ["src", "docs", "build.rs", "Cargo.toml", "Cargo.lock", "experiments", "reference/values", "benches/quadrature.rs"]
 
 
+STOPPING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
 class Stop(Exception):
-    """A run stopped by a signal (SIGINT, SIGTERM)."""
+    """A run stopped by a signal (SIGINT, SIGTERM, SIGHUP)."""
+
+    def __init__(self, signum):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
 
 
 def stop_on_signal(signum, _frame):
-    raise Stop(signal.Signals(signum).name)
+    raise Stop(signum)
+
+
+def child(command, **options):
+    """`subprocess.run` in a process group of its own, the whole group
+    killed if this one stops (cargo's rustc with cargo)."""
+    try:
+        process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **options)
+    except OSError as e:
+        raise SystemExit(f"could not run {command[0]}: {e.strerror}")
+    try:
+        out, err = process.communicate()
+    except BaseException:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+        raise
+    return subprocess.CompletedProcess(command, process.returncode, out, err)
 
 
 def git(*args):
@@ -93,12 +116,7 @@ def source_stamp():
 def bench_binary(folder):
     """Builds the `quadrature` bench, copies its executable into `folder`
     and returns the copy."""
-    built = subprocess.run(
-        ["cargo", "bench", "--bench", "quadrature", "--no-run", "--message-format=json"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-    )
+    built = child(["cargo", "bench", "--bench", "quadrature", "--no-run", "--message-format=json"], cwd=ROOT)
     sys.stderr.write(built.stderr)
     executables = []
     for line in built.stdout.splitlines():
@@ -121,13 +139,7 @@ def median_ns(binary, home, name, n):
     estimates = Path(home) / "gl_small" / name.replace("/", "_") / str(n) / "new" / "estimates.json"
     estimates.unlink(missing_ok=True)
     filter_ = "^" + re.escape(f"gl_small/{name}/{n}") + "$"
-    run = subprocess.run(
-        [str(binary), "--bench", "--noplot", filter_],
-        cwd=ROOT,
-        env=dict(os.environ, CRITERION_HOME=str(home)),
-        capture_output=True,
-        text=True,
-    )
+    run = child([str(binary), "--bench", "--noplot", filter_], cwd=ROOT, env=dict(os.environ, CRITERION_HOME=str(home)))
     if run.returncode != 0:
         raise SystemExit(f"gl_small/{name}/{n} failed:\n{run.stderr}")
     try:
@@ -235,9 +247,13 @@ def checked_round(path, i, entries):
             raise SystemExit(f"{where}: contender {key[0]!r} at n = {key[1]!r}: expected one of {', '.join(LABELS)} at n in {BENCH_NS}")
         if key in times:
             raise SystemExit(f"{where}: {key[0]} at n = {key[1]} twice")
-        if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or t <= 0:
-            raise SystemExit(f"{where}: {key[0]} at n = {key[1]}: median_ns = {t!r}; expected a finite number above 0")
-        times[key] = float(t)
+        try:
+            t = float(t) if isinstance(t, (int, float)) and not isinstance(t, bool) else math.nan
+        except OverflowError:
+            t = math.inf
+        if not math.isfinite(t) or t <= 0:
+            raise SystemExit(f"{where}: {key[0]} at n = {key[1]}: median_ns = {e.get('median_ns')!r:.40}; expected a finite number above 0")
+        times[key] = t
     return times
 
 
@@ -291,8 +307,11 @@ def arguments():
         raw = Path(args.raw)
         if args.raw == "" or raw.exists() or not raw.resolve().parent.is_dir():
             parser.error(f"--raw {args.raw!r}: expected a new file's path in a folder that exists")
-        if not os.access(raw.resolve().parent, os.W_OK):
-            parser.error(f"--raw {args.raw}: its folder is not writable")
+        try:
+            raw.with_name(raw.name + ".partial").open("x").close()
+            raw.with_name(raw.name + ".partial").unlink()
+        except OSError as e:
+            parser.error(f"--raw {args.raw}: a file cannot be made there ({e.strerror})")
     return args
 
 
@@ -314,36 +333,56 @@ def run(args):
     stamp = source_stamp()
     raw = Path(args.raw) if args.raw else None
     ns = list(args.n or BENCH_NS)
-    lock = open(ROOT / "target" / "gl_small_rounds.lock", "w") if (ROOT / "target").is_dir() else None
-    if lock is not None:
-        try:
-            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise SystemExit("another gl_small_rounds run is under way here: two at once would time each other")
+    lock = take_lock()
     rounds = []
     with tempfile.TemporaryDirectory(prefix="gl_small_rounds.") as home:
-        binary = bench_binary(home)
         try:
+            binary = bench_binary(home)
             for r in range(args.rounds):
-                rounds.append(one_round(binary, home, ns, r))
+                times = one_round(binary, home, ns, r)
+                # The file and the count agree where a signal comes.
+                signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
                 if raw:
-                    write_raw(raw, rounds, stamp, binary)
+                    write_raw(raw, rounds + [times], stamp, binary)
+                rounds.append(times)
+                signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPPING)
                 print(f"round {r + 1} of {args.rounds} done", file=sys.stderr)
         except Stop as e:
             saved = f"; {plural(len(rounds), 'round')} in {raw}" if raw and rounds else ""
-            raise SystemExit(f"stopped by {e} after {plural(len(rounds), 'round')}{saved}")
+            print(f"stopped by {e} after {plural(len(rounds), 'round')}{saved}", file=sys.stderr)
+            raise SystemExit(128 + e.signum)
+    lock.close()
     print_report(rounds, ns, f"Commit {stamp}")
 
 
+def take_lock():
+    """This checkout's lock on runs, held while the file stays open."""
+    (ROOT / "target").mkdir(exist_ok=True)
+    try:
+        lock = open(ROOT / "target" / "gl_small_rounds.lock", "w")
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise SystemExit("another gl_small_rounds run is under way here: two at once would time each other")
+    except OSError as e:
+        raise SystemExit(f"target/gl_small_rounds.lock: cannot take the lock ({e.strerror})")
+    return lock
+
+
 def main():
-    signal.signal(signal.SIGINT, stop_on_signal)
-    signal.signal(signal.SIGTERM, stop_on_signal)
-    signal.signal(signal.SIGPIPE, signal.SIG_DFL)
-    args = arguments()
-    if args.sources:
-        report_saved(args)
-    else:
-        run(args)
+    for signum in STOPPING:
+        signal.signal(signum, stop_on_signal)
+    try:
+        args = arguments()
+        if args.sources:
+            report_saved(args)
+        else:
+            run(args)
+    except Stop as e:
+        raise SystemExit(128 + e.signum)
+    except BrokenPipeError:
+        # The reader went away (`| head`); the temporary folder is gone by now.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        raise SystemExit(141)
 
 
 if __name__ == "__main__":
