@@ -56,8 +56,21 @@ PEERS = ("bilby", "gauss-quad")
 # The orders the bench times.
 BENCH_NS = (5, 10, 20, 50, 100)
 MAX_ROUNDS = 1000
-# What the binary is built from, as build.rs counts it, and the bench.
-SOURCES = ["src", "docs", "build.rs", "Cargo.toml", "Cargo.lock", "experiments", "reference/values", "benches/quadrature.rs"]
+
+
+def sources():
+    """What the bench binary is built from: build.rs's own list of the
+    crate's sources (its `SOURCES`, read from build.rs, so that the two
+    cannot drift apart), and the bench; None where build.rs has no such
+    list."""
+    try:
+        text = (ROOT / "build.rs").read_text()
+    except OSError:
+        return None
+    found = re.search(r"const SOURCES: \[&str; \d+\] = \[(.*?)\];", text, re.S)
+    if not found:
+        return None
+    return re.findall(r'"([^"]+)"', found.group(1)) + ["benches/quadrature.rs"]
 
 
 STOPPING = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -107,9 +120,12 @@ def source_stamp():
     if git("ls-files", "--error-unmatch", "build.rs") is None:
         return "unknown (not a git checkout of lightquad)"
     head = git("rev-parse", "--short", "HEAD")
-    changes = git("--no-optional-locks", "status", "--porcelain", "--", *SOURCES)
+    paths = sources()
     if head is None:
         return "unknown (no commit)"
+    if paths is None:
+        return head.strip() + " (whether the sources differ from it is unknown: build.rs lists no SOURCES)"
+    changes = git("--no-optional-locks", "status", "--porcelain", "--", *paths)
     return head.strip() + ("" if changes == "" else "+")
 
 
