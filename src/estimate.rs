@@ -129,6 +129,28 @@ impl<V: Value> Estimate<V> {
         }
     }
 
+    /// [`Estimate::combine`] for the integrals over two pieces of one
+    /// region (a segment's between its breaks, an infinite interval's cuts):
+    /// `self` the sum over the earlier pieces. An error where both values
+    /// are finite and their sum is not, naming them, where the sum would
+    /// otherwise come back as a bare `inf`.
+    pub fn combine_pieces(self, other: Self) -> Result<Self, crate::QuadError> {
+        let total = self.combine(other);
+        if total.value.all_finite() || !self.value.all_finite() || !other.value.all_finite() {
+            return Ok(total);
+        }
+        Err(crate::QuadError::invalid(
+            "integrand",
+            format!(
+                "its integral over the earlier piece(s), {}, plus that over the next, {}, is {}: beyond the f64 range",
+                crate::error::channels(self.value),
+                crate::error::channels(other.value),
+                crate::error::channels(total.value)
+            ),
+            "an integral at most 1.8e308 in magnitude: scale the integrand down",
+        ))
+    }
+
     /// Adds an independent estimate over a disjoint region: values add;
     /// deterministic errors add, standard errors add in quadrature. A sum with
     /// a random part is random, and its error is the linear sum of the parts

@@ -178,7 +178,7 @@ impl Segment {
             let est = super::try_integrate_over(rule, &piece, n, rng, |t| g(t, mid))?;
             total = Some(match total {
                 None => est,
-                Some(t) => t.combine(est),
+                Some(t) => t.combine_pieces(est)?,
             });
         }
         Ok(total.unwrap_or(Estimate::zero()))

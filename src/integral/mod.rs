@@ -189,7 +189,7 @@ impl Built {
                     None => Ok(V::zero()),
                 }
             })?;
-            total = total.combine(est);
+            total = total.combine_pieces(est)?;
         }
         Ok(total)
     }

@@ -522,3 +522,46 @@ fn a_value_whose_product_with_the_jacobian_passes_the_range_is_named_as_such() {
     );
     close("8.9e307 on [-1, 1]", m.value[0], 1.78e308, 1e-15);
 }
+
+/// Pieces each within the range whose sum is not: `1e308` on a segment cut
+/// at 1 is `1e308` on each piece, `2e308` in all; `8e307 / (1 + x^2)` on
+/// the whole line is `8e307 pi = 2.5e308`, its pieces `(-inf, -1]`,
+/// `[-1, 1]` and `[1, inf)` `8e307 pi / 4`, `/ 2` and `/ 4`, the first two
+/// already past the range together. The sum was a bare "non-finite
+/// integral (inf)"; it now names the pieces' values.
+#[test]
+fn pieces_within_the_range_whose_sum_is_not_are_named() {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    for (domain, integrand, earlier) in [
+        (
+            json!({"type": "segment", "a": 0, "b": 2, "breaks": [1]}),
+            "1e308",
+            "1e308",
+        ),
+        (
+            json!({"type": "interval", "a": "-inf", "b": "inf"}),
+            "8e307/(1 + x*x)",
+            "6.2",
+        ),
+    ] {
+        let scene = built(json!({"domain": domain, "integrand": integrand}))
+            .unwrap_or_else(|e| panic!("{integrand}: {e}"));
+        for rule in ["gauss-legendre", "trapezoid"] {
+            let err = Integral::evaluate(
+                &scene,
+                &Method::Rule(AnyRule::by_name(rule).expect("rule")),
+                64,
+                &mut rng,
+                &[Quantity::Integral],
+            )
+            .expect_err("past the range");
+            let text = err.to_string();
+            assert!(
+                text.contains(&format!(
+                    "its integral over the earlier piece(s), {earlier}"
+                )) && text.contains(", is inf: beyond the f64 range"),
+                "{domain} {rule}: {text}"
+            );
+        }
+    }
+}
