@@ -259,46 +259,7 @@ fn run(command: Command) -> Result<(), Failure> {
             if no_cost_limit {
                 experiment::validate::lift_cost_limit();
             }
-            // Names shared between files are refused as `run` refuses them.
-            let mut names = std::collections::BTreeMap::new();
-            for f in sources(files)? {
-                let exp = experiment::load_source(&registry, &f)?;
-                if let Some(other) = names.insert(exp.name().to_string(), f.display()) {
-                    return Err(experiment::RunError::Spec {
-                        file: f.display(),
-                        source: lightquad::error::SpecError::at(
-                            "name",
-                            format!(
-                                "{:?} is also the name of {other}: one run (one output folder) \
-                                 cannot hold both; rename one",
-                                exp.name()
-                            ),
-                        ),
-                    }
-                    .into());
-                }
-                for w in exp.warnings() {
-                    lightquad::say!("warning: {}: {}", f.display(), readable(&w.to_string()));
-                }
-                let (rules, budgets, repeats) = exp.shape();
-                let [jobs, reference] = exp.cost();
-                let reference = if reference > 0.0 {
-                    format!(", its reference stage up to {reference:.1e}")
-                } else {
-                    String::new()
-                };
-                writeln!(
-                    out,
-                    "{}: ok ({}, family {}, {rules} rule(s) x {budgets} budget(s) x {repeats} repeat(s), hash {}; \
-                     priced for the cost limits at about {jobs:.1e} integrand evaluations in its \
-                     jobs{reference}: estimates that count the rules' caps and every ray a \
-                     branching ray tree may spawn, so the work done is often less)",
-                    f.display(),
-                    exp.name(),
-                    exp.family(),
-                    exp.hash()
-                )?;
-            }
+            check_files(&mut out, &registry, sources(files)?)?;
         }
         Command::Schema {
             summary: false,
@@ -563,6 +524,80 @@ fn sources(files: Vec<PathBuf>) -> Result<Vec<Source>, Failure> {
         );
     }
     Ok(suite)
+}
+
+/// `check`: every file read, validated and priced, in order, its verdict
+/// printed (`ok` on stdout, each error on stderr) and the next file checked
+/// after a bad one; an error at the end where any file failed.
+fn check_files(
+    out: &mut impl Write,
+    registry: &experiment::Registry,
+    files: Vec<Source>,
+) -> Result<(), Failure> {
+    // Names shared between files are refused as `run` refuses them.
+    let mut names = std::collections::BTreeMap::new();
+    let mut failed = 0;
+    let total = files.len();
+    for f in files {
+        if let Err(e) = check_file(out, registry, &f, &mut names) {
+            failed += 1;
+            // The `ok` lines before it first, so the two streams read in order.
+            out.flush()?;
+            lightquad::say!("error: {}", readable(&e.to_string()));
+        }
+    }
+    if failed > 0 {
+        return Err(
+            format!("{failed} of {total} file(s) failed the check (each named above)").into(),
+        );
+    }
+    Ok(())
+}
+
+/// One file of `check`: its `ok` line, or why it is refused.
+fn check_file(
+    out: &mut impl Write,
+    registry: &experiment::Registry,
+    f: &Source,
+    names: &mut std::collections::BTreeMap<String, String>,
+) -> Result<(), Failure> {
+    let exp = experiment::load_source(registry, f)?;
+    if let Some(other) = names.insert(exp.name().to_string(), f.display()) {
+        return Err(experiment::RunError::Spec {
+            file: f.display(),
+            source: lightquad::error::SpecError::at(
+                "name",
+                format!(
+                    "{:?} is also the name of {other}: one run (one output folder) \
+                     cannot hold both; rename one",
+                    exp.name()
+                ),
+            ),
+        }
+        .into());
+    }
+    for w in exp.warnings() {
+        lightquad::say!("warning: {}: {}", f.display(), readable(&w.to_string()));
+    }
+    let (rules, budgets, repeats) = exp.shape();
+    let [jobs, reference] = exp.cost();
+    let reference = if reference > 0.0 {
+        format!(", its reference stage up to {reference:.1e}")
+    } else {
+        String::new()
+    };
+    writeln!(
+        out,
+        "{}: ok ({}, family {}, {rules} rule(s) x {budgets} budget(s) x {repeats} repeat(s), hash {}; \
+         priced for the cost limits at about {jobs:.1e} integrand evaluations in its \
+         jobs{reference}: estimates that count the rules' caps and every ray a \
+         branching ray tree may spawn, so the work done is often less)",
+        f.display(),
+        exp.name(),
+        exp.family(),
+        exp.hash()
+    )?;
+    Ok(())
 }
 
 /// Every rule and estimator, then the families with their quantities.

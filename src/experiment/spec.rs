@@ -76,8 +76,9 @@ pub struct ExperimentSpec<F: Family> {
     pub seed: u64,
     /// The reference the errors are measured against.
     pub reference: ReferenceSpec<F::Quantity>,
-    /// Relative errors whose time-to-reach the report gives.
+    /// Relative errors whose time-to-reach the report gives, each once.
     #[serde(default = "default_targets")]
+    #[schemars(extend("uniqueItems" = true))]
     pub targets: Vec<f64>,
 }
 
@@ -119,7 +120,14 @@ fn default_targets() -> Vec<f64> {
 #[serde(untagged)]
 pub enum Budgets {
     /// An explicit list.
-    List(#[schemars(inner(range(min = 1, max = 100_000_000)))] Vec<i64>),
+    List(
+        #[schemars(
+            length(min = 1),
+            extend("uniqueItems" = true),
+            inner(range(min = 1, max = 100_000_000))
+        )]
+        Vec<i64>,
+    ),
     /// A geometric range.
     Range(BudgetRange),
 }

@@ -495,6 +495,37 @@ fn check_refuses_two_files_of_one_name() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// `check a b c` checks every file: a bad one is named and the next one
+/// checked (it stopped at the first bad file, so a second went unseen),
+/// and the exit status fails where any file failed.
+#[test]
+fn check_names_every_bad_file_and_checks_the_rest() {
+    let dir = scratch("checkall");
+    let good = root().join("experiments/calibration-exp.json");
+    let (bad1, bad2) = (dir.join("bad1.json"), dir.join("bad2.json"));
+    fs::write(&bad1, "{ \"name\": ").expect("write");
+    let mut second: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&good).expect("read")).expect("json");
+    second["name"] = json!("second");
+    second["repeats"] = json!(0);
+    fs::write(&bad2, second.to_string()).expect("write");
+    let o = bin()
+        .arg("check")
+        .args([&bad1, &good, &bad2])
+        .output()
+        .expect("runs");
+    assert!(!o.status.success());
+    let (out, err) = (String::from_utf8_lossy(&o.stdout), stderr(&o));
+    assert!(out.contains("calibration-exp.json: ok ("), "{out}");
+    assert!(
+        err.contains("bad1.json") && err.contains("bad2.json"),
+        "{err}"
+    );
+    assert!(err.contains("`repeats`"), "{err}");
+    assert!(err.contains("2 of 3 file(s) failed the check"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
 /// A Mitsuba reference naming a file that is not there is refused naming
 /// that file first (the message spoke only of the bundled values being
 /// stale).

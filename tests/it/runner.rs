@@ -144,6 +144,15 @@ fn broken_files_are_rejected_with_the_json_path_and_what_is_accepted() {
         "budgets[2]",
         "4 repeats budgets[0]: give each budget once",
     );
+    // A repeated target was a second column of the same times.
+    rejected(
+        &VALID.replace(
+            "\"seed\": 7",
+            "\"seed\": 7, \"targets\": [1e-3, 1e-6, 0.001]",
+        ),
+        "targets[2]",
+        "0.001 repeats targets[0]: give each target once",
+    );
     rejected(
         &VALID.replace("\"kappa\": 2.0", "\"kappa\": -2.0"),
         "scene.medium.kappa",
@@ -449,6 +458,36 @@ fn a_schema_named_in_the_file_is_accepted_and_allowed_by_the_schema() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("at `$schema`"), "{}", stderr(&o));
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// The experiment schema, read by boon (an independent validator), refuses
+/// what `check` refuses of a list: an empty or repeated budget and a
+/// repeated target (it allowed all three), and still allows VALID.
+#[test]
+fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
+    let schema = bin().arg("schema").output().expect("runs");
+    let schema: serde_json::Value = serde_json::from_slice(&schema.stdout).expect("json");
+    let mut schemas = boon::Schemas::new();
+    let mut compiler = boon::Compiler::new();
+    compiler
+        .add_resource("experiment.schema.json", schema)
+        .expect("resource");
+    let id = compiler
+        .compile("experiment.schema.json", &mut schemas)
+        .expect("the schema compiles");
+    let valid = |text: &str| {
+        let v: serde_json::Value = serde_json::from_str(text).expect("json");
+        schemas.validate(&v, id).is_ok()
+    };
+    assert!(valid(VALID));
+    assert!(valid(&VALID.replace("\"seed\": 7", "\"seed\": 7, \"targets\": [1e-3, 1e-6]")));
+    for refused in [
+        VALID.replace("[4, 16, 64]", "[]"),
+        VALID.replace("[4, 16, 64]", "[4, 16, 4]"),
+        VALID.replace("\"seed\": 7", "\"seed\": 7, \"targets\": [1e-3, 1e-6, 1e-3]"),
+    ] {
+        assert!(!valid(&refused), "allowed: {refused}");
+    }
 }
 
 /// `lightquad run` without files runs the bundled suite from any folder (here

@@ -273,6 +273,10 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
             ));
         }
     }
+    let bits: Vec<u64> = spec.targets.iter().map(|t| t.to_bits()).collect();
+    once_each("targets", "target", &bits, |&b| {
+        f64::from_bits(b).to_string()
+    })?;
     Ok(())
 }
 
@@ -400,7 +404,7 @@ fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
                 .enumerate()
                 .map(|(i, &n)| check(format!("budgets[{i}]"), n))
                 .collect::<Result<Vec<_>, _>>()?;
-            once_each(&out)?;
+            once_each("budgets", "budget", &out, usize::to_string)?;
             out
         }
         Budgets::Range(r) => {
@@ -420,15 +424,22 @@ fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
     Ok(out)
 }
 
-/// Every budget of a list given once: a repeated one would run once and
-/// be reported once, not as often as it was listed.
-fn once_each(list: &[usize]) -> Result<(), SpecError> {
-    let mut first = std::collections::HashMap::with_capacity(list.len());
-    for (i, &n) in list.iter().enumerate() {
-        if let Some(j) = first.insert(n, i) {
+/// Every entry of the list `field` given once (`keys`, its entries as
+/// compared; `shown`, one as the error writes it): a repeated budget would
+/// run once and be reported once, not as often as it was listed, and a
+/// repeated target would be a second column of the same times.
+fn once_each<K: std::hash::Hash + Eq>(
+    field: &str,
+    each: &str,
+    keys: &[K],
+    shown: impl Fn(&K) -> String,
+) -> Result<(), SpecError> {
+    let mut first = std::collections::HashMap::with_capacity(keys.len());
+    for (i, key) in keys.iter().enumerate() {
+        if let Some(j) = first.insert(key, i) {
             return Err(SpecError::at(
-                format!("budgets[{i}]"),
-                format!("{n} repeats budgets[{j}]: give each budget once"),
+                format!("{field}[{i}]"),
+                format!("{} repeats {field}[{j}]: give each {each} once", shown(key)),
             ));
         }
     }
