@@ -3220,3 +3220,113 @@ fn the_findings_say_what_theory_says_of_a_case_built_for_it() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A rule whose every job failed has no rank: `sin(x)/x` on [0, 1] is
+/// 0/0 at the end the trapezoid and Simpson rules take, so each of their
+/// jobs fails, while Gauss–Legendre (no node at an end) reaches the
+/// target. The failed rules were ranked 2 and 3, alphabetically, in
+/// index.md, index.html and summary.json, though no time orders them.
+#[test]
+fn rules_whose_every_job_failed_are_not_ranked() {
+    let spec = r#"{
+      "name": "t", "family": "integral",
+      "scene": {"domain": {"type": "interval", "a": 0, "b": 1},
+                "integrand": "sin(x)/x", "exact": "0.94608307036718301494"},
+      "quantities": ["integral"],
+      "rules": [{"rule": "trapezoid"}, {"rule": "simpson"}, {"rule": "gauss-legendre"}],
+      "budgets": [8, 16], "repeats": 1, "seed": 1,
+      "reference": {"type": "closed-form"}
+    }"#;
+    let (dir, out, o) = run_text("unranked", spec);
+    let summary: serde_json::Value = serde_json::from_str(
+        &fs::read_to_string(out.join("t/summary.json"))
+            .unwrap_or_else(|e| panic!("{e}: {}", stderr(&o))),
+    )
+    .expect("summary.json");
+    let rules = summary["experiments"][0]["quantities"][0]["rules"]
+        .as_array()
+        .expect("rules");
+    let rank = |label: &str| {
+        let rule = rules.iter().find(|r| r["label"] == label).expect(label);
+        (rule["rank"].clone(), rule["tied"].clone())
+    };
+    assert_eq!(rank("gauss-legendre"), (1.into(), false.into()));
+    for failed in ["trapezoid", "simpson"] {
+        assert_eq!(
+            rank(failed),
+            (serde_json::Value::Null, false.into()),
+            "{failed}"
+        );
+    }
+    let index = fs::read_to_string(out.join("index.md")).expect("index.md");
+    let line = index
+        .lines()
+        .find(|l| l.starts_with("- integral:"))
+        .expect("the quantity's ranking");
+    assert!(
+        line.contains("simpson (not reached)") && line.contains("trapezoid (not reached)"),
+        "{line}"
+    );
+    assert!(!line.contains("tied"), "{line}");
+    // Each failed job records the time it ran until it failed, not 0.
+    let results = fs::read_to_string(out.join("t/results.jsonl")).expect("results");
+    let failed: Vec<serde_json::Value> = results
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).expect("json"))
+        .filter(|v| v["failure"].is_string())
+        .collect();
+    assert_eq!(failed.len(), 4, "{results}");
+    for job in &failed {
+        assert!(job["seconds"].as_f64().is_some_and(|s| s > 0.0), "{job}");
+    }
+    let html = fs::read_to_string(out.join("index.html")).expect("index.html");
+    for failed in ["trapezoid", "simpson"] {
+        let row = html
+            .split("<tr>")
+            .find(|r| r.starts_with("<td>integral</td>") && r.contains(failed))
+            .unwrap_or_else(|| panic!("{failed}'s row"));
+        assert!(
+            row.starts_with("<td>integral</td><td class=\"num\">—</td>"),
+            "{row}"
+        );
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A row where some repeats failed says how many: `sqrt(x - 1/2)` is not a
+/// number below 1/2, so a Monte Carlo job of two samples fails unless both
+/// land above it (1 in 4). The row said "failed" whether one repeat of
+/// four failed or all four; the count here is taken from results.jsonl.
+#[test]
+fn a_row_says_how_many_of_its_repeats_failed() {
+    let spec = r#"{
+      "name": "t", "family": "integral",
+      "scene": {"domain": {"type": "interval", "a": 0, "b": 1},
+                "integrand": "sqrt(x - 0.5)", "exact": "0.2357022603955158"},
+      "quantities": ["integral"],
+      "rules": [{"rule": "monte-carlo"}],
+      "budgets": [2], "repeats": 4, "seed": 3,
+      "reference": {"type": "closed-form"}
+    }"#;
+    let (dir, out, o) = run_text("some-failed", spec);
+    let results = fs::read_to_string(out.join("t/results.jsonl"))
+        .unwrap_or_else(|e| panic!("{e}: {}", stderr(&o)));
+    let failed = results
+        .lines()
+        .filter(|l| l.contains("\"failure\":\""))
+        .count();
+    assert!(
+        (1..4).contains(&failed),
+        "a seed with some repeats failed: {results}"
+    );
+    let report = fs::read_to_string(out.join("t/report.md")).expect("report");
+    let row = report
+        .lines()
+        .find(|l| l.starts_with("| monte-carlo | 2 |"))
+        .expect("the row");
+    assert!(
+        row.contains(&format!("failed in {failed} of 4 repeats: ")),
+        "{row}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -7,7 +7,7 @@ use std::path::Path;
 use crate::experiment::markdown::{escape, to_html};
 use crate::experiment::plot;
 use crate::experiment::reference::{CROSSCHECK_INTRO, Crosscheck, crosscheck_markdown};
-use crate::experiment::report::{EXACT_FROM_START, Summary, TIED, ranked, ranks};
+use crate::experiment::report::{EXACT_FROM_START, Summary, TIED, ranked, ranks, shares_rank};
 use crate::experiment::run::write_report_file;
 
 use super::{document, num_cell, rule_cell};
@@ -61,7 +61,7 @@ pub fn write_index(
                 let best: Vec<String> = ranking
                     .iter()
                     .zip(ranks(&ranking))
-                    .filter(|(r, rank)| *rank == 1 && r.seconds.is_some())
+                    .filter(|(_, rank)| *rank == Some(1))
                     .map(|(r, _)| {
                         format!(
                             "<span class=\"sw\" style=\"background:{}\"></span>{}",
@@ -145,7 +145,7 @@ pub fn write_index(
                 let time = r
                     .seconds
                     .map_or("not reached".to_string(), |t| format!("{t:.1e}"));
-                let tied = i > 0 && ranks[i] == ranks[i - 1];
+                let tied = shares_rank(&ranks, i);
                 let note: Vec<&str> = [(tied, TIED), (r.exact_from_start, EXACT_FROM_START)]
                     .into_iter()
                     .filter_map(|(on, text)| on.then_some(text))
@@ -154,10 +154,10 @@ pub fn write_index(
                     b,
                     "<tr><td>{}</td><td class=\"num\">{}</td>{}{}<td>{}</td></tr>",
                     escape(q),
-                    if tied {
-                        format!("={}", ranks[i])
-                    } else {
-                        ranks[i].to_string()
+                    match ranks[i] {
+                        None => "—".to_string(),
+                        Some(rank) if tied => format!("={rank}"),
+                        Some(rank) => rank.to_string(),
                     },
                     rule_cell(&palette, &r.label),
                     num_cell(&time, r.seconds.unwrap_or(f64::NAN)),

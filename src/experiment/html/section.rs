@@ -14,7 +14,7 @@ use super::{num_cell, rule_cell};
 fn alarming(f: &RowFlag) -> bool {
     matches!(
         f,
-        RowFlag::Failed(_)
+        RowFlag::Failed { .. }
             | RowFlag::NonFinite
             | RowFlag::OutsideStandardErrors
             | RowFlag::EstimateOff

@@ -1,6 +1,7 @@
 //! `results.csv`: a line per job and quantity, timed by the quantity's own
-//! evaluation (the job's time where the job failed before any quantity),
-//! with the quantity's reference and the job's true error against it.
+//! evaluation (a job that failed before any quantity: the time it ran until
+//! it failed), with the quantity's reference and the job's true error
+//! against it.
 
 use std::fmt::Write as _;
 

@@ -105,7 +105,7 @@ fn orders(s: &Section) -> String {
 /// estimate).
 fn kind(f: &RowFlag) -> Option<&'static str> {
     Some(match f {
-        RowFlag::Failed(_) => "failed",
+        RowFlag::Failed { .. } => "failed",
         RowFlag::NonFinite => "gave a value that is not a number",
         RowFlag::OutsideStandardErrors => "is more than 4 standard errors off",
         RowFlag::EstimateOff => "has an error estimate off by more than 10x",

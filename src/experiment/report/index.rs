@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::ranking::{EXACT_FROM_START, Summary, TIED, ranked, ranks};
+use super::ranking::{EXACT_FROM_START, Summary, TIED, ranked, ranks, shares_rank};
 use crate::experiment::reference::{CROSSCHECK_INTRO, Crosscheck, crosscheck_markdown};
 use crate::experiment::run::write_report_file;
 
@@ -47,7 +47,7 @@ pub fn write_index(
                 .enumerate()
                 .map(|(i, r)| {
                     let mut exact = String::new();
-                    if i > 0 && ranks[i] == ranks[i - 1] {
+                    if shares_rank(&ranks, i) {
                         exact.push_str(&format!(", {TIED}"));
                     }
                     if r.exact_from_start {

@@ -67,7 +67,7 @@ pub use page::{
     FIT_NOTE, SHARED, external_times, interval_cell, provenance, write_experiment, write_summary,
 };
 pub use pictures::Picture;
-pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIED, ranked, ranks, tied};
+pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIED, ranked, ranks, shares_rank, tied};
 pub use rows::{FLAG_LEGEND, Row, RowFlag, rows};
 pub use section::not_run;
 pub use section::{

@@ -105,7 +105,7 @@ pub fn time_to<'a>(rows: &[&'a Row], target: f64) -> Option<&'a Row> {
             && !r
                 .flags
                 .iter()
-                .any(|f| matches!(f, RowFlag::Failed(_) | RowFlag::Job(Flag::Underflow)))
+                .any(|f| matches!(f, RowFlag::Failed { .. } | RowFlag::Job(Flag::Underflow)))
     };
     let mut by_budget: Vec<&'a Row> = rows.to_vec();
     by_budget.sort_by_key(|r| r.budget);

@@ -320,9 +320,11 @@ fn table(page: &Page, rows: &[Row], display: Option<&Display>) -> String {
             .flags
             .iter()
             .map(|f| match f {
-                RowFlag::Failed(why) => {
-                    format!("failed: {}", crate::experiment::markdown::plain(why))
-                }
+                RowFlag::Failed { why, failed, of } => format!(
+                    "{}: {}",
+                    super::rows::failed_in(*failed, *of),
+                    crate::experiment::markdown::plain(why)
+                ),
                 f => f.to_string(),
             })
             .collect();

@@ -22,7 +22,8 @@ pub struct Ranked {
     pub exact_from_start: bool,
 }
 
-/// A ranking, fastest first; rules that never reached the target last, by name.
+/// A ranking, fastest first; rules that never reached the target last, by
+/// name (unranked: [`ranks`]).
 pub fn ranked(ranking: &[Ranked]) -> Vec<Ranked> {
     let mut ranked = ranking.to_vec();
     ranked.sort_by(|a, b| match (a.seconds, b.seconds) {
@@ -36,15 +37,26 @@ pub fn ranked(ranking: &[Ranked]) -> Vec<Ranked> {
 
 /// The rank of each rule in `ranked` (sorted by [`ranked`]): 1, 2, ...,
 /// with a rule whose time's interval overlaps that of the rule before it
-/// sharing that one's rank (their times are not told apart). Rules that did
-/// not reach the target rank after all that did.
-pub fn ranks(ranked: &[Ranked]) -> Vec<usize> {
-    let mut out: Vec<usize> = Vec::with_capacity(ranked.len());
+/// sharing that one's rank (their times are not told apart). A rule that
+/// did not reach the target has no rank: no time orders it against the
+/// others, whether it ran out of budget or every job of it failed.
+pub fn ranks(ranked: &[Ranked]) -> Vec<Option<usize>> {
+    let mut out: Vec<Option<usize>> = Vec::with_capacity(ranked.len());
     for (i, r) in ranked.iter().enumerate() {
-        let tied = i > 0 && tied(&ranked[i - 1], r);
-        out.push(if tied { out[i - 1] } else { i + 1 });
+        let rank = match (r.seconds, i.checked_sub(1)) {
+            (None, _) => None,
+            (Some(_), Some(before)) if tied(&ranked[before], r) => out[before],
+            (Some(_), _) => Some(i + 1),
+        };
+        out.push(rank);
     }
     out
+}
+
+/// Whether the rule at `i` shares its rank with the rule before it
+/// (`ranks` of a ranking); never where it has no rank.
+pub fn shares_rank(ranks: &[Option<usize>], i: usize) -> bool {
+    i > 0 && ranks[i].is_some() && ranks[i] == ranks[i - 1]
 }
 
 /// Whether two reached times are not told apart: their intervals overlap,
@@ -87,7 +99,7 @@ mod tests {
 
     /// Times whose intervals overlap the one before share its rank; a gap
     /// starts a new rank at the position; rules that did not reach the
-    /// target are never tied.
+    /// target have no rank, and share none.
     #[test]
     fn times_whose_intervals_overlap_share_a_rank() {
         let r = ranked(&[
@@ -99,6 +111,8 @@ mod tests {
         ]);
         let labels: Vec<&str> = r.iter().map(|x| x.label.as_str()).collect();
         assert_eq!(labels, ["a", "b", "c", "d", "e"]);
-        assert_eq!(ranks(&r), [1, 1, 3, 4, 5]);
+        assert_eq!(ranks(&r), [Some(1), Some(1), Some(3), None, None]);
+        let shared: Vec<bool> = (0..r.len()).map(|i| shares_rank(&ranks(&r), i)).collect();
+        assert_eq!(shared, [false, true, false, false, false]);
     }
 }

@@ -13,8 +13,16 @@ use crate::family::{Display, Flag, Measured};
 /// A fact about a row of a report table.
 #[derive(Debug, Clone, PartialEq)]
 pub enum RowFlag {
-    /// A job failed, with its reason.
-    Failed(String),
+    /// Jobs of the row failed: the first one's reason, and how many of the
+    /// row's repeats failed.
+    Failed {
+        /// The first failed job's reason.
+        why: String,
+        /// The repeats that failed.
+        failed: usize,
+        /// The row's repeats.
+        of: usize,
+    },
     /// A value is NaN or infinite.
     NonFinite,
     /// A fact the family recorded on the value.
@@ -28,8 +36,9 @@ pub enum RowFlag {
     ErrorGrew,
     /// The error is at or below the reference's own relative accuracy.
     AtReferenceAccuracy(f64),
-    /// The method's error estimate is infinite: it had no information to
-    /// estimate the error (stratified sampling on two cells).
+    /// The method's error estimate is infinite: it had none to give (the
+    /// estimate switched off, stratified sampling on two cells), or the
+    /// estimate passed the f64 range (values near 1.8e308).
     NoEstimate,
     /// The true relative error is beyond the f64 range though value and
     /// reference are finite: the reference is too small to divide by (a
@@ -37,10 +46,20 @@ pub enum RowFlag {
     ErrorBeyondRange,
 }
 
+/// "failed", with how many of the row's repeats failed where it had more
+/// than one: "failed in 1 of 2 repeats".
+pub fn failed_in(failed: usize, of: usize) -> String {
+    if of > 1 {
+        format!("failed in {failed} of {of} repeats")
+    } else {
+        "failed".to_string()
+    }
+}
+
 impl std::fmt::Display for RowFlag {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            RowFlag::Failed(why) => write!(f, "failed: {why}"),
+            RowFlag::Failed { why, failed, of } => write!(f, "{}: {why}", failed_in(*failed, *of)),
             RowFlag::NonFinite => write!(f, "non-finite value"),
             RowFlag::Job(flag) => write!(f, "{flag}"),
             RowFlag::OutsideStandardErrors => write!(f, "outside 4 standard errors"),
@@ -49,7 +68,8 @@ impl std::fmt::Display for RowFlag {
             RowFlag::AtReferenceAccuracy(a) => write!(f, "at the reference's accuracy ({a:.1e})"),
             RowFlag::NoEstimate => write!(
                 f,
-                "no error estimate (infinite: too little to estimate from)"
+                "no error estimate (infinite: the rule had none to give, as with the estimate \
+                 switched off or too few cells, or its estimate passed the f64 range)"
             ),
             RowFlag::ErrorBeyondRange => write!(
                 f,
@@ -74,8 +94,8 @@ sample variance is carried by a few samples); `error grew with the budget` (by m
 from one budget to the next, from an error above 1e-11; smaller rises are not flagged); `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
 parts); `relative error beyond the f64 range` (a finite value against a finite reference too small to \
 divide by); `underflows` (the value is below the smallest f64 and reads 0; its logarithm is exact: ask for `ln_tau`, \
-and `ln I_B = ln B + ln tau`); `no error estimate` (the method had too little to estimate from: \
-stratified sampling on two cells); `at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
+and `ln I_B = ln B + ln tau`); `no error estimate` (the method had none to give: its estimate switched off, or stratified \
+sampling on two cells; or its estimate passed the f64 range); `at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
 scored alike` (a tracking estimate with zero sample variance: its error is a Wilson half-width \
 / 1.96, not a sample standard error); `N walks carried by a few` (a tracking estimate whose \
 scores' sample variance is carried by a few walks, as the mean of a product of many factors is: \
@@ -201,8 +221,13 @@ fn row(
     random: bool,
 ) -> Row {
     let mut flags = Vec::new();
-    if let Some(f) = jobs.iter().find_map(|j| j.failure.clone()) {
-        flags.push(RowFlag::Failed(f));
+    if let Some(why) = jobs.iter().find_map(|j| j.failure.clone()) {
+        let failed = jobs.iter().filter(|j| j.failure.is_some()).count();
+        flags.push(RowFlag::Failed {
+            why,
+            failed,
+            of: jobs.len(),
+        });
     }
     // A sample per finished repeat: the quantity's own time where the job
     // timed it alone, the job's otherwise (older results files). The

@@ -17,7 +17,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::fitted::{Reach, Slope};
-use super::ranking::{ranked, ranks};
+use super::ranking::{ranked, ranks, shares_rank};
 use super::rows::{Row, RowFlag};
 use super::section::Section;
 use super::{Page, label};
@@ -127,8 +127,8 @@ pub struct RuleSummary {
     pub evaluations_slope: Option<Slope>,
     /// Per target, in `targets`' order.
     pub targets: Vec<TargetSummary>,
-    /// Rank by time to `ranked_at` (1 fastest; rules that did not reach it
-    /// rank after all that did); null where the rule has no rows.
+    /// Rank by time to `ranked_at` (1 fastest); null where the rule did not
+    /// reach it (out of budget, or every job failed) or has no rows.
     pub rank: Option<usize>,
     /// Shares its rank with the rule ranked before it: their times'
     /// confidence intervals overlap.
@@ -236,7 +236,7 @@ impl RowFlag {
     /// The flag's code in `summary.json`.
     pub fn kind(&self) -> &'static str {
         match self {
-            RowFlag::Failed(_) => "failed",
+            RowFlag::Failed { .. } => "failed",
             RowFlag::NonFinite => "non-finite",
             RowFlag::OutsideStandardErrors => "outside-standard-errors",
             RowFlag::EstimateOff => "estimate-off",
@@ -312,10 +312,10 @@ fn quantity(page: &Page, i: usize, s: &Section) -> QuantitySummary {
     // Ranks by label, as the index ranks them.
     let order = ranked(&s.ranking);
     let all = ranks(&order);
-    let rank_of: BTreeMap<&str, (usize, bool)> = order
+    let rank_of: BTreeMap<&str, (Option<usize>, bool)> = order
         .iter()
         .enumerate()
-        .map(|(k, r)| (r.label.as_str(), (all[k], k > 0 && all[k] == all[k - 1])))
+        .map(|(k, r)| (r.label.as_str(), (all[k], shares_rank(&all, k))))
         .collect();
     let rules = s
         .fits
@@ -347,7 +347,7 @@ fn quantity(page: &Page, i: usize, s: &Section) -> QuantitySummary {
                 .collect();
             let (rank, tied) = rank_of
                 .get(f.label.as_str())
-                .map_or((None, false), |&(r, t)| (Some(r), t));
+                .map_or((None, false), |&(r, t)| (r, t));
             RuleSummary {
                 rule_index: f.rule_index,
                 label: label(page, f.rule_index),

@@ -86,7 +86,9 @@ pub struct JobResult {
     pub seed: u64,
     /// Each quantity: its channels, error estimates, cost and flags.
     pub quantities: BTreeMap<String, Measured>,
-    /// Wall time of the evaluation, seconds (the clock is read outside it).
+    /// Wall time of the evaluation, seconds (the clock is read outside it);
+    /// for a failed job the time it ran until it failed (0 where nothing
+    /// ran: a rule the file does not have).
     pub seconds: f64,
     /// Why the job failed, if it did.
     pub failure: Option<String>,
@@ -190,6 +192,7 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         return out;
     };
     let asked = quantities_at::<F>(&exp.scene, method, &spec.quantities, budget);
+    let start = Instant::now();
     let outcome = match method {
         Listed::Own(method) => own_outcome(exp, method, &asked, budget, seed),
         Listed::External(x) => external_outcome(exp, x, &asked, (rule_index, budget, repeat), seed),
@@ -198,6 +201,7 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         Ok(outcome) => outcome,
         Err(why) => {
             out.failure = Some(why);
+            out.seconds = start.elapsed().as_secs_f64();
             return out;
         }
     };
