@@ -480,11 +480,17 @@ fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
         schemas.validate(&v, id).is_ok()
     };
     assert!(valid(VALID));
-    assert!(valid(&VALID.replace("\"seed\": 7", "\"seed\": 7, \"targets\": [1e-3, 1e-6]")));
+    assert!(valid(&VALID.replace(
+        "\"seed\": 7",
+        "\"seed\": 7, \"targets\": [1e-3, 1e-6]"
+    )));
     for refused in [
         VALID.replace("[4, 16, 64]", "[]"),
         VALID.replace("[4, 16, 64]", "[4, 16, 4]"),
-        VALID.replace("\"seed\": 7", "\"seed\": 7, \"targets\": [1e-3, 1e-6, 1e-3]"),
+        VALID.replace(
+            "\"seed\": 7",
+            "\"seed\": 7, \"targets\": [1e-3, 1e-6, 1e-3]",
+        ),
     ] {
         assert!(!valid(&refused), "allowed: {refused}");
     }
