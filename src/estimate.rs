@@ -129,28 +129,6 @@ impl<V: Value> Estimate<V> {
         }
     }
 
-    /// [`Estimate::combine`] for the integrals over two pieces of one
-    /// region (a segment's between its breaks, an infinite interval's cuts):
-    /// `self` the sum over the earlier pieces. An error where both values
-    /// are finite and their sum is not, naming them, where the sum would
-    /// otherwise come back as a bare `inf`.
-    pub fn combine_pieces(self, other: Self) -> Result<Self, crate::QuadError> {
-        let total = self.combine(other);
-        if total.value.all_finite() || !self.value.all_finite() || !other.value.all_finite() {
-            return Ok(total);
-        }
-        Err(crate::QuadError::invalid(
-            "integrand",
-            format!(
-                "its integral over the earlier piece(s), {}, plus that over the next, {}, is {}: beyond the f64 range",
-                crate::error::channels(self.value),
-                crate::error::channels(other.value),
-                crate::error::channels(total.value)
-            ),
-            "an integral at most 1.8e308 in magnitude: scale the integrand down",
-        ))
-    }
-
     /// Adds an independent estimate over a disjoint region: values add;
     /// deterministic errors add, standard errors add in quadrature. A sum with
     /// a random part is random, and its error is the linear sum of the parts
@@ -178,6 +156,65 @@ impl<V: Value> Estimate<V> {
                 && (other.alike || other.evaluations == 0)
                 && (self.alike || other.alike),
         }
+    }
+}
+
+/// The integral over a region cut into `k` pieces (a segment's between
+/// its breaks, an infinite interval's middle and tails): the pieces'
+/// estimates [combined](Estimate::combine) in order, their values also
+/// added scaled by `2^-s`, `2^s >= k`, where no partial sum can overflow
+/// (the scaling is exact). Where the plain sum passes the f64 range and
+/// the scaled one, scaled back, does not, the latter is the value:
+/// `1e308 + 1e308 - 1e308` is `1e308` in every order. Only a total itself
+/// beyond the range is an error, which names it.
+pub struct PieceSum<V: Value> {
+    total: Estimate<V>,
+    scaled: V,
+    s: i32,
+    pieces: usize,
+}
+
+impl<V: Value> PieceSum<V> {
+    /// A sum of `k` pieces (at least one assumed).
+    pub fn new(k: usize) -> Self {
+        PieceSum {
+            total: Estimate::zero(),
+            scaled: V::zero(),
+            s: k.max(1).next_power_of_two().trailing_zeros() as i32,
+            pieces: 0,
+        }
+    }
+
+    /// Adds the next piece's estimate.
+    pub fn add(&mut self, piece: Estimate<V>) {
+        let down = 2f64.powi(-self.s);
+        self.scaled = self.scaled.zip(piece.value, |a, b| a + b * down);
+        self.total = self.total.combine(piece);
+        self.pieces += 1;
+    }
+
+    /// The total; an error where its value is beyond the f64 range.
+    pub fn finish(self) -> Result<Estimate<V>, crate::QuadError> {
+        if self.total.value.all_finite() {
+            return Ok(self.total);
+        }
+        let up = 2f64.powi(self.s);
+        let value = self.scaled.map(|v| v * up);
+        if value.all_finite() {
+            return Ok(Estimate {
+                value,
+                ..self.total
+            });
+        }
+        Err(crate::QuadError::invalid(
+            "integrand",
+            format!(
+                "[{}], the sum of its integrals over {} pieces, is beyond the f64 range",
+                crate::error::channels(value),
+                self.pieces
+            ),
+            "an integral at most 1.8e308 in magnitude: scale the integrand down",
+        ))
     }
 }
 

@@ -167,7 +167,7 @@ impl Segment {
         rng: &mut Rg,
         mut g: G,
     ) -> Result<Estimate<V>, QuadError> {
-        let mut total: Option<Estimate<V>> = None;
+        let mut total = crate::estimate::PieceSum::new(self.breaks.len() + 1);
         for (lo, hi) in self.pieces() {
             let piece = Segment {
                 a: lo,
@@ -175,13 +175,11 @@ impl Segment {
                 breaks: Vec::new(),
             };
             let mid = 0.5 * (lo + hi);
-            let est = super::try_integrate_over(rule, &piece, n, rng, |t| g(t, mid))?;
-            total = Some(match total {
-                None => est,
-                Some(t) => t.combine_pieces(est)?,
-            });
+            total.add(super::try_integrate_over(rule, &piece, n, rng, |t| {
+                g(t, mid)
+            })?);
         }
-        Ok(total.unwrap_or(Estimate::zero()))
+        total.finish()
     }
 }
 

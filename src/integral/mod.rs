@@ -178,7 +178,7 @@ impl Built {
         n: usize,
         rng: &mut rand_pcg::Pcg64,
     ) -> Result<crate::estimate::Estimate<V>, QuadError> {
-        let mut total = crate::estimate::Estimate::<V>::zero();
+        let mut total = crate::estimate::PieceSum::<V>::new(pieces.len());
         for &piece in pieces {
             let est = rule.try_integrate(n, rng, |u: [f64; 1]| {
                 let mut values = [0.0; MAX_VARIABLES];
@@ -189,9 +189,9 @@ impl Built {
                     None => Ok(V::zero()),
                 }
             })?;
-            total = total.combine_pieces(est)?;
+            total.add(est);
         }
-        Ok(total)
+        total.finish()
     }
 
     /// The pieces a rule runs on (a segment's between its breaks; else 1).
