@@ -653,7 +653,7 @@ impl Comparison {
              intervals are apart and their ratio is beyond {:.2}x either way, the noise \
              threshold; {pace}{single})\n- ranks at the middle target: {ranks} rule(s) changed \
              rank; {swapped} pair(s) of rules ranked apart in both runs swapped order (the other \
-             changes are rules moving between tied and apart)\n",
+             changes are rules moving between tied and apart, or into or out of the ranking)\n",
             self.experiments.len(),
             listed(", only in the baseline: ", &self.only_old),
             listed(", only in the new run: ", &self.only_new),

@@ -46,7 +46,7 @@ pub fn write_index(
     }
     b.push_str(
         "<p class=\"lead\">Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error \
-         (1e-6 unless the experiment says otherwise); <em>not reached</em> means no budget got there. \
+         (1e-6 unless the experiment says otherwise); <em>not reached</em> means no budget got there and stayed there with every repeat finished (such a rule has no rank). \
          A rule lightquad ships has the same colour on every page; no two rules of one page share one.</p>\n",
     );
     // The overview table.

@@ -31,7 +31,7 @@ pub fn write_index(
         );
     }
     md.push_str(
-        "Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (1e-6 unless the experiment says otherwise); `not reached` means no budget got there.\n\n",
+        "Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (1e-6 unless the experiment says otherwise); `not reached` means no budget got there and stayed there with every repeat finished (such a rule has no rank).\n\n",
     );
     for (name, description, summary) in entries {
         let _ = writeln!(

@@ -95,10 +95,13 @@ pub fn fitted(rows: &[&Row], against: Against, floor: f64) -> Option<Order> {
 /// An error that dips below the target at one budget by a lucky
 /// cancellation and rises above it again does not count (Gauss–Legendre on
 /// r-sphere-below-horizon: 3.2e-7 at n = 1024, 5.7e-6 at 4096, below 1e-6
-/// only from 65536 on; the first row ranked it first). A failed row reaches
-/// nothing, nor does one whose value underflowed: 0 against a reference
-/// that also reads 0 in f64 is an error of 0 on paper and of 100% against
-/// the true value (`e^-100000` on the stiff sphere).
+/// only from 65536 on; the first row ranked it first). A row where some
+/// repeats failed reaches nothing, nor does one whose value underflowed: 0
+/// against a reference that also reads 0 in f64 is an error of 0 on paper
+/// and of 100% against the true value (`e^-100000` on the stiff sphere). A
+/// row where every repeat failed measured no error, so it is left out: a
+/// larger budget whose node lands on a singularity does not undo the
+/// target reached below it (the row still shows its failure).
 pub fn time_to<'a>(rows: &[&'a Row], target: f64) -> Option<&'a Row> {
     let meets = |r: &Row| {
         r.rel_error <= target
@@ -107,7 +110,12 @@ pub fn time_to<'a>(rows: &[&'a Row], target: f64) -> Option<&'a Row> {
                 .iter()
                 .any(|f| matches!(f, RowFlag::Failed { .. } | RowFlag::Job(Flag::Underflow)))
     };
-    let mut by_budget: Vec<&'a Row> = rows.to_vec();
+    let all_failed = |r: &Row| {
+        r.flags
+            .iter()
+            .any(|f| matches!(f, RowFlag::Failed { failed, of, .. } if failed == of))
+    };
+    let mut by_budget: Vec<&'a Row> = rows.iter().copied().filter(|r| !all_failed(r)).collect();
     by_budget.sort_by_key(|r| r.budget);
     // The rows past the last budget that misses the target.
     let from = by_budget
@@ -163,6 +171,39 @@ mod tests {
         // came before.
         let dip = [row(16, 1e-9, 1e-6), row(64, 1e-3, 4e-6)];
         let refs: Vec<&Row> = dip.iter().collect();
+        assert!(time_to(&refs, 1e-6).is_none());
+    }
+
+    /// A larger budget where every repeat failed (a node on a singularity)
+    /// measured nothing: the target reached below it stands. A row where
+    /// some repeats failed does not reach it. A rule whose every row failed
+    /// reaches nothing.
+    #[test]
+    fn a_row_where_every_repeat_failed_does_not_undo_the_target() {
+        let failed = |budget, failed, of| Row {
+            flags: vec![RowFlag::Failed {
+                why: "inf at x = 0".into(),
+                failed,
+                of,
+            }],
+            ..row(budget, f64::NAN, f64::NAN)
+        };
+        let rows = [
+            row(16, 1e-15, 4e-7),
+            row(64, 1e-15, 1e-6),
+            failed(4096, 3, 3),
+        ];
+        let refs: Vec<&Row> = rows.iter().collect();
+        assert_eq!(time_to(&refs, 1e-6).map(|r| r.budget), Some(16));
+        let some = Row {
+            rel_error: 1e-15,
+            ..failed(4096, 1, 3)
+        };
+        let rows = [row(16, 1e-15, 4e-7), some];
+        let refs: Vec<&Row> = rows.iter().collect();
+        assert!(time_to(&refs, 1e-6).is_none());
+        let rows = [failed(16, 3, 3), failed(64, 3, 3)];
+        let refs: Vec<&Row> = rows.iter().collect();
         assert!(time_to(&refs, 1e-6).is_none());
     }
 }

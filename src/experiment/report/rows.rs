@@ -68,8 +68,9 @@ impl std::fmt::Display for RowFlag {
             RowFlag::AtReferenceAccuracy(a) => write!(f, "at the reference's accuracy ({a:.1e})"),
             RowFlag::NoEstimate => write!(
                 f,
-                "no error estimate (infinite: the rule had none to give, as with the estimate \
-                 switched off or too few cells, or its estimate passed the f64 range)"
+                "no error estimate (infinite: the method gave none, as with the estimate \
+                 switched off, too few nodes or cells, or an external estimator without one; \
+                 or its estimate passed the f64 range)"
             ),
             RowFlag::ErrorBeyondRange => write!(
                 f,
@@ -94,8 +95,9 @@ sample variance is carried by a few samples); `error grew with the budget` (by m
 from one budget to the next, from an error above 1e-11; smaller rises are not flagged); `cancellation` (a sum below 1e-6 of the summed magnitudes of its \
 parts); `relative error beyond the f64 range` (a finite value against a finite reference too small to \
 divide by); `underflows` (the value is below the smallest f64 and reads 0; its logarithm is exact: ask for `ln_tau`, \
-and `ln I_B = ln B + ln tau`); `no error estimate` (the method had none to give: its estimate switched off, or stratified \
-sampling on two cells; or its estimate passed the f64 range); `at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
+and `ln I_B = ln B + ln tau`); `no error estimate` (the method gave none: its estimate switched off, too few nodes or cells \
+(Gauss–Legendre at one node, stratified sampling on two cells), an external estimator without \
+one; or its estimate passed the f64 range); `at the reference's accuracy` (the error is not resolved by the reference); `all N walks \
 scored alike` (a tracking estimate with zero sample variance: its error is a Wilson half-width \
 / 1.96, not a sample standard error); `N walks carried by a few` (a tracking estimate whose \
 scores' sample variance is carried by a few walks, as the mean of a product of many factors is: \
