@@ -562,20 +562,25 @@ fn check_file(
     names: &mut std::collections::BTreeMap<String, String>,
 ) -> Result<(), Failure> {
     let exp = experiment::load_source(registry, f)?;
-    if let Some(other) = names.insert(exp.name().to_string(), f.display()) {
+    // The first file of a name keeps it: a later one is refused, and its
+    // refusal names the file that holds the name.
+    if let Some(other) = names.get(exp.name()) {
+        let why = if *other == f.display() {
+            "this file is given twice: give it once".to_string()
+        } else {
+            format!(
+                "{:?} is also the name of {other}: one run (one output folder) cannot hold \
+                 both; rename one",
+                exp.name()
+            )
+        };
         return Err(experiment::RunError::Spec {
             file: f.display(),
-            source: lightquad::error::SpecError::at(
-                "name",
-                format!(
-                    "{:?} is also the name of {other}: one run (one output folder) \
-                     cannot hold both; rename one",
-                    exp.name()
-                ),
-            ),
+            source: lightquad::error::SpecError::at("name", why),
         }
         .into());
     }
+    names.insert(exp.name().to_string(), f.display());
     for w in exp.warnings() {
         lightquad::say!("warning: {}: {}", f.display(), readable(&w.to_string()));
     }

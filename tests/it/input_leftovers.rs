@@ -523,6 +523,18 @@ fn check_names_every_bad_file_and_checks_the_rest() {
     );
     assert!(err.contains("`repeats`"), "{err}");
     assert!(err.contains("2 of 3 file(s) failed the check"), "{err}");
+    // One file given twice is said so, not called a clash of two names.
+    let o = bin()
+        .arg("check")
+        .args([&good, &good])
+        .output()
+        .expect("runs");
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("this file is given twice"),
+        "{}",
+        stderr(&o)
+    );
     let _ = fs::remove_dir_all(&dir);
 }
 
