@@ -170,24 +170,28 @@ impl<V: Value> Estimate<V> {
 pub struct PieceSum<V: Value> {
     total: Estimate<V>,
     scaled: V,
-    s: i32,
+    /// `2^-s` and `2^s`.
+    down: f64,
+    up: f64,
     pieces: usize,
 }
 
 impl<V: Value> PieceSum<V> {
     /// A sum of `k` pieces (at least one assumed).
     pub fn new(k: usize) -> Self {
+        let s = k.max(1).next_power_of_two().trailing_zeros() as i32;
         PieceSum {
             total: Estimate::zero(),
             scaled: V::zero(),
-            s: k.max(1).next_power_of_two().trailing_zeros() as i32,
+            down: 2f64.powi(-s),
+            up: 2f64.powi(s),
             pieces: 0,
         }
     }
 
     /// Adds the next piece's estimate.
     pub fn add(&mut self, piece: Estimate<V>) {
-        let down = 2f64.powi(-self.s);
+        let down = self.down;
         self.scaled = self.scaled.zip(piece.value, |a, b| a + b * down);
         self.total = self.total.combine(piece);
         self.pieces += 1;
@@ -198,7 +202,7 @@ impl<V: Value> PieceSum<V> {
         if self.total.value.all_finite() {
             return Ok(self.total);
         }
-        let up = 2f64.powi(self.s);
+        let up = self.up;
         let value = self.scaled.map(|v| v * up);
         if value.all_finite() {
             return Ok(Estimate {
