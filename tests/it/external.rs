@@ -693,3 +693,31 @@ fn a_failed_job_is_no_sample_of_its_rows_time() {
         assert!(t["low"].as_f64().is_some_and(|s| s >= 0.04), "{row}");
     }
 }
+
+#[test]
+fn a_failed_jobs_time_is_its_request_not_the_programs_start_up() {
+    // Each process takes 0.5 s to start and answers garbage at once, so
+    // every job of the program starts a fresh one and fails.
+    let program = format!(
+        "import time\ntime.sleep(0.5)\n{}",
+        answering("print('x', flush=True); continue")
+    );
+    let (dir, file) = setup("ext-start", &program, serde_json::json!({}));
+    let out = dir.join("out");
+    let _ = run(&file, &out, &[]);
+    let failed: Vec<Json> = results(&out)
+        .into_iter()
+        .filter(|r| r["rule"] == "prog")
+        .collect();
+    assert_eq!(failed.len(), 4);
+    for job in &failed {
+        assert!(
+            job["failure"]
+                .as_str()
+                .is_some_and(|f| f.contains("not a response")),
+            "{job}"
+        );
+        let seconds = job["seconds"].as_f64().unwrap_or(f64::NAN);
+        assert!(seconds > 0.0 && seconds < 0.25, "{job}");
+    }
+}

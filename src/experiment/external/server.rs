@@ -131,44 +131,50 @@ impl Server {
 
     /// Sends `request` (its `id` set here) and waits up to `timeout` for the
     /// answer: the measured value and lightquad's own time for it, or why
-    /// not, and whether the process may serve again.
+    /// not, whether the process may serve again, and the seconds from
+    /// sending the request to its failure (0 where it was not sent).
     fn ask(
         &mut self,
         mut request: Request,
         timeout: Duration,
-    ) -> Result<(Measured, f64), (String, bool)> {
+    ) -> Result<(Measured, f64), (String, bool, f64)> {
         self.requests += 1;
         request.id = self.requests;
         self.limit
             .store(longest_line(request.channels), Ordering::Relaxed);
-        let line = serde_json::to_string(&request).map_err(|e| (e.to_string(), false))? + "\n";
+        let line = serde_json::to_string(&request).map_err(|e| (e.to_string(), false, 0.0))? + "\n";
         let start = Instant::now();
+        let since = |start: Instant| start.elapsed().as_secs_f64();
         if self.writer.send(line).is_err() {
+            let seconds = since(start);
             return Err((
                 format!("could not send the request{}", self.exited()),
                 false,
+                seconds,
             ));
         }
         let text = match self.lines.recv_timeout(timeout) {
             Ok(Ok(text)) => text,
-            Ok(Err(why)) => return Err((why, false)),
+            Ok(Err(why)) => return Err((why, false, since(start))),
             Err(RecvTimeoutError::Timeout) => {
                 return Err((
                     format!("no answer within timeout_s = {} s", timeout.as_secs_f64()),
                     false,
+                    since(start),
                 ));
             }
             Err(RecvTimeoutError::Disconnected) => {
-                return Err((format!("no answer{}", self.exited()), false));
+                let seconds = since(start);
+                return Err((format!("no answer{}", self.exited()), false, seconds));
             }
         };
-        let seconds = start.elapsed().as_secs_f64();
+        let seconds = since(start);
         let response: Response =
-            serde_json::from_str(&text).map_err(|e| (garbage(&text, &e), false))?;
+            serde_json::from_str(&text).map_err(|e| (garbage(&text, &e), false, seconds))?;
         let declined = response.error.is_some();
         protocol::answer(response, request.id, request.channels, request.budget)
             .map(|m| (m, seconds))
-            .map_err(|e| (e, declined))
+            .map_err(|e| (e, declined, seconds))
     }
 
     /// `: the program exited with <status>` when it has (waited for a moment).
@@ -307,6 +313,17 @@ fn keep_tail(stderr: impl Read, tail: &Mutex<VecDeque<String>>) {
     }
 }
 
+/// A request that got no measured value: why, and the seconds from
+/// sending it to its failure (0 where it was not sent: the program did not
+/// start).
+#[derive(Debug)]
+pub struct Unanswered {
+    /// The failure, naming the request and the program's last stderr lines.
+    pub why: String,
+    /// Seconds from sending the request to its failure.
+    pub seconds: f64,
+}
+
 /// The idle processes of each external rule of one experiment run: a lane
 /// takes one (or starts one) for a job and gives it back when it served
 /// well; all are stopped when this is dropped.
@@ -335,7 +352,7 @@ impl Servers {
         program: &Program,
         request: Request,
         timeout_s: f64,
-    ) -> Result<Measured, String> {
+    ) -> Result<Measured, Unanswered> {
         let taken = self.idle.lock().ok().and_then(|mut idle| {
             let k = idle.iter().position(|(r, _)| *r == rule)?;
             Some(idle.swap_remove(k).1)
@@ -348,7 +365,10 @@ impl Servers {
             Some(s) => s,
             None => self
                 .start(rule, program, timeout_s)
-                .map_err(|e| format!("{what}: {e}"))?,
+                .map_err(|e| Unanswered {
+                    why: format!("{what}: {e}"),
+                    seconds: 0.0,
+                })?,
         };
         match server.ask(request, Duration::from_secs_f64(timeout_s)) {
             Ok((mut m, seconds)) => {
@@ -356,14 +376,17 @@ impl Servers {
                 self.give_back(rule, server);
                 // The program's request lies within lightquad's timing of it.
                 match m.program_seconds {
-                    Some(own) if own > seconds + OWN_TIME_SLACK => Err(format!(
-                        "{what}: reported taking {own:.3e} s for a request that lightquad timed \
-                         at {seconds:.3e} s from sending it to reading the answer"
-                    )),
+                    Some(own) if own > seconds + OWN_TIME_SLACK => Err(Unanswered {
+                        why: format!(
+                            "{what}: reported taking {own:.3e} s for a request that lightquad \
+                             timed at {seconds:.3e} s from sending it to reading the answer"
+                        ),
+                        seconds,
+                    }),
                     _ => Ok(m),
                 }
             }
-            Err((why, keep)) => {
+            Err((why, keep, seconds)) => {
                 let tail = server
                     .stderr_tail()
                     .map(|t| format!("; its stderr ended: {t}"))
@@ -371,7 +394,10 @@ impl Servers {
                 if keep {
                     self.give_back(rule, server);
                 }
-                Err(format!("{what}: {why}{tail}"))
+                Err(Unanswered {
+                    why: format!("{what}: {why}{tail}"),
+                    seconds,
+                })
             }
         }
     }

@@ -86,9 +86,12 @@ pub struct JobResult {
     pub seed: u64,
     /// Each quantity: its channels, error estimates, cost and flags.
     pub quantities: BTreeMap<String, Measured>,
-    /// Wall time of the evaluation, seconds (the clock is read outside it);
-    /// for a failed job the time it ran until it failed (0 where nothing
-    /// ran: a rule the file does not have).
+    /// Wall time of the evaluation, seconds (the clock is read outside it):
+    /// the sum of its quantities' times. For a failed job, the time of its
+    /// work until it failed: the finished quantities' times and the failing
+    /// evaluation's own (an external program's request from sending it,
+    /// not the program's start-up); 0 where nothing ran (a rule the file
+    /// does not have, a program that did not start).
     pub seconds: f64,
     /// Why the job failed, if it did.
     pub failure: Option<String>,
@@ -192,16 +195,15 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
         return out;
     };
     let asked = quantities_at::<F>(&exp.scene, method, &spec.quantities, budget);
-    let start = Instant::now();
     let outcome = match method {
         Listed::Own(method) => own_outcome(exp, method, &asked, budget, seed),
         Listed::External(x) => external_outcome(exp, x, &asked, (rule_index, budget, repeat), seed),
     };
     let outcome = match outcome {
         Ok(outcome) => outcome,
-        Err(why) => {
-            out.failure = Some(why);
-            out.seconds = start.elapsed().as_secs_f64();
+        Err(failed) => {
+            out.failure = Some(failed.why);
+            out.seconds = failed.seconds;
             return out;
         }
     };
@@ -213,6 +215,13 @@ pub fn run_job<F: Family>(exp: &Experiment<F>, (rule_index, budget, repeat): Job
     out
 }
 
+/// A job that failed: why, and the seconds of its work until then (the
+/// finished quantities' times, one evaluation each, and the failing one's).
+struct Failed {
+    why: String,
+    seconds: f64,
+}
+
 /// Each quantity `asked` evaluated alone by the family's `method`, from the
 /// job's seed, and timed alone: its time to a target is then its own cost (a
 /// family computes only what the asked-for quantities need).
@@ -222,8 +231,9 @@ fn own_outcome<F: Family>(
     asked: &[F::Quantity],
     budget: usize,
     seed: u64,
-) -> Result<Outcome<F::Quantity>, String> {
+) -> Result<Outcome<F::Quantity>, Failed> {
     let mut outcome = Outcome::new();
+    let mut finished = 0.0;
     for q in asked {
         let evaluate = || {
             let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
@@ -246,7 +256,11 @@ fn own_outcome<F: Family>(
         } else {
             once
         };
-        let values = result.map_err(|e| crate::error::readable(&format!("{}: {e}", q.name())))?;
+        let values = result.map_err(|e| Failed {
+            why: crate::error::readable(&format!("{}: {e}", q.name())),
+            seconds: finished + once,
+        })?;
+        finished += seconds;
         for (k, mut m) in values {
             m.seconds = Some(seconds);
             outcome.insert(k, m);
@@ -263,15 +277,18 @@ fn external_outcome<F: Family>(
     asked: &[F::Quantity],
     (rule_index, budget, repeat): JobKey,
     seed: u64,
-) -> Result<Outcome<F::Quantity>, String> {
+) -> Result<Outcome<F::Quantity>, Failed> {
+    let failed = |why: String, seconds: f64| Failed { why, seconds };
     let Some(Found::Program(program)) = exp.programs.get(&rule_index) else {
-        return Err(format!(
+        let why = format!(
             "rules[{rule_index}] ({}): its program was not found",
             external.name
-        ));
+        );
+        return Err(failed(why, 0.0));
     };
-    let scene = serde_json::to_value(&exp.spec.scene).map_err(|e| e.to_string())?;
+    let scene = serde_json::to_value(&exp.spec.scene).map_err(|e| failed(e.to_string(), 0.0))?;
     let mut outcome = Outcome::new();
+    let mut finished = 0.0;
     for &q in asked {
         let request = Request {
             protocol: protocol::NAME.into(),
@@ -290,7 +307,11 @@ fn external_outcome<F: Family>(
         let m = exp
             .servers
             .ask(rule_index, program, request, external.timeout_s)
-            .map_err(|e| crate::error::readable(&format!("external `{}`: {e}", external.name)))?;
+            .map_err(|e| {
+                let why = format!("external `{}`: {}", external.name, e.why);
+                failed(crate::error::readable(&why), finished + e.seconds)
+            })?;
+        finished += m.seconds.unwrap_or(0.0);
         outcome.insert(q, m);
     }
     Ok(outcome)
