@@ -111,13 +111,33 @@ pub struct ExperimentComparison {
     pub ratios: Vec<f64>,
     /// Rows whose time changed beyond both intervals.
     pub times: Vec<TimeChange>,
-    /// Rules whose rank changed: (quantity, label, old rank, new rank).
-    pub ranks: Vec<(String, String, Option<usize>, Option<usize>)>,
+    /// Rules whose standing changed: (quantity, label, old, new).
+    pub ranks: Vec<(String, String, Standing, Standing)>,
     /// Pairs of rules of one quantity ranked apart in both runs, in
     /// opposite orders: (quantity, one label, the other).
     pub swapped: Vec<(String, String, String)>,
     /// What could not be compared.
     pub notes: Vec<String>,
+}
+
+/// A rule's place in its quantity's ranking at the middle target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Standing {
+    /// Its rank (None: the target not reached).
+    pub rank: Option<usize>,
+    /// Whether another rule of the quantity holds the same rank (their
+    /// times not told apart).
+    pub tied: bool,
+}
+
+impl std::fmt::Display for Standing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (self.rank, self.tied) {
+            (None, _) => f.write_str("—"),
+            (Some(r), false) => write!(f, "{r}"),
+            (Some(r), true) => write!(f, "{r} (tied)"),
+        }
+    }
 }
 
 /// Two report folders compared.
@@ -530,17 +550,7 @@ fn times_and_ranks(
             });
         }
     }
-    let ranks = |s: &ExperimentSummary| -> BTreeMap<(String, String), Option<usize>> {
-        s.quantities
-            .iter()
-            .flat_map(|q| {
-                q.rules
-                    .iter()
-                    .map(|r| ((q.quantity.clone(), r.label.clone()), r.rank))
-            })
-            .collect()
-    };
-    let (ka, kb) = (ranks(a), ranks(b));
+    let (ka, kb) = (standings(a), standings(b));
     for (key, old) in &ka {
         if let Some(new) = kb.get(key)
             && new != old
@@ -551,7 +561,7 @@ fn times_and_ranks(
     // Pairs of one quantity's rules ranked apart in both runs, in opposite orders.
     let both: Vec<(&(String, String), usize, usize)> = ka
         .iter()
-        .filter_map(|(k, &x)| Some((k, x?, (*kb.get(k)?)?)))
+        .filter_map(|(k, x)| Some((k, x.rank?, kb.get(k)?.rank?)))
         .collect();
     for (i, (k, x, y)) in both.iter().enumerate() {
         for (l, u, v) in &both[i + 1..] {
@@ -560,6 +570,21 @@ fn times_and_ranks(
             }
         }
     }
+}
+
+/// Each rule's standing by (quantity, label): its rank, and whether
+/// another rule of the quantity holds the same one.
+fn standings(s: &ExperimentSummary) -> BTreeMap<(String, String), Standing> {
+    let mut out = BTreeMap::new();
+    for q in &s.quantities {
+        for r in &q.rules {
+            let tied =
+                r.rank.is_some() && q.rules.iter().filter(|other| other.rank == r.rank).count() > 1;
+            let standing = Standing { rank: r.rank, tied };
+            out.insert((q.quantity.clone(), r.label.clone()), standing);
+        }
+    }
+    out
 }
 
 impl Comparison {
@@ -652,8 +677,9 @@ impl Comparison {
              the timings can tell, of {timed} (faster or slower: the two medians' confidence \
              intervals are apart and their ratio is beyond {:.2}x either way, the noise \
              threshold; {pace}{single})\n- ranks at the middle target: {ranks} rule(s) changed \
-             rank; {swapped} pair(s) of rules ranked apart in both runs swapped order (the other \
-             changes are rules moving between tied and apart, or into or out of the ranking)\n",
+             rank or tie; {swapped} pair(s) of rules ranked apart in both runs swapped order \
+             (the other changes are rules moving between tied and apart, or into or out of the \
+             ranking)\n",
             self.experiments.len(),
             listed(", only in the baseline: ", &self.only_old),
             listed(", only in the new run: ", &self.only_new),
@@ -774,18 +800,15 @@ fn experiment_markdown(md: &mut String, e: &ExperimentComparison) {
             );
         }
     }
-    let rank = |r: Option<usize>| r.map_or("—".to_string(), |r| r.to_string());
     if !e.ranks.is_empty() {
         md.push('\n');
     }
     for (q, label, a, b) in &e.ranks {
         let _ = writeln!(
             md,
-            "- rank of {} on {}: {} -> {}",
+            "- rank of {} on {}: {a} -> {b}",
             one_line(label),
             one_line(q),
-            rank(*a),
-            rank(*b)
         );
     }
     for (q, x, y) in swapped {

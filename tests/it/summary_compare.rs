@@ -403,3 +403,72 @@ fn summaries_are_valid_against_their_schema() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A rule whose rank another rule comes to share is said to be tied, and a
+/// rule that keeps its rank number but comes to share it is listed too.
+/// Both runs' summaries are one run's with the ranks written in: 1, 2, 3
+/// in the baseline; 1, 1 (tied), 3 in the new run.
+#[test]
+fn compare_says_when_a_rank_becomes_shared() {
+    let dir = scratch("compare-tied");
+    let text = r#"{"name": "tied", "family": "counted", "scene": {"tag": 9}, "quantities": ["square"],
+        "rules": [{"rule": "trapezoid"}, {"rule": "simpson"}, {"rule": "gauss-legendre"}],
+        "budgets": [5, 17], "repeats": 2, "reference": {"type": "closed-form"}}"#;
+    run(&dir, "old", text);
+    let new = dir.join("new/tied");
+    fs::create_dir_all(&new).expect("mkdir");
+    for f in ["results.jsonl", "summary.json"] {
+        fs::copy(dir.join("old/tied").join(f), new.join(f)).expect("copy");
+    }
+    let rank = |run: &str, ranks: [(&str, u64, bool); 3]| {
+        let path = dir.join(run).join("tied/summary.json");
+        let mut summary: serde_json::Value =
+            serde_json::from_str(&fs::read_to_string(&path).expect("summary")).expect("json");
+        let rules = summary["experiments"][0]["quantities"][0]["rules"]
+            .as_array_mut()
+            .expect("rules");
+        for r in rules.iter_mut() {
+            let (_, n, tied) = ranks
+                .iter()
+                .find(|(label, ..)| r["label"] == *label)
+                .expect("a rule of the three");
+            r["rank"] = (*n).into();
+            r["tied"] = (*tied).into();
+        }
+        fs::write(&path, summary.to_string()).expect("write");
+    };
+    rank(
+        "old",
+        [
+            ("trapezoid", 1, false),
+            ("simpson", 2, false),
+            ("gauss-legendre", 3, false),
+        ],
+    );
+    rank(
+        "new",
+        [
+            ("trapezoid", 1, false),
+            ("simpson", 1, true),
+            ("gauss-legendre", 3, false),
+        ],
+    );
+    let c = compare(
+        &dir.join("old"),
+        &dir.join("new"),
+        &CompareOptions::default(),
+    )
+    .expect("compares");
+    let md = c.markdown();
+    assert!(
+        md.contains("- rank of simpson on square: 2 -> 1 (tied)\n"),
+        "{md}"
+    );
+    assert!(
+        md.contains("- rank of trapezoid on square: 1 -> 1 (tied)\n"),
+        "{md}"
+    );
+    assert!(!md.contains("rank of gauss-legendre"), "{md}");
+    assert!(md.contains("2 rule(s) changed rank or tie"), "{md}");
+    let _ = fs::remove_dir_all(&dir);
+}
