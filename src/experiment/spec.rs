@@ -76,9 +76,15 @@ pub struct ExperimentSpec<F: Family> {
     pub seed: u64,
     /// The reference the errors are measured against.
     pub reference: ReferenceSpec<F::Quantity>,
-    /// Relative errors whose time-to-reach the report gives, each once.
+    /// Relative errors in (0, 1) whose time-to-reach the report gives, each
+    /// once, at least one; validation sorts them from the largest, and the
+    /// rules are ranked at the middle one.
     #[serde(default = "default_targets")]
-    #[schemars(extend("uniqueItems" = true))]
+    #[schemars(
+        length(min = 1),
+        extend("uniqueItems" = true),
+        extend("items" = {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1})
+    )]
     pub targets: Vec<f64>,
 }
 
@@ -122,7 +128,7 @@ pub enum Budgets {
     /// An explicit list.
     List(
         #[schemars(
-            length(min = 1),
+            length(min = 1, max = 200),
             extend("uniqueItems" = true),
             inner(range(min = 1, max = 100_000_000))
         )]
@@ -145,6 +151,7 @@ pub struct BudgetRange {
     #[schemars(range(min = 1, max = 100_000_000))]
     pub to: i64,
     /// Ratio between consecutive budgets (> 1).
+    #[schemars(extend("exclusiveMinimum" = 1))]
     pub factor: f64,
 }
 

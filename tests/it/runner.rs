@@ -461,8 +461,9 @@ fn a_schema_named_in_the_file_is_accepted_and_allowed_by_the_schema() {
 }
 
 /// The experiment schema, read by boon (an independent validator), refuses
-/// what `check` refuses of a list: an empty or repeated budget and a
-/// repeated target (it allowed all three), and still allows VALID.
+/// what `check` refuses of the lists: an empty or repeated budget, more
+/// than 200 budgets, a range's factor of 1, no target, a repeated one or
+/// one outside (0, 1); and both still allow VALID.
 #[test]
 fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
     let schema = bin().arg("schema").output().expect("runs");
@@ -484,16 +485,62 @@ fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
         "\"seed\": 7",
         "\"seed\": 7, \"targets\": [1e-3, 1e-6]"
     )));
-    for refused in [
-        VALID.replace("[4, 16, 64]", "[]"),
-        VALID.replace("[4, 16, 64]", "[4, 16, 4]"),
-        VALID.replace(
-            "\"seed\": 7",
-            "\"seed\": 7, \"targets\": [1e-3, 1e-6, 1e-3]",
+    let many: Vec<String> = (1..=201).map(|n| n.to_string()).collect();
+    let targets = |t: &str| VALID.replace("\"seed\": 7", &format!("\"seed\": 7, \"targets\": {t}"));
+    let dir = scratch("schema-lists");
+    let file = dir.join("e.json");
+    for (refused, field) in [
+        (VALID.replace("[4, 16, 64]", "[]"), "budgets"),
+        (VALID.replace("[4, 16, 64]", "[4, 16, 4]"), "budgets"),
+        (
+            VALID.replace("[4, 16, 64]", &format!("[{}]", many.join(", "))),
+            "budgets",
         ),
+        (
+            VALID.replace("[4, 16, 64]", r#"{"from": 4, "to": 64, "factor": 1}"#),
+            "budgets",
+        ),
+        (targets("[1e-3, 1e-6, 1e-3]"), "targets"),
+        (targets("[]"), "targets"),
+        (targets("[0]"), "targets[0]"),
+        (targets("[1e-3, 1]"), "targets[1]"),
     ] {
-        assert!(!valid(&refused), "allowed: {refused}");
+        assert!(!valid(&refused), "the schema allowed: {refused}");
+        fs::write(&file, &refused).expect("write");
+        let o = bin().arg("check").arg(&file).output().expect("runs");
+        assert!(!o.status.success(), "check allowed: {refused}");
+        assert!(stderr(&o).contains(&format!("`{field}")), "{}", stderr(&o));
     }
+    fs::write(&file, VALID).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// Targets listed in any order are reported from the largest down and the
+/// rules ranked at the middle value, not at the list's middle position.
+#[test]
+fn targets_in_any_order_are_ranked_at_the_middle_value() {
+    let text = VALID.replace(
+        "\"seed\": 7",
+        "\"seed\": 7, \"targets\": [1e-9, 1e-3, 1e-6]",
+    );
+    let (dir, out, o) = run_text("targets-order", &text);
+    let summary: serde_json::Value = serde_json::from_str(
+        &fs::read_to_string(out.join("t/summary.json"))
+            .unwrap_or_else(|e| panic!("{e}: {}", stderr(&o))),
+    )
+    .expect("summary.json");
+    let e = &summary["experiments"][0];
+    assert_eq!(e["ranked_at"].as_f64(), Some(1e-6), "{e}");
+    let listed: Vec<f64> = e["targets"]
+        .as_array()
+        .expect("targets")
+        .iter()
+        .filter_map(serde_json::Value::as_f64)
+        .collect();
+    assert_eq!(listed, [1e-3, 1e-6, 1e-9]);
+    let _ = fs::remove_dir_all(&dir);
 }
 
 /// `lightquad run` without files runs the bundled suite from any folder (here
@@ -3333,6 +3380,17 @@ fn a_row_says_how_many_of_its_repeats_failed() {
     assert!(
         row.contains(&format!("failed in {failed} of 4 repeats: ")),
         "{row}"
+    );
+    // The findings paragraph says it too.
+    let flags = report
+        .lines()
+        .find(|l| l.contains("Flags: "))
+        .expect("the findings' flags");
+    assert!(
+        flags.contains(&format!(
+            "monte-carlo failed in {failed} of 4 repeats at n = 2"
+        )),
+        "{flags}"
     );
     let _ = fs::remove_dir_all(&dir);
 }

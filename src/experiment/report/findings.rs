@@ -3,8 +3,10 @@
 //! which rules carry flags at which budgets. Every figure comes from the
 //! results, so no description has to state one (and none can go stale).
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 
+use super::rows::failed_in;
 use super::{Page, RowFlag, Section, label};
 use crate::experiment::timing::TimeInterval;
 use crate::family::Flag;
@@ -102,10 +104,10 @@ fn orders(s: &Section) -> String {
 
 /// What a flag says of a rule, in a few words; none for the flags that say
 /// nothing against the rule (an error at the reference's accuracy, no
-/// estimate).
-fn kind(f: &RowFlag) -> Option<&'static str> {
-    Some(match f {
-        RowFlag::Failed { .. } => "failed",
+/// estimate). A failure says in how many of the row's repeats.
+fn kind(f: &RowFlag) -> Option<Cow<'static, str>> {
+    Some(Cow::Borrowed(match f {
+        RowFlag::Failed { failed, of, .. } => return Some(failed_in(*failed, *of).into()),
         RowFlag::NonFinite => "gave a value that is not a number",
         RowFlag::OutsideStandardErrors => "is more than 4 standard errors off",
         RowFlag::EstimateOff => "has an error estimate off by more than 10x",
@@ -122,12 +124,12 @@ fn kind(f: &RowFlag) -> Option<&'static str> {
         RowFlag::Job(Flag::Underflow) => "underflows f64",
         RowFlag::Job(Flag::Cancellation { .. }) => "lost digits to cancellation",
         RowFlag::AtReferenceAccuracy(_) | RowFlag::NoEstimate => return None,
-    })
+    }))
 }
 
 /// A clause per rule and flag: the budgets it shows at.
 fn flags(page: &Page, s: &Section) -> String {
-    let mut by: BTreeMap<(usize, &'static str), Vec<usize>> = BTreeMap::new();
+    let mut by: BTreeMap<(usize, Cow<'static, str>), Vec<usize>> = BTreeMap::new();
     for r in &s.rows {
         for f in &r.flags {
             if let Some(k) = kind(f) {

@@ -51,7 +51,8 @@ pub use parse::{deserialize, parse_and_load, parse_json};
 /// Largest budget accepted (per smooth piece).
 pub const MAX_BUDGET: i64 = 100_000_000;
 
-/// Most budgets a range may expand to.
+/// Most budgets a list may hold or a range expand to (the schema's
+/// `maxItems` on a list).
 const MAX_BUDGETS: usize = 200;
 
 /// A validated experiment of family `F`, ready to run.
@@ -93,6 +94,10 @@ pub fn validate_from<F: Family>(
     origin: Origin,
 ) -> Result<Experiment<F>, SpecError> {
     check_header::<F>(&spec)?;
+    // The report's columns run from the largest target error down, and the
+    // rules are ranked at the middle one, whatever order the file lists.
+    let mut spec = spec;
+    spec.targets.sort_by(|a, b| b.total_cmp(a));
     let scene = F::build(&spec.scene)?;
     for (k, q) in spec.quantities.iter().enumerate() {
         if let Some(why) = F::lacks(&scene, *q) {
@@ -265,6 +270,13 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
             format!("{} is not an integer in 1..=1000", spec.repeats),
         ));
     }
+    if spec.targets.is_empty() {
+        return Err(SpecError::at(
+            "targets",
+            "an empty list: give at least one relative error in (0, 1) (the rules are \
+             ranked at the middle one)",
+        ));
+    }
     for (i, t) in spec.targets.iter().enumerate() {
         if !(t.is_finite() && *t > 0.0 && *t < 1.0) {
             return Err(SpecError::at(
@@ -396,6 +408,15 @@ fn budgets(spec: &Budgets) -> Result<Vec<usize>, SpecError> {
             return Err(SpecError::at(
                 "budgets",
                 "an empty list: give at least one budget",
+            ));
+        }
+        Budgets::List(list) if list.len() > MAX_BUDGETS => {
+            return Err(SpecError::at(
+                "budgets",
+                format!(
+                    "a list of {} budgets: give at most {MAX_BUDGETS}",
+                    list.len()
+                ),
             ));
         }
         Budgets::List(list) => {
