@@ -36,7 +36,7 @@ def one_run(n):
         cwd=ROOT, capture_output=True, text=True, check=False,
     )
     if run.returncode != 0:
-        raise SystemExit(f"gl_race.sh at n = {n} failed (exit {run.returncode}):\n{run.stderr[-2000:]}")
+        raise RaceFailed(f"gl_race.sh at n = {n} failed (exit {run.returncode}):\n{run.stderr[-2000:]}")
     found = {}
     for line in run.stdout.splitlines():
         m = ROW.match(line)
@@ -44,15 +44,38 @@ def one_run(n):
             found[(m.group(1), m.group(2))] = float(m.group(3))
     want = {(c, p) for c in CONTENDERS for p in PEERS}
     if set(found) != want:
-        raise SystemExit(f"gl_race.sh at n = {n} printed {sorted(found)}, expected {sorted(want)}")
+        raise RaceFailed(f"gl_race.sh at n = {n} printed {sorted(found)}, expected {sorted(want)}")
     return found
+
+
+class RaceFailed(Exception):
+    """A gl_race.sh run that failed or printed other rows."""
+
+
+def table(runs, passes):
+    """The median over `passes` whole passes of each ratio, with each pass's value."""
+    print(f"Median over {passes} passes of each gl_race.sh run's median (7 processes, 101 rounds):\n")
+    print("| n | ratio | median over passes | each pass |")
+    print("|---:|---|---:|---|")
+    for n, done in runs.items():
+        done = done[:passes]
+        med = {k: statistics.median(r[k] for r in done) for k in done[0]}
+        faster = max(PEERS, key=lambda peer: med[("fixed", peer)])
+        for c in CONTENDERS:
+            for peer in PEERS:
+                mark = " (faster peer)" if peer == faster else ""
+                each = " ".join(f"{r[(c, peer)]:.4f}" for r in done)
+                print(f"| {n} | {c} / {peer}{mark} | {med[(c, peer)]:.4f} | {each} |")
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("passes", nargs="?", type=int, default=6)
+    ap.add_argument("passes", nargs="?", type=int, default=6, help="passes, 1 to 100 (default 6)")
     ap.add_argument("--pause", type=float, default=40.0, help="seconds between passes (default 40)")
-    ap.add_argument("--n", type=int, nargs="+", default=[5, 10, 20, 50, 100])
+    ap.add_argument(
+        "--n", type=int, nargs="+", default=[5, 10, 20, 50, 100],
+        help="orders, distinct, 1 to 100 (default 5 10 20 50 100)",
+    )
     a = ap.parse_args()
     if not 1 <= a.passes <= 100:
         ap.error(f"PASSES {a.passes}: expected 1 to 100")
@@ -64,20 +87,17 @@ def main():
     for p in range(a.passes):
         if p:
             time.sleep(a.pause)
-        for n in a.n:
-            runs[n].append(one_run(n))
+        try:
+            for n in a.n:
+                runs[n].append(one_run(n))
+        except RaceFailed as e:
+            print(e, file=sys.stderr)
+            if p:
+                print(f"\nThe {p} whole pass(es) before it:\n")
+                table(runs, p)
+            sys.exit(1)
         print(f"pass {p + 1} of {a.passes} done", file=sys.stderr)
-    print(f"Median over {a.passes} passes of each gl_race.sh run's median (7 processes, 101 rounds):\n")
-    print("| n | ratio | median over passes | each pass |")
-    print("|---:|---|---:|---|")
-    for n in a.n:
-        med = {k: statistics.median(r[k] for r in runs[n]) for k in runs[n][0]}
-        faster = max(PEERS, key=lambda peer: med[("fixed", peer)])
-        for c in CONTENDERS:
-            for peer in PEERS:
-                mark = " (faster peer)" if peer == faster else ""
-                each = " ".join(f"{r[(c, peer)]:.4f}" for r in runs[n])
-                print(f"| {n} | {c} / {peer}{mark} | {med[(c, peer)]:.4f} | {each} |")
+    table(runs, a.passes)
 
 
 if __name__ == "__main__":
