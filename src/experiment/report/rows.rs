@@ -37,8 +37,9 @@ pub enum RowFlag {
     /// The error is at or below the reference's own relative accuracy.
     AtReferenceAccuracy(f64),
     /// The method's error estimate is infinite: it had none to give (the
-    /// estimate switched off, stratified sampling on two cells), or the
-    /// estimate passed the f64 range (values near 1.8e308).
+    /// estimate switched off, too few nodes or cells for one, an external
+    /// estimator that sends none), or the estimate passed the f64 range
+    /// (values near 1.8e308).
     NoEstimate,
     /// The true relative error is beyond the f64 range though value and
     /// reference are finite: the reference is too small to divide by (a
