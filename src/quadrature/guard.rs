@@ -381,10 +381,12 @@ fn beyond<V: Value>(y: &V) -> bool {
     })
 }
 
-/// Keeps the integrand's own `error` in `own` and stops the pass: the
-/// guard returns it as it is, whatever the rule's sum makes of the stop.
+/// Keeps the integrand's own `error` in `own` and stops the sum it was
+/// called in: the caller returns `own` as it is, whatever the sum makes of
+/// the stop (the guard; [`FixedOrder`](super::gauss_legendre::FixedOrder)'s
+/// compensated sum).
 #[cold]
-fn stopped_by(own: &mut Option<QuadError>, error: QuadError) -> QuadError {
+pub(crate) fn stopped_by(own: &mut Option<QuadError>, error: QuadError) -> QuadError {
     *own = Some(error);
     pass_stopped()
 }

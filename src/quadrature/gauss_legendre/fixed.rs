@@ -15,6 +15,7 @@ use super::unit_table::{running_sum, unit_table};
 use super::{TABLE_MAX_ORDER, check_order, unit_nodes, unit_rule};
 use crate::error::{QuadError, channels, readable_number};
 use crate::quadrature::nodes::{UnitNodes, product_value};
+use crate::quadrature::guard::stopped_by;
 use crate::value::Value;
 
 /// The `n`-node Gauss–Legendre rule on an interval, its nodes found once.
@@ -191,11 +192,7 @@ fn compensated<V: Value>(
     // (a value not finite at a node of [0, 1]) is told at its x.
     let mut own = None;
     let mean = product_value([nodes], |u: [f64; 1]| {
-        f(x_at(u[0])).map_err(|e| {
-            own = Some(e);
-            // Stops the sum; the error returned is `own`.
-            QuadError::invalid("integrand", "its own error", "")
-        })
+        f(x_at(u[0])).map_err(|e| stopped_by(&mut own, e))
     });
     if let Some(error) = own {
         return Err(error);
