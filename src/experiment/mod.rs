@@ -174,7 +174,8 @@ pub fn run_sources(
     memory::warm_workers();
     if let Some(cap) = memory::hard_cap() {
         for (exp, source, _) in &loaded {
-            let need = exp.max_job_bytes(&run::pending_jobs(exp.as_ref(), opts));
+            let pending = run::pending_jobs(exp.as_ref(), opts);
+            let need = exp.max_job_bytes(&pending);
             if need + memory::REPORT_RESERVE > cap.room {
                 let what = if need > 0.0 {
                     format!(
@@ -248,7 +249,8 @@ pub fn run_sources(
         // No more jobs at once than the machine's memory holds (four jobs of
         // 4 GB each on four threads aborted the run).
         let threads = rayon::current_num_threads();
-        let need = exp.max_job_bytes(&run::pending_jobs(exp.as_ref(), opts));
+        let pending = run::pending_jobs(exp.as_ref(), opts);
+        let need = exp.max_job_bytes(&pending);
         let room = memory::available().map(|a| (a - memory::REPORT_RESERVE).max(0.0));
         let fit = jobs_that_fit(need, room).min(threads);
         if fit < threads {
@@ -272,7 +274,9 @@ pub fn run_sources(
                     ),
                 )
             })?;
-        progress::finished(opts.progress, &bar, exp.name(), &results, started.elapsed());
+        let kept = results.len().saturating_sub(pending.len());
+        let took = started.elapsed();
+        progress::finished(opts.progress, &bar, exp.name(), &results, kept, took);
         done.push((exp, results));
     }
     bar.finish_and_clear();

@@ -25,12 +25,22 @@ pub(super) fn bar(show: bool, total: usize) -> ProgressBar {
     bar
 }
 
-/// The line of a finished experiment: its name, jobs, failures and seconds.
-pub(super) fn line(name: &str, results: &[JobResult], elapsed: Duration) -> String {
+/// The line of a finished experiment: its name, jobs (of which `kept` were
+/// kept from an earlier run by `--resume`, not run now), failures and
+/// seconds.
+pub(super) fn line(name: &str, results: &[JobResult], kept: usize, elapsed: Duration) -> String {
     let failed = results.iter().filter(|r| r.failure.is_some()).count();
+    let jobs = results.len();
+    let jobs = if kept > 0 {
+        format!(
+            "{jobs} jobs ({} run now, {kept} kept from before)",
+            jobs - kept
+        )
+    } else {
+        format!("{jobs} jobs")
+    };
     format!(
-        "finished {name}: {} jobs, {failed} failed, {:.1} s",
-        results.len(),
+        "finished {name}: {jobs}, {failed} failed, {:.1} s",
         elapsed.as_secs_f64()
     )
 }
@@ -42,12 +52,13 @@ pub(super) fn finished(
     bar: &ProgressBar,
     name: &str,
     results: &[JobResult],
+    kept: usize,
     elapsed: Duration,
 ) {
     if !show {
         return;
     }
-    let line = line(name, results, elapsed);
+    let line = line(name, results, kept, elapsed);
     if bar.is_hidden() {
         crate::say!("{line}");
     } else {

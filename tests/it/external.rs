@@ -242,6 +242,12 @@ fn resume_retries_only_the_failed_jobs() {
     let o = run(&file, &out, &["--resume"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(failures(&out).is_empty());
+    // Its line says what ran now and what was kept.
+    assert!(
+        stderr(&o).contains("finished ext: 8 jobs (4 run now, 4 kept from before), 0 failed, "),
+        "{}",
+        stderr(&o)
+    );
     // The finished jobs were kept as they were, not run again.
     let after: Vec<Json> = results(&out)
         .into_iter()
