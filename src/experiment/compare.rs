@@ -494,15 +494,13 @@ fn times_and_ranks(
     c: &mut ExperimentComparison,
 ) {
     type Key = (String, String, usize);
-    // A failed row's time is the failure's, not the rule's.
+    // A row's time is its finished repeats' (a failed job is no sample of
+    // it); a row where every repeat failed has none.
     let rows = |s: &ExperimentSummary| -> BTreeMap<Key, TimeInterval> {
         let mut m = BTreeMap::new();
         for q in &s.quantities {
             for r in &q.rules {
                 for row in &r.rows {
-                    if row.flags.iter().any(|f| f.kind == "failed") {
-                        continue;
-                    }
                     if let Some(t) = row.seconds.filter(plausible) {
                         m.insert((q.quantity.clone(), r.label.clone(), row.budget), t);
                     }
@@ -549,6 +547,14 @@ fn times_and_ranks(
                 new: *new,
             });
         }
+    }
+    if a.ranked_at.to_bits() != b.ranked_at.to_bits() {
+        c.notes.push(format!(
+            "ranks not compared: the baseline ranks the rules by their time to {:e}, the new \
+             run to {:e} (its targets changed)",
+            a.ranked_at, b.ranked_at
+        ));
+        return;
     }
     let (ka, kb) = (standings(a), standings(b));
     for (key, old) in &ka {
@@ -677,7 +683,7 @@ impl Comparison {
              the timings can tell, of {timed} (faster or slower: the two medians' confidence \
              intervals are apart and their ratio is beyond {:.2}x either way, the noise \
              threshold; {pace}{single})\n- ranks at the middle target: {ranks} rule(s) changed \
-             rank or tie; {swapped} pair(s) of rules ranked apart in both runs swapped order \
+             rank or tie (`N (tied)`: another rule holds rank N too); {swapped} pair(s) of rules ranked apart in both runs swapped order \
              (the other changes are rules moving between tied and apart, or into or out of the \
              ranking)\n",
             self.experiments.len(),

@@ -470,5 +470,30 @@ fn compare_says_when_a_rank_becomes_shared() {
     );
     assert!(!md.contains("rank of gauss-legendre"), "{md}");
     assert!(md.contains("2 rule(s) changed rank or tie"), "{md}");
+    // Ranked at another target, the ranks are not compared, and it is said.
+    let path = dir.join("new/tied/summary.json");
+    let text = fs::read_to_string(&path).expect("summary");
+    let mut summary: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let at = summary["experiments"][0]["ranked_at"]
+        .as_f64()
+        .expect("ranked_at");
+    summary["experiments"][0]["ranked_at"] = (at / 8.0).into();
+    fs::write(&path, summary.to_string()).expect("write");
+    let c = compare(
+        &dir.join("old"),
+        &dir.join("new"),
+        &CompareOptions::default(),
+    )
+    .expect("compares");
+    let md = c.markdown();
+    assert!(!md.contains("- rank of"), "{md}");
+    assert!(
+        md.contains(&format!(
+            "ranks not compared: the baseline ranks the rules by their time to {at:e}, the new \
+             run to {:e}",
+            at / 8.0
+        )),
+        "{md}"
+    );
     let _ = fs::remove_dir_all(&dir);
 }
