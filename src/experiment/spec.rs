@@ -76,14 +76,14 @@ pub struct ExperimentSpec<F: Family> {
     pub seed: u64,
     /// The reference the errors are measured against.
     pub reference: ReferenceSpec<F::Quantity>,
-    /// Relative errors in (0, 1) whose time-to-reach the report gives, each
+    /// Relative errors in [1e-15, 1) whose time-to-reach the report gives, each
     /// once, at least one; validation sorts them from the largest, and the
     /// rules are ranked at the middle one.
     #[serde(default = "default_targets")]
     #[schemars(
         length(min = 1),
         extend("uniqueItems" = true),
-        extend("items" = {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1})
+        extend("items" = {"type": "number", "minimum": 1e-15, "exclusiveMaximum": 1})
     )]
     pub targets: Vec<f64>,
 }

@@ -504,6 +504,7 @@ fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
         (targets("[]"), "targets"),
         (targets("[0]"), "targets[0]"),
         (targets("[1e-3, 1]"), "targets[1]"),
+        (targets("[1e-3, 1e-16]"), "targets[1]"),
     ] {
         assert!(!valid(&refused), "the schema allowed: {refused}");
         fs::write(&file, &refused).expect("write");
@@ -540,6 +541,54 @@ fn targets_in_any_order_are_ranked_at_the_middle_value() {
         .filter_map(serde_json::Value::as_f64)
         .collect();
     assert_eq!(listed, [1e-3, 1e-6, 1e-9]);
+    // Every ranking a person reads names the target it ranks at.
+    let index = fs::read_to_string(out.join("index.md")).expect("index.md");
+    assert!(index.contains("- tau (to 1e-6): "), "{index}");
+    let html = fs::read_to_string(out.join("index.html")).expect("index.html");
+    assert!(html.contains("seconds to reach 1e-6 (log)"), "{html}");
+    let report = fs::read_to_string(out.join("t/report.md")).expect("report.md");
+    assert!(
+        report.contains("Target relative errors 1e-3, 1e-6, 1e-9; the index ranks the rules by their time to 1e-6"),
+        "{report}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// Targets that differ in their second digit are told apart in every
+/// heading; a target whose extrapolated budget lies past the largest a
+/// file may ask is said to, not given as a number of evaluations no run
+/// could make.
+#[test]
+fn close_targets_are_told_apart_and_far_extrapolations_are_bounded() {
+    let spec = r#"{
+      "name": "t", "family": "integral",
+      "scene": {"domain": {"type": "interval", "a": 0, "b": 1},
+                "integrand": "sqrt(x)", "exact": "0.66666666666666666667"},
+      "quantities": ["integral"],
+      "rules": [{"rule": "trapezoid"}],
+      "budgets": [8, 16, 32, 64], "repeats": 1, "seed": 1,
+      "reference": {"type": "closed-form"},
+      "targets": [2.5e-3, 3e-3, 1e-15]
+    }"#;
+    let (dir, out, o) = run_text("close-targets", spec);
+    let report = fs::read_to_string(out.join("t/report.md"))
+        .unwrap_or_else(|e| panic!("{e}: {}", stderr(&o)));
+    for t in ["3e-3", "2.5e-3", "1e-15"] {
+        assert!(
+            report.contains(&format!("time to {t} (s)")),
+            "{t}: {report}"
+        );
+    }
+    let row = report
+        .lines()
+        .find(|l| l.starts_with("| trapezoid |") && l.contains("not reached"))
+        .expect("the trapezoid's times to the targets");
+    assert!(
+        row.contains(
+            "not reached (extrapolated: beyond n = 1e8, the largest budget a file may ask)"
+        ),
+        "{row}"
+    );
     let _ = fs::remove_dir_all(&dir);
 }
 
@@ -2407,7 +2456,7 @@ fn underflow_constant_integrands_and_missing_estimates_are_labelled() {
     let index = fs::read_to_string(out.join("index.md")).expect("index");
     let ib = index
         .lines()
-        .find(|l| l.starts_with("- I_B:"))
+        .find(|l| l.starts_with("- I_B (to "))
         .expect("I_B ranked");
     assert!(
         !ib.contains("easy for it") && ib.contains("not reached"),
@@ -3314,7 +3363,7 @@ fn rules_whose_every_job_failed_are_not_ranked() {
     let index = fs::read_to_string(out.join("index.md")).expect("index.md");
     let line = index
         .lines()
-        .find(|l| l.starts_with("- integral:"))
+        .find(|l| l.starts_with("- integral (to "))
         .expect("the quantity's ranking");
     assert!(
         line.contains("simpson (not reached)") && line.contains("trapezoid (not reached)"),

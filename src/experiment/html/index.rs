@@ -46,7 +46,7 @@ pub fn write_index(
     }
     b.push_str(
         "<p class=\"lead\">Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error \
-         (1e-6 unless the experiment says otherwise); <em>not reached</em> means no budget got there and stayed there with every repeat finished (such a rule has no rank). \
+         (the middle of the experiment's targets from the largest down, of two the smaller; each chart and table says which); <em>not reached</em> means no budget got there and stayed there with every repeat finished (such a rule has no rank). \
          A rule lightquad ships has the same colour on every page; no two rules of one page share one.</p>\n",
     );
     // The overview table.
@@ -70,12 +70,15 @@ pub fn write_index(
                         )
                     })
                     .collect();
+                let q = match ranking.first() {
+                    Some(r) => format!("{} (to {:e})", escape(q), r.target),
+                    None => escape(q),
+                };
                 match best.len() {
-                    0 => format!("{}: none reached", escape(q)),
-                    1 => format!("{}: {}", escape(q), best[0]),
+                    0 => format!("{q}: none reached"),
+                    1 => format!("{q}: {}", best[0]),
                     _ => format!(
-                        "{}: {} (tied: their time intervals overlap)",
-                        escape(q),
+                        "{q}: {} (tied: their time intervals overlap)",
                         best.join(" = ")
                     ),
                 }
@@ -137,7 +140,7 @@ pub fn write_index(
                 ranking_chart(summary, scale, &palette)
             );
         }
-        b.push_str("<details><summary>as a table</summary><div class=\"scroll\"><table class=\"sortable\"><thead><tr><th>quantity</th><th class=\"num\">rank</th><th>rule</th><th class=\"num\">time to target (s)</th><th>note</th></tr></thead><tbody>");
+        b.push_str("<details><summary>as a table</summary><div class=\"scroll\"><table class=\"sortable\"><thead><tr><th>quantity</th><th class=\"num\">rank</th><th>rule</th><th class=\"num\">target</th><th class=\"num\">time to it (s)</th><th>note</th></tr></thead><tbody>");
         for (q, ranking) in summary {
             let ranking = ranked(ranking);
             let ranks = ranks(&ranking);
@@ -152,7 +155,7 @@ pub fn write_index(
                     .collect();
                 let _ = write!(
                     b,
-                    "<tr><td>{}</td><td class=\"num\">{}</td>{}{}<td>{}</td></tr>",
+                    "<tr><td>{}</td><td class=\"num\">{}</td>{}{}{}<td>{}</td></tr>",
                     escape(q),
                     match ranks[i] {
                         None => "—".to_string(),
@@ -160,6 +163,7 @@ pub fn write_index(
                         Some(rank) => rank.to_string(),
                     },
                     rule_cell(&palette, &r.label),
+                    num_cell(&format!("{:e}", r.target), r.target),
                     num_cell(&time, r.seconds.unwrap_or(f64::NAN)),
                     note.join("; ")
                 );
@@ -212,6 +216,10 @@ fn percent(s: &str) -> String {
 fn ranking_chart(summary: &Summary, scale: (f64, f64), palette: &plot::Palette) -> String {
     let (lo, hi) = (scale.0.log10(), scale.1.log10());
     let (left, width, row_h, top) = (300.0, 560.0, 20.0, 28.0);
+    let target = summary
+        .iter()
+        .find_map(|(_, r)| r.first())
+        .map_or(String::new(), |r| format!("{:e}", r.target));
     let rows: Vec<(&str, crate::experiment::report::Ranked)> = summary
         .iter()
         .flat_map(|(q, r)| ranked(r).into_iter().map(move |x| (*q, x)))
@@ -236,8 +244,9 @@ fn ranking_chart(summary: &Summary, scale: (f64, f64), palette: &plot::Palette) 
     }
     let _ = write!(
         svg,
-        "<text x=\"{}\" y=\"14\" text-anchor=\"end\" fill=\"#5b6168\">seconds to the middle target (log)</text>",
-        left - 30.0
+        "<text x=\"{}\" y=\"14\" text-anchor=\"end\" fill=\"#5b6168\">seconds to reach {} (log)</text>",
+        left - 30.0,
+        target
     );
     let mut last_q = "";
     for (i, (q, r)) in rows.iter().enumerate() {

@@ -22,7 +22,7 @@
 //! // holds markup: it is shown as text, and the page loads nothing from elsewhere.
 //! let out = std::env::temp_dir().join(format!("lightquad-doc-html-{}", std::process::id()));
 //! std::fs::create_dir_all(&out)?;
-//! let ranked = Ranked { label: "gauss-legendre".into(), seconds: Some(2e-6), time: None, exact_from_start: false };
+//! let ranked = Ranked { label: "gauss-legendre".into(), target: 1e-6, seconds: Some(2e-6), time: None, exact_from_start: false };
 //! let entries = [("exp".to_string(), "e^u <b>& friends</b>".to_string(), vec![("exp", vec![ranked])])];
 //! write_index(&out, &entries, &[], &[], &[], &[])?;
 //! let page = std::fs::read_to_string(out.join("index.html"))?;

@@ -141,7 +141,7 @@ fn facts(dir: &Path, page: &Page, results: &[JobResult]) -> String {
     if !page.settings.is_empty() {
         rows.push(("Settings", escape(&page.settings)));
     }
-    let targets: Vec<String> = page.targets.iter().map(|t| format!("{t:.0e}")).collect();
+    let targets: Vec<String> = page.targets.iter().map(|t| format!("{t:e}")).collect();
     rows.push(("Target errors", targets.join(", ")));
     if page.quantities.len() > 1 {
         rows.push(("Timing", escape(SHARED.trim())));

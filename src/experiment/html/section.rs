@@ -104,10 +104,10 @@ pub(super) fn section(page: &Page, s: &Section) -> String {
     );
     for t in page.targets {
         b.push_str(&th(
-            &format!("time to {t:.0e} (s)"),
+            &format!("time to {t:e} (s)"),
             &format!(
                 "least median time among the rows from the budget on which the error stays at \
-                 most {t:.0e} at every larger budget (a row whose value underflows has no \
+                 most {t:e} at every larger budget (a row whose value underflows has no \
                  error and reaches nothing)"
             ),
             true,

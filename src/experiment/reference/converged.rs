@@ -205,9 +205,10 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
         let largest = changes.values().copied().fold(0.0, f64::max);
         crate::say!(
             "{}: the converged reference changed by {largest:.1e} from n = {} to {m} (goal \
-             {goal:.0e}): doubling to n = {}",
+             {}): doubling to n = {}",
             exp.spec.name,
             m / 2,
+            three_digits(goal),
             m * 2
         );
         // An evaluation past the first two that fails (a family's own
@@ -286,7 +287,7 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
     }));
     let floor = if goal == CONVERGED_FLOOR {
         format!(
-            " (the goal: a hundredth of the tightest target, {tightest:.0e}, but not below \
+            " (the goal: a hundredth of the tightest target, {tightest:e}, but not below \
              {CONVERGED_FLOOR:.0e}, the evaluation's own rounding)"
         )
     } else {
@@ -294,11 +295,15 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
     };
     let stopped = stopped.map_or(String::new(), |why| format!("; {why}"));
     let verdict = if unconverged.is_empty() {
-        format!("every quantity converged to {goal:.0e} or better{floor}")
+        format!(
+            "every quantity converged to {} or better{floor}",
+            three_digits(goal)
+        )
     } else {
         format!(
-            "NOT converged to {goal:.0e}{floor}: {}; errors below that are not \
+            "NOT converged to {}{floor}: {}; errors below that are not \
              resolved{stopped}",
+            three_digits(goal),
             unconverged.join(", ")
         )
     };
@@ -320,4 +325,12 @@ pub(super) fn converged_reference<F: Family>(exp: &Experiment<F>, n: usize) -> R
         channel_accuracy: per_channel,
         unverified: doubted,
     }
+}
+
+/// `x` to at most three significant digits, as briefly as it reads:
+/// `1e-11`, `2.5e-5` (a hundredth of a target of 2.5e-3), not `1.00e-11`
+/// or the quotient's `2.5000000000000002e-5`.
+fn three_digits(x: f64) -> String {
+    let rounded: f64 = format!("{x:.2e}").parse().unwrap_or(x);
+    format!("{rounded:e}")
 }

@@ -46,21 +46,21 @@ fn targets(page: &Page, s: &Section) -> String {
         });
         let sentence = match reached.as_slice() {
             _ if below => {
-                format!("{t:.0e} is below the reference's accuracy: no rule is judged against it.")
+                format!("{t:e} is below the reference's accuracy: no rule is judged against it.")
             }
-            [] => format!("No rule reaches {t:.0e}."),
-            [(a, x, _)] => format!("Only {a} reaches {t:.0e}, in {x:.2e} s."),
+            [] => format!("No rule reaches {t:e}."),
+            [(a, x, _)] => format!("Only {a} reaches {t:e}, in {x:.2e} s."),
             [(a, x, i), (b, y, j), ..] if !i.apart(j) => format!(
-                "{a} and {b} reach {t:.0e} in {x:.2e} and {y:.2e} s, not told apart (their \
+                "{a} and {b} reach {t:e} in {x:.2e} and {y:.2e} s, not told apart (their \
                  times' confidence intervals overlap, or single readings within 1.5x; {} of {} \
                  rules reach it).",
                 reached.len(),
                 s.fits.len()
             ),
             [(a, x, _), (b, y, _), ..] => format!(
-                "{a} reaches {t:.0e} first, in {x:.2e} s, {:.1} times faster than the next, \
+                "{a} reaches {t:e} first, in {x:.2e} s, {} times as fast as the next, \
                  {b} ({} of {} rules reach it).",
-                y / x,
+                speedup(y / x),
                 reached.len(),
                 s.fits.len()
             ),
@@ -74,6 +74,16 @@ fn targets(page: &Page, s: &Section) -> String {
         ));
     }
     out.join(" ")
+}
+
+/// A ratio of times above 1, to three digits below 10 (`1.04`: rules told
+/// apart by a few percent do not read as `1.0` times as fast).
+fn speedup(r: f64) -> String {
+    if r < 10.0 {
+        format!("{r:.2}")
+    } else {
+        format!("{r:.0}")
+    }
 }
 
 /// The fitted orders against evaluations, erratic ones named as such.
@@ -140,14 +150,20 @@ fn flags(page: &Page, s: &Section) -> String {
     if by.is_empty() {
         return "No row carries a flag against its rule.".into();
     }
-    let clauses: Vec<String> = by
+    // A rule's clauses in the order of their first budget ("failed in 10
+    // of 12" at n = 8 before "failed in 2 of 12" at n = 16).
+    let mut clauses: Vec<(usize, usize, String)> = by
         .into_iter()
         .map(|((i, k), mut budgets)| {
             budgets.sort_unstable();
             budgets.dedup();
-            format!("{} {k} at {}", label(page, i), at(page.budgets, &budgets))
+            let first = budgets.first().copied().unwrap_or(0);
+            let clause = format!("{} {k} at {}", label(page, i), at(page.budgets, &budgets));
+            (i, first, clause)
         })
         .collect();
+    clauses.sort();
+    let clauses: Vec<String> = clauses.into_iter().map(|(_, _, c)| c).collect();
     format!("Flags: {}.", clauses.join("; "))
 }
 

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::order::{Against, ERRATIC, Order, fitted, time_to};
 use super::rows::Row;
 use crate::experiment::timing::TimeInterval;
+use crate::experiment::validate::MAX_BUDGET;
 
 /// A fitted slope of log error against log cost, with its 95% interval.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -178,6 +179,12 @@ impl Reach {
             Reach::BelowReferenceAccuracy => "below reference accuracy".into(),
             Reach::Reached { seconds, .. } => format!("{:.2e}", seconds.median),
             Reach::NotReached { extrapolated: None } => "not reached".into(),
+            Reach::NotReached {
+                extrapolated: Some(x),
+            } if x.budget > MAX_BUDGET as f64 => format!(
+                "not reached (extrapolated: beyond n = {:.0e}, the largest budget a file may ask)",
+                MAX_BUDGET as f64
+            ),
             Reach::NotReached {
                 extrapolated: Some(x),
             } => format!(

@@ -31,7 +31,7 @@ pub fn write_index(
         );
     }
     md.push_str(
-        "Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (1e-6 unless the experiment says otherwise); `not reached` means no budget got there and stayed there with every repeat finished (such a rule has no rank).\n\n",
+        "Every experiment, and per quantity the rules ranked by the time they need to reach the middle target relative error (the middle of the experiment's targets from the largest down, of two the smaller; each quantity says which); `not reached` means no budget got there and stayed there with every repeat finished (such a rule has no rank).\n\n",
     );
     for (name, description, summary) in entries {
         let _ = writeln!(
@@ -59,7 +59,10 @@ pub fn write_index(
                     }
                 })
                 .collect();
-            let _ = writeln!(md, "- {q}: {}", list.join(", "));
+            let at = ranking
+                .first()
+                .map_or(String::new(), |r| format!(" (to {:e})", r.target));
+            let _ = writeln!(md, "- {q}{at}: {}", list.join(", "));
         }
         md.push('\n');
     }

@@ -66,7 +66,7 @@ pub fn write_experiment(
             s.slope_heading,
             page.targets
                 .iter()
-                .map(|t| format!("time to {t:.0e} (s)"))
+                .map(|t| format!("time to {t:e} (s)"))
                 .collect::<Vec<_>>()
                 .join(" | "),
             "---:|".repeat(page.targets.len())
@@ -186,11 +186,20 @@ fn header(page: &Page, results: &[JobResult]) -> String {
     } else {
         ""
     };
+    let targets: Vec<String> = page.targets.iter().map(|t| format!("{t:e}")).collect();
     let _ = writeln!(
         md,
         "Family `{}`.{equations} Budgets {:?} ({}), {} repeat(s), seed {}{settings}.{shared}\n\n\
-         Reference: {}\n",
-        page.family, page.budgets, page.budget_unit, page.repeats, page.seed, page.reference.note
+         Target relative errors {}; the index ranks the rules by their time to {:e}, the middle \
+         one.\n\nReference: {}\n",
+        page.family,
+        page.budgets,
+        page.budget_unit,
+        page.repeats,
+        page.seed,
+        targets.join(", "),
+        page.middle_target(),
+        page.reference.note
     );
     let skipped = skipped(page);
     if !skipped.is_empty() {

@@ -12,7 +12,10 @@ pub type Summary = Vec<(&'static str, Vec<Ranked>)>;
 pub struct Ranked {
     /// The rule's label.
     pub label: String,
-    /// Its time to the middle target (None: not reached).
+    /// The target relative error it is ranked at: its experiment's middle
+    /// target (the targets sorted from the largest; of two, the smaller).
+    pub target: f64,
+    /// Its time to `target` (None: not reached).
     pub seconds: Option<f64>,
     /// That time's confidence interval (None: not reached, or no time read).
     pub time: Option<TimeInterval>,
@@ -84,6 +87,7 @@ mod tests {
 
     fn rule(label: &str, seconds: Option<f64>) -> Ranked {
         Ranked {
+            target: 1e-6,
             label: label.into(),
             seconds,
             time: seconds.map(|s| TimeInterval {

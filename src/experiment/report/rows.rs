@@ -82,7 +82,7 @@ impl std::fmt::Display for RowFlag {
 }
 
 /// The legend of the flags (Markdown), below every page.
-pub const FLAG_LEGEND: &str = "Flags: `failed` (the job's reason follows); `non-finite value`; \
+pub const FLAG_LEGEND: &str = "Flags: `failed` (with more than one repeat, `failed in K of N repeats`; the first failed job's reason follows); `non-finite value`; \
 `outside 4 standard errors` (a random estimate whose standard error misses the true error: \
 the root mean square over channels of error / standard error above 4); \
 `estimate off by more than 10x` (a deterministic error estimate: too small beside an error \

@@ -392,6 +392,7 @@ fn orders_and_plots(
             .min_by_key(|r| r.budget);
         ranking.push(Ranked {
             label: label.clone(),
+            target: middle,
             seconds: at_middle.seconds(),
             time: at_middle.interval(),
             // At the floor from the first budget, deterministic or random

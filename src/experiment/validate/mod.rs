@@ -51,6 +51,11 @@ pub use parse::{deserialize, parse_and_load, parse_json};
 /// Largest budget accepted (per smooth piece).
 pub const MAX_BUDGET: i64 = 100_000_000;
 
+/// The smallest target relative error: below it an error is within the
+/// rounding of a value and its reference in f64 (2.2e-16 a step), and no
+/// rule is told to reach it or not (the schema's `minimum`).
+pub const MIN_TARGET: f64 = 1e-15;
+
 /// Most budgets a list may hold or a range expand to (the schema's
 /// `maxItems` on a list).
 const MAX_BUDGETS: usize = 200;
@@ -278,10 +283,13 @@ fn check_header<F: Family>(spec: &ExperimentSpec<F>) -> Result<(), SpecError> {
         ));
     }
     for (i, t) in spec.targets.iter().enumerate() {
-        if !(t.is_finite() && *t > 0.0 && *t < 1.0) {
+        if !(t.is_finite() && *t >= MIN_TARGET && *t < 1.0) {
             return Err(SpecError::at(
                 format!("targets[{i}]"),
-                format!("{t} is not a relative error in (0, 1)"),
+                format!(
+                    "{t} is not a relative error in [{MIN_TARGET:e}, 1) (below {MIN_TARGET:e}, an \
+                     error is within the f64 rounding of a value and its reference)"
+                ),
             ));
         }
     }
