@@ -1453,6 +1453,28 @@ fn an_incomplete_merge_says_so_in_the_index() {
     );
     let index = fs::read_to_string(merged.join("index.md")).expect("index");
     assert!(index.contains("**This report is incomplete**"), "{index}");
+    // The experiment's own page says how many rows lack repeats, counted
+    // here from its results.
+    let results = fs::read_to_string(merged.join("t/results.jsonl")).expect("results");
+    let mut rows: std::collections::BTreeMap<(u64, u64), usize> = Default::default();
+    for line in results.lines() {
+        let v: serde_json::Value = serde_json::from_str(line).expect("json");
+        let key = (
+            v["rule_index"].as_u64().expect("rule"),
+            v["budget"].as_u64().expect("n"),
+        );
+        *rows.entry(key).or_default() += 1;
+    }
+    let short = rows.values().filter(|&&k| k < 2).count();
+    assert!(short > 0);
+    let report = fs::read_to_string(merged.join("t/report.md")).expect("report");
+    assert!(
+        report.contains(&format!(
+            "**Incomplete**: {short} of {} row(s) hold fewer than the 2 repeat(s)",
+            rows.len()
+        )),
+        "{report}"
+    );
     let _ = fs::remove_dir_all(&dir);
 }
 

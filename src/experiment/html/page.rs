@@ -167,6 +167,9 @@ fn facts(dir: &Path, page: &Page, results: &[JobResult]) -> String {
             format!("No rows: {}.", escape(&not_run.join("; "))),
         ));
     }
+    if let Some(short) = crate::experiment::report::short_rows(page, results) {
+        rows.push(("Incomplete", escape(&short)));
+    }
     if let Some(p) = provenance(results) {
         rows.push(("Run", escape(&p)));
     }

@@ -64,7 +64,8 @@ pub use fitted::{Extrapolated, Reach, Slope};
 pub use index::write_index;
 pub use order::{Against, ERRATIC, FIT_ROWS, Order, fit_floor, fitted, order, time_to};
 pub use page::{
-    FIT_NOTE, SHARED, external_times, interval_cell, provenance, write_experiment, write_summary,
+    FIT_NOTE, SHARED, external_times, interval_cell, provenance, short_rows, write_experiment,
+    write_summary,
 };
 pub use pictures::Picture;
 pub use ranking::{EXACT_FROM_START, Ranked, Summary, TIED, ranked, ranks, shares_rank, tied};

@@ -216,10 +216,33 @@ fn header(page: &Page, results: &[JobResult]) -> String {
     if !not_run.is_empty() {
         let _ = writeln!(md, "Not run, no rows: {}.\n", not_run.join("; "));
     }
+    if let Some(short) = short_rows(page, results) {
+        let _ = writeln!(md, "**Incomplete**: {short}\n");
+    }
     if let Some(p) = provenance(results) {
         let _ = writeln!(md, "{p}\n");
     }
     md
+}
+
+/// Said where some (rule, budget) rows hold fewer jobs than the
+/// experiment's repeats (a shard left out of a merge): their figures, and
+/// any "K of N repeats", rest on the repeats present.
+pub fn short_rows(page: &Page, results: &[JobResult]) -> Option<String> {
+    let mut per_row: std::collections::BTreeMap<(usize, usize), usize> =
+        std::collections::BTreeMap::new();
+    for r in results {
+        *per_row.entry((r.rule_index, r.budget)).or_default() += 1;
+    }
+    let short = per_row.values().filter(|&&k| k < page.repeats).count();
+    (short > 0).then(|| {
+        format!(
+            "{short} of {} row(s) hold fewer than the {} repeat(s) (a shard \
+             missing from a merge, or a run stopped); their figures rest on the repeats present.",
+            per_row.len(),
+            page.repeats
+        )
+    })
 }
 
 /// Said of an experiment of several quantities.
