@@ -59,10 +59,12 @@ pub struct ExperimentSpec<F: Family> {
     /// The scene, in the family's format: only the parts it has.
     #[serde(deserialize_with = "super::tagged::object")]
     pub scene: F::SceneSpec,
-    /// Quantities to compute.
+    /// Quantities to compute, at least one, each once.
     #[serde(deserialize_with = "super::tagged::names")]
+    #[schemars(length(min = 1), extend("uniqueItems" = true))]
     pub quantities: Vec<F::Quantity>,
-    /// Rules and estimators to compare, with their parameters.
+    /// Rules and estimators to compare, with their parameters; at least one.
+    #[schemars(length(min = 1))]
     pub rules: Vec<Listed<F::Estimator>>,
     /// Budgets: a list, or a geometric range.
     pub budgets: Budgets,
@@ -73,6 +75,7 @@ pub struct ExperimentSpec<F: Family> {
     pub repeats: usize,
     /// Seed of every random stream (each job derives its own from it).
     #[serde(default, deserialize_with = "seed")]
+    #[schemars(range(max = u64::MAX))]
     pub seed: u64,
     /// The reference the errors are measured against.
     pub reference: ReferenceSpec<F::Quantity>,

@@ -463,7 +463,10 @@ fn a_schema_named_in_the_file_is_accepted_and_allowed_by_the_schema() {
 /// The experiment schema, read by boon (an independent validator), refuses
 /// what `check` refuses of the lists: an empty or repeated budget, more
 /// than 200 budgets, a range's factor of 1, no target, a repeated one or
-/// one outside (0, 1); and both still allow VALID.
+/// one outside [1e-15, 1), no quantity or a repeated one, and no rule;
+/// and both still allow VALID. (A seed past u64 is refused by check and by
+/// the schema's maximum read exactly; boon reads 2^64 as the f64 of
+/// u64::MAX and allows it.)
 #[test]
 fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
     let schema = bin().arg("schema").output().expect("runs");
@@ -505,6 +508,18 @@ fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
         (targets("[0]"), "targets[0]"),
         (targets("[1e-3, 1]"), "targets[1]"),
         (targets("[1e-3, 1e-16]"), "targets[1]"),
+        (VALID.replace("[\"tau\", \"I_E\"]", "[]"), "quantities"),
+        (
+            VALID.replace("[\"tau\", \"I_E\"]", "[\"tau\", \"tau\"]"),
+            "quantities",
+        ),
+        (
+            VALID.replace(
+                r#"[ { "rule": "gauss-legendre" }, { "rule": "stratified" } ]"#,
+                "[]",
+            ),
+            "rules",
+        ),
     ] {
         assert!(!valid(&refused), "the schema allowed: {refused}");
         fs::write(&file, &refused).expect("write");
