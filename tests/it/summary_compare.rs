@@ -453,13 +453,16 @@ fn compare_says_when_a_rank_becomes_shared() {
             ("gauss-legendre", 3, false),
         ],
     );
-    let c = compare(
-        &dir.join("old"),
-        &dir.join("new"),
-        &CompareOptions::default(),
-    )
-    .expect("compares");
-    let md = c.markdown();
+    let markdown = || {
+        compare(
+            &dir.join("old"),
+            &dir.join("new"),
+            &CompareOptions::default(),
+        )
+        .expect("compares")
+        .markdown()
+    };
+    let md = markdown();
     assert!(
         md.contains("- rank of simpson on square: 2 -> 1 (tied)\n"),
         "{md}"
@@ -479,13 +482,7 @@ fn compare_says_when_a_rank_becomes_shared() {
         .expect("ranked_at");
     summary["experiments"][0]["ranked_at"] = (at / 8.0).into();
     fs::write(&path, summary.to_string()).expect("write");
-    let c = compare(
-        &dir.join("old"),
-        &dir.join("new"),
-        &CompareOptions::default(),
-    )
-    .expect("compares");
-    let md = c.markdown();
+    let md = markdown();
     assert!(!md.contains("- rank of"), "{md}");
     assert!(
         md.contains(&format!(
