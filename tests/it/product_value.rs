@@ -299,3 +299,55 @@ fn values_that_are_not_finite_give_the_same_errors() {
     );
     assert_eq!(value, whole);
 }
+
+/// From 128 nodes on one axis the value's lanes are summed alone, and a
+/// block (256 nodes) whose sums are not finite sends the sum back to the
+/// first node: `f` is called once at each node where every value is
+/// finite, and twice up to the end of the failing block where one is not
+/// (the count the documentation of `product_value` gives). With an
+/// infinite error beside finite values (`WithError`, whose `all_finite`
+/// reads the value) nothing is taken again.
+#[test]
+fn the_sum_is_taken_again_only_past_a_value_that_is_not_finite() {
+    for n in [128, 255, 256, 257, 1000, 5000] {
+        let nodes = unit_nodes(n).expect("nodes");
+        let calls = std::cell::Cell::new(0usize);
+        let counted = |[u]: [f64; 1]| {
+            calls.set(calls.get() + 1);
+            Ok((3.0 * u).exp())
+        };
+        let value = product_value([&*nodes], counted).expect("finite");
+        assert!(
+            (value - (3f64.exp() - 1.0) / 3.0).abs() < 1e-13,
+            "{n}: {value}"
+        );
+        assert_eq!(calls.get(), n, "{n} nodes, finite");
+
+        let with_error = |[u]: [f64; 1]| {
+            calls.set(calls.get() + 1);
+            Ok(WithError {
+                value: u,
+                error: f64::INFINITY,
+            })
+        };
+        calls.set(0);
+        let value = product_value([&*nodes], with_error).expect("finite value");
+        assert!((value.value - 0.5).abs() < 1e-14, "{n}: {value:?}");
+        assert_eq!(calls.get(), n, "{n} nodes, infinite errors");
+
+        for bad in [0, n / 2, n - 1] {
+            calls.set(0);
+            let nan_at = |[u]: [f64; 1]| {
+                calls.set(calls.get() + 1);
+                Ok(if u == nodes.u[bad] { f64::NAN } else { u })
+            };
+            let err = product_value([&*nodes], nan_at).expect_err("a NaN");
+            assert!(
+                matches!(&err, QuadError::NonFiniteIntegrand { point, .. } if point == &[nodes.u[bad]]),
+                "{n} nodes, NaN at {bad}: {err}"
+            );
+            let block_end = ((bad / 256 + 1) * 256).min(n);
+            assert_eq!(calls.get(), 2 * block_end, "{n} nodes, NaN at {bad}");
+        }
+    }
+}

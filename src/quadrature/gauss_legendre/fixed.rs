@@ -29,8 +29,9 @@ use crate::value::Value;
 ///
 /// A result that is not finite is never returned: the error names the
 /// first node whose value is not finite, an end that is not finite, or the
-/// integral beyond the f64 range (in the table, after taking the integrand
-/// again at every node by the compensated sum).
+/// integral beyond the f64 range, after taking the integrand again by the
+/// compensated sum: in the table at every node, above it up to where the
+/// sum stopped ([`product_value`]).
 ///
 /// ```
 /// use lightquad::quadrature::gauss_legendre::FixedOrder;
@@ -109,8 +110,9 @@ impl FixedOrder {
     ///
     /// Errors where `a` or `b` or `b - a` is not finite, where `f` returns a
     /// value that is not finite (naming the node `x` and the value), and
-    /// where the integral passes the f64 range; in the table, to find
-    /// which, `f` is called at every node a second time.
+    /// where the integral passes the f64 range; to find which, `f` is
+    /// called a second time, in the table at every node, above it up to
+    /// where the sum stopped ([`product_value`]).
     #[inline]
     pub fn try_integrate<V: Value>(
         &self,
