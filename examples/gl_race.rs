@@ -2,14 +2,18 @@
 //! against `bilby` and `gauss-quad`, timed in interleaved rounds.
 //!
 //! `cargo run --release --example gl_race -- [ROUNDS] [--serial | --parallel] [--n N] [--calls C]`
-//! (in any order; ROUNDS default 41; `--serial` leaves out the two
+//! (in any order; ROUNDS default 41; `--serial` leaves out the three
 //! parallel contenders, `--parallel` times them alone; N nodes, default
 //! 1e6, 1 to 1e7; C calls a timing, default 1, so that a few-node call,
 //! some 50 ns, is timed in batches well above the clock's resolution)
 //!
 //! `lightquad rule` is the same integral through [`Rule::integrate`] with
 //! the error estimate off (as the peers have none), what a user calls;
-//! `lightquad` is the sum alone (`product_sum`). Up to 100 nodes
+//! `lightquad` is the sum alone (`product_sum`), `lightquad fixed` the
+//! rule prepared once ([`FixedOrder`]), as the peers' are, and `lightquad
+//! fixed par` its nodes shared among the threads
+//! ([`FixedOrder::par_integrate`]); `lightquad par` is `line_sum_par`, the
+//! whole sum (with what an error estimate reads). Up to 100 nodes
 //! `lightquad estimate` times the rule with its estimate on too.
 //!
 //! The same integral as `cargo bench --bench quadrature -- gl_integrate`:
@@ -233,6 +237,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }),
         ),
         (
+            "lightquad fixed par",
+            Box::new(|| {
+                fixed
+                    .par_integrate(black_box(a), black_box(b), integrand)
+                    .unwrap_or(f64::NAN)
+            }),
+        ),
+        (
             "gauss-quad par",
             Box::new(|| gq.par_integrate(black_box(a), black_box(b), integrand)),
         ),
@@ -309,6 +321,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("lightquad", "bilby"),
         ("lightquad", "gauss-quad"),
         ("lightquad", "plain loop"),
+        ("lightquad fixed par", "gauss-quad par"),
+        ("lightquad fixed par", "lightquad par"),
         ("lightquad par", "gauss-quad par"),
         ("lightquad par", "bilby"),
         ("lightquad par", "lightquad"),

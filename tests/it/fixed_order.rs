@@ -304,3 +304,43 @@ proptest! {
         prop_assert!(outside.is_none(), "n = {}, [{}, {}]: node {:?}", n, a, b, outside);
     }
 }
+
+/// `par_integrate`, the nodes shared among threads: `integrate`'s bits up
+/// to one span (4096 nodes), the same bits on one and on two threads,
+/// within the closed form's rounding bound above a span (the bound of
+/// `the_benchmark_integral_converges_on_both_sides_of_the_table`), and a
+/// value not finite named at its `x` as `integrate` names it.
+#[test]
+fn the_parallel_sum_is_the_serial_one_to_a_span_and_as_exact_beyond() {
+    let exact = 50f64.sin() / 25.0;
+    let f = |x: f64| (50.0 * x).cos();
+    let u = f64::EPSILON / 2.0;
+    let bound = 50.0 * (4.0 * u + 2.0 * u) * 2.0 + 4.0 * u * 1.3;
+    let pool = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+    };
+    for n in [5, 100, 101, 4096, 4097, 100_001, 1_000_000] {
+        let fixed = rule(n);
+        let serial = fixed.integrate(-1.0, 1.0, f).expect("finite");
+        let one = pool(1).install(|| fixed.par_integrate(-1.0, 1.0, f).expect("finite"));
+        let two = pool(2).install(|| fixed.par_integrate(-1.0, 1.0, f).expect("finite"));
+        assert_eq!(one.to_bits(), two.to_bits(), "n = {n}");
+        if n <= 4096 {
+            assert_eq!(one.to_bits(), serial.to_bits(), "n = {n}");
+        }
+        if n > 100 {
+            let error = (one - exact).abs();
+            assert!(error < bound, "n = {n}: error {error:e}");
+        }
+    }
+    let odd = rule(100_001);
+    let serial = odd.integrate(-1.0, 1.0, |x: f64| 1.0 / x).expect_err("1/0");
+    let par = pool(2)
+        .install(|| odd.par_integrate(-1.0, 1.0, |x: f64| 1.0 / x))
+        .expect_err("1/0");
+    assert_eq!(par, serial);
+    assert!(par.to_string().contains("inf at x = 0"), "{par}");
+}

@@ -8,7 +8,9 @@
 
 use lightquad::error::QuadError;
 use lightquad::quadrature::gauss_legendre::unit_nodes;
-use lightquad::quadrature::nodes::{PAR_SPAN, ProductSum, line_sum_par, par_span, product_sum};
+use lightquad::quadrature::nodes::{
+    PAR_SPAN, ProductSum, line_sum_par, line_value_par, par_span, product_sum,
+};
 use lightquad::quadrature::product::WithError;
 use lightquad::quadrature::{GaussLegendre, Rule, trapezoid};
 use lightquad::value::{Rgb, Value};
@@ -566,5 +568,66 @@ fn an_infinite_error_at_some_nodes_sums_to_an_infinite_error() {
             sum.value.value
         );
         assert_eq!(sum.value.error, f64::INFINITY);
+    }
+}
+
+/// `line_value_par`, the value alone across threads: `line_sum_par`'s
+/// value bit for bit on one to four threads, below, at and above one span
+/// (the closed form `sin(50)/50` bounds that sum); the same error for a
+/// NaN in a late span, for finite values near `f64::MAX` (found, as the
+/// whole sum finds them) and for an infinite error beside finite values
+/// (summed, not taken again: `WithError` reads the value).
+#[test]
+fn the_value_alone_is_the_whole_sums_bit_for_bit_with_its_errors() {
+    for n in [5, 200, PAR_SPAN, PAR_SPAN + 1, 3 * PAR_SPAN + 5, 200_000] {
+        let nodes = unit_nodes(n).expect("nodes");
+        let f = |u: f64| Ok((50.0 * u).cos());
+        let whole = line_sum_par(&nodes, f).expect("finite");
+        for threads in [1, 2, 4] {
+            let value = in_pool(threads, || line_value_par(&nodes, f)).expect("finite");
+            assert_eq!(
+                value.to_bits(),
+                whole.value.to_bits(),
+                "{n} nodes, {threads} threads"
+            );
+        }
+        // Converged from 200 nodes: within the nodes' own rounding, `|f'|
+        // = 50` times some `6 u` of node error, and the sum's `4 u`.
+        let u = f64::EPSILON / 2.0;
+        if n >= 200 {
+            let error = (whole.value - EXACT_HI - EXACT_LO).abs();
+            assert!(error < 50.0 * 6.0 * u + 4.0 * u, "{n}: error {error:e}");
+        }
+        let near_max = in_pool(2, || line_value_par(&nodes, |_| Ok(f64::MAX)));
+        let expected = line_sum_par(&nodes, |_| Ok(f64::MAX)).map(|s| s.value);
+        assert_eq!(near_max, expected, "{n} nodes, f64::MAX");
+        let infinite_error = |u: f64| {
+            Ok(WithError {
+                value: u,
+                error: f64::INFINITY,
+            })
+        };
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        let counted = |u: f64| {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            infinite_error(u)
+        };
+        let value = in_pool(2, || line_value_par(&nodes, counted)).expect("finite value");
+        let whole = line_sum_par(&nodes, infinite_error)
+            .expect("finite value")
+            .value;
+        assert_eq!(value.value.to_bits(), whole.value.to_bits(), "{n} nodes");
+        assert_eq!(calls.into_inner(), n, "{n} nodes: every node once");
+    }
+    let nodes = unit_nodes(200_000).expect("nodes");
+    let first = *nodes.u.iter().find(|&&u| u > 0.7).expect("a node past 0.7");
+    let nan_late = |u: f64| Ok(if u > 0.7 { f64::NAN } else { u });
+    for threads in [1, 2] {
+        match in_pool(threads, || line_value_par(&nodes, nan_late)) {
+            Err(QuadError::NonFiniteIntegrand { point, .. }) => {
+                assert_eq!(point, vec![first], "{threads} threads")
+            }
+            other => panic!("{threads} threads: expected the NaN at {first}, got {other:?}"),
+        }
     }
 }

@@ -14,7 +14,7 @@ use std::sync::Arc;
 use super::unit_table::{running_sum, unit_table};
 use super::{TABLE_MAX_ORDER, check_order, unit_nodes, unit_rule};
 use crate::error::{QuadError, channels, readable_number};
-use crate::quadrature::nodes::{UnitNodes, product_value};
+use crate::quadrature::nodes::{UnitNodes, line_value_par, product_value};
 use crate::quadrature::guard::stopped_by;
 use crate::value::Value;
 
@@ -139,6 +139,39 @@ impl FixedOrder {
         retabulated(table.len(), &[a, b], f)
     }
 
+    /// [`FixedOrder::integrate`] with the nodes shared among rayon's
+    /// threads above [`PAR_SPAN`] nodes ([`line_value_par`]), for an
+    /// integrand that may be called from several threads at once, as
+    /// gauss-quad's `par_integrate`; at most [`TABLE_MAX_ORDER`] nodes,
+    /// [`FixedOrder::integrate`] itself. The value is `integrate`'s bit for
+    /// bit up to [`PAR_SPAN`] nodes, and above differs from it in rounding
+    /// only (both compensated sums: the lanes restart at every span), the
+    /// same whatever the number of threads. The same errors, but that the
+    /// integrand is called a second time at the spans that ran where a
+    /// value is not finite, to name it.
+    ///
+    /// ```
+    /// use lightquad::quadrature::gauss_legendre::FixedOrder;
+    ///
+    /// let rule = FixedOrder::new(1_000_000)?;
+    /// let integral = rule.par_integrate(-1.0, 1.0, |x: f64| (50.0 * x).cos())?;
+    /// assert!((integral - 50f64.sin() / 25.0).abs() < 1e-16);
+    /// # Ok::<(), lightquad::QuadError>(())
+    /// ```
+    ///
+    /// [`PAR_SPAN`]: crate::quadrature::nodes::PAR_SPAN
+    pub fn par_integrate<V: Value>(
+        &self,
+        a: f64,
+        b: f64,
+        f: impl Fn(f64) -> V + Sync,
+    ) -> Result<V, QuadError> {
+        match &self.computed {
+            Some(nodes) => compensated_par(nodes, a, b, f),
+            None => self.integrate(a, b, f),
+        }
+    }
+
     /// [`compensated`] on the computed rule, every call above
     /// [`TABLE_MAX_ORDER`] nodes. Out of line, as [`retabulated`] is.
     #[inline(never)]
@@ -187,19 +220,60 @@ fn compensated<V: Value>(
     b: f64,
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<V, QuadError> {
-    let h = finite_length(a, b)?;
-    let s = scale_within(a, b, nodes.u.last().copied().unwrap_or(0.0));
-    let x_at = move |u: f64| a + s * u;
     // The integrand's own error goes back as it is; only the sum's own
     // (a value not finite at a node of [0, 1]) is told at its x.
     let mut own = None;
-    let mean = product_value([nodes], |u: [f64; 1]| {
-        f(x_at(u[0])).map_err(|e| stopped_by(&mut own, e))
+    let value = times_length(nodes, a, b, |at| {
+        product_value([nodes], |u: [f64; 1]| {
+            f(at.x(u[0])).map_err(|e| stopped_by(&mut own, e))
+        })
     });
-    if let Some(error) = own {
-        return Err(error);
+    match own {
+        Some(error) => Err(error),
+        None => value,
     }
-    let mean = mean.map_err(|e| named_at_x(e, x_at, a.min(b), a.max(b)))?;
+}
+
+/// [`compensated`] with the nodes shared among rayon's threads
+/// ([`line_value_par`]), for an integrand that does not fail.
+fn compensated_par<V: Value>(
+    nodes: &UnitNodes,
+    a: f64,
+    b: f64,
+    f: impl Fn(f64) -> V + Sync,
+) -> Result<V, QuadError> {
+    times_length(nodes, a, b, |at| line_value_par(nodes, |u| Ok(f(at.x(u)))))
+}
+
+/// Where a node `u` of `[0, 1]` lies on `[a, b]`: `a + s u`.
+#[derive(Clone, Copy)]
+struct NodeAt {
+    a: f64,
+    s: f64,
+}
+
+impl NodeAt {
+    #[inline(always)]
+    fn x(self, u: f64) -> f64 {
+        self.a + self.s * u
+    }
+}
+
+/// `h = b - a` times the `mean` taken with the nodes placed on `[a, b]`
+/// ([`compensated`]'s scale), a value not finite told at its `x`, and an
+/// integral beyond the f64 range refused.
+fn times_length<V: Value>(
+    nodes: &UnitNodes,
+    a: f64,
+    b: f64,
+    mean: impl FnOnce(NodeAt) -> Result<V, QuadError>,
+) -> Result<V, QuadError> {
+    let h = finite_length(a, b)?;
+    let at = NodeAt {
+        a,
+        s: scale_within(a, b, nodes.u.last().copied().unwrap_or(0.0)),
+    };
+    let mean = mean(at).map_err(|e| named_at_x(e, |u| at.x(u), a.min(b), a.max(b)))?;
     let value = mean.map(|m| m * h);
     if value.all_finite() {
         return Ok(value);

@@ -125,10 +125,6 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     a: &UnitNodes,
     f: F,
 ) -> Result<ProductSum<V>, QuadError> {
-    use rayon::prelude::*;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    use std::sync::{Mutex, PoisonError};
-
     // A value of no channels has nothing to store ([`LineSum::STORED`] is
     // 0): its nodes are evaluated, and their errors found, serially; and a
     // few nodes are summed term by term, as `line_sum` sums them.
@@ -136,6 +132,72 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     if V::CHANNELS == 0 || a.len() < LANES_FROM {
         return line_sum(a, f);
     }
+    match par_sum::<V, F, false>(a, &f)? {
+        Some(sums) => in_range(sums.finish(a)),
+        None => serially(a, f),
+    }
+}
+
+/// [`line_sum_par`]'s `value` alone, bit for bit, with its errors but for a
+/// companion's, as [`product_value`] is [`product_sum`]'s: the spans sum
+/// the value's lanes alone (no `sum |w y|`, largest term or companions),
+/// and where a span's sums stop being finite (a value not finite, a sum
+/// past the range) the whole of [`line_sum_par`] is taken again, which
+/// names it (`f` called a second time at the nodes of the spans that ran).
+///
+/// ```
+/// use lightquad::quadrature::gauss_legendre::unit_nodes;
+/// use lightquad::quadrature::nodes::{line_sum_par, line_value_par};
+///
+/// let nodes = unit_nodes(100_000)?;
+/// let f = |u: f64| Ok((50.0 * u).cos());
+/// let value = line_value_par(&nodes, f)?;
+/// assert_eq!(value, line_sum_par(&nodes, f)?.value);
+/// assert!((value - 50f64.sin() / 50.0).abs() < 1e-17);
+/// # Ok::<(), lightquad::error::QuadError>(())
+/// ```
+///
+/// [`product_value`]: super::product_value
+/// [`product_sum`]: super::product_sum
+pub fn line_value_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
+    a: &UnitNodes,
+    f: F,
+) -> Result<V, QuadError> {
+    a.check()?;
+    if V::CHANNELS == 0 || a.len() < LANES_FROM {
+        return line_value(a, f);
+    }
+    if let Some(sums) = par_sum::<V, F, true>(a, &f)? {
+        let value = sums.value.total();
+        if value.all_finite() {
+            return Ok(value);
+        }
+    }
+    value_in_range(line_sum_par(a, f)?)
+}
+
+/// [`line_sum`]: where the spans stopped without naming why, which only
+/// [`line_value_par`]'s do (the whole sum's name the value that is not
+/// finite), so never on [`line_sum_par`]'s path.
+#[cold]
+fn serially<V: Value>(
+    a: &UnitNodes,
+    f: impl FnMut(f64) -> Result<V, QuadError>,
+) -> Result<ProductSum<V>, QuadError> {
+    line_sum(a, f)
+}
+
+/// The sums of [`line_sum_par`] (with `VALUE_ONLY`, of
+/// [`line_value_par`]) over the spans of `a`, merged in node order; `None`
+/// where a value-only span stopped at sums that are not finite before any
+/// span failed.
+fn par_sum<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync, const VALUE_ONLY: bool>(
+    a: &UnitNodes,
+    f: &F,
+) -> Result<Option<LineSum<V>>, QuadError> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::{Mutex, PoisonError};
     // An atomic on a cache line of its own: a claim (a write) is not
     // seen by the other threads' reads of what lay beside it.
     #[repr(align(128))]
@@ -179,9 +241,9 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
                 // `f` is only borrowed, and a span that panicked is never
                 // read: nothing broken by the panic is seen again.
                 let span = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    LineSum::of_span(a, range, &f, sums)
+                    LineSum::of_span::<VALUE_ONLY>(a, range, f, sums)
                 }));
-                if !matches!(span, Ok(Ok(()))) {
+                if !matches!(span, Ok(Ok(true))) {
                     failed.0.fetch_min(k, Ordering::Relaxed);
                 }
                 *outcome = Some(span);
@@ -201,15 +263,16 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
         .into_iter()
         .zip(sums.chunks_exact(LineSum::<V>::STORED));
     let failure = spans.find_map(|(span, slot)| match span? {
-        Ok(Ok(())) => {
+        Ok(Ok(true)) => {
             total.merge(&LineSum::load(slot));
             None
         }
-        Ok(Err(error)) => Some(Ok(error)),
+        Ok(Ok(false)) => Some(Ok(None)),
+        Ok(Err(error)) => Some(Ok(Some(error))),
         Err(panic) => Some(Err(panic)),
     });
     let Some(failure) = failure else {
-        return in_range(total.finish(a));
+        return Ok(Some(total));
     };
     for (span, _) in spans {
         if let Some(Err(panic)) = span {
@@ -217,7 +280,8 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
         }
     }
     match failure {
-        Ok(error) => Err(error),
+        Ok(None) => Ok(None),
+        Ok(Some(error)) => Err(error),
         Err(panic) => std::panic::resume_unwind(panic),
     }
 }
@@ -234,7 +298,8 @@ fn drop_panic(panic: Box<dyn std::any::Any + Send>) {
 
 /// What one span of [`line_sum_par`] came to: its sums stored, the
 /// integrand's error, or the payload of its panic.
-type SpanOutcome = std::thread::Result<Result<(), QuadError>>;
+/// `Ok(Ok(false))`: a value-only span stopped at sums that are not finite.
+type SpanOutcome = std::thread::Result<Result<bool, QuadError>>;
 
 /// Nodes per block of [`LineSum::add_span`]: the values of a block are
 /// checked finite at once, and the companions summed. 256 rather than 64:
@@ -413,24 +478,28 @@ impl<V: Value> LineSum<V> {
     /// The sums over the nodes `range` of `a`, stored in `slot`
     /// ([`LineSum::store`]). Not inlined: in rayon's deeply inlined worker
     /// the integrand was left a call of its own at every node.
+    /// With `VALUE_ONLY`, the value's lanes alone, and `Ok(false)` (nothing
+    /// stored) where they stop ([`LineSum::add_value_span`]).
     #[inline(never)]
-    fn of_span(
+    fn of_span<const VALUE_ONLY: bool>(
         a: &UnitNodes,
         range: std::ops::Range<usize>,
         f: &impl Fn(f64) -> Result<V, QuadError>,
         slot: &mut [f64x4],
-    ) -> Result<(), QuadError> {
+    ) -> Result<bool, QuadError> {
         let mut sums = Self::new();
-        with_kernel_sharing(
-            SharedSpan {
+        let whole = with_kernel_sharing(
+            SharedSpan::<V, VALUE_ONLY> {
                 sums: &mut sums,
                 a,
                 range,
             },
             f,
         )?;
-        sums.store(slot);
-        Ok(())
+        if whole {
+            sums.store(slot);
+        }
+        Ok(whole)
     }
 
     /// Vectors [`LineSum::store`] fills: ten [`LaneValues`] (the sums and
@@ -510,21 +579,21 @@ struct Span<'a, V: Value, F, const VALUE_ONLY: bool> {
 
 /// [`Span`] with the integrand shared: [`LineSum::of_span`]'s, which
 /// reads it through a shared reference ([`KernelTask`]).
-struct SharedSpan<'a, V: Value> {
+struct SharedSpan<'a, V: Value, const VALUE_ONLY: bool> {
     sums: &'a mut LineSum<V>,
     a: &'a UnitNodes,
     range: std::ops::Range<usize>,
 }
 
-impl<V: Value, F: Fn(f64) -> Result<V, QuadError>> KernelTask<V, F> for SharedSpan<'_, V> {
-    type Output = Result<(), QuadError>;
+impl<V: Value, F: Fn(f64) -> Result<V, QuadError>, const VALUE_ONLY: bool> KernelTask<V, F>
+    for SharedSpan<'_, V, VALUE_ONLY>
+{
+    type Output = Result<bool, QuadError>;
 
     #[inline(always)]
     fn run(self, kernel: impl Kernel<V>, f: &F) -> Self::Output {
         let Self { sums, a, range } = self;
-        Span::<V, _, false> { sums, a, range, f }
-            .run(kernel, &())
-            .map(|_| ())
+        Span::<V, _, VALUE_ONLY> { sums, a, range, f }.run(kernel, &())
     }
 }
 

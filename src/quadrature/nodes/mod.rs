@@ -19,7 +19,7 @@ mod short;
 pub use composite::{CHECKED_POINTS, Composite, MAX_POINTS, coarse_weights};
 pub(crate) use estimate::ROUNDING_ULPS;
 pub use estimate::{DOMINANT_SHARE, dominated, richardson};
-pub use line::{PAR_SPAN, line_sum_par, par_span};
+pub use line::{PAR_SPAN, line_sum_par, line_value_par, par_span};
 use line::{line_sum, line_value};
 
 /// A 1-D rule on `[0, 1]`: nodes `u_i` and weights `w_i` with `sum w_i = 1`
