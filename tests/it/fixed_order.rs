@@ -331,6 +331,13 @@ fn the_parallel_sum_is_the_serial_one_to_a_span_and_as_exact_beyond() {
         if n <= 4096 {
             assert_eq!(one.to_bits(), serial.to_bits(), "n = {n}");
         }
+        // Two compensated sums of the same terms: each within an ulp or so
+        // of the terms' exact sum.
+        let apart = (one - serial).abs();
+        assert!(
+            apart <= 4.0 * f64::EPSILON * serial.abs(),
+            "n = {n}: {apart:e} apart"
+        );
         if n > 100 {
             let error = (one - exact).abs();
             assert!(error < bound, "n = {n}: error {error:e}");

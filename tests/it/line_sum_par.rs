@@ -9,10 +9,10 @@
 use lightquad::error::QuadError;
 use lightquad::quadrature::gauss_legendre::unit_nodes;
 use lightquad::quadrature::nodes::{
-    PAR_SPAN, ProductSum, line_sum_par, line_value_par, par_span, product_sum,
+    PAR_SPAN, ProductSum, line_sum_par, line_value_par, par_span, product_sum, product_value,
 };
 use lightquad::quadrature::product::WithError;
-use lightquad::quadrature::{GaussLegendre, Rule, trapezoid};
+use lightquad::quadrature::{GaussLegendre, Rule, simpson, trapezoid};
 use lightquad::value::{Rgb, Value};
 use rand::SeedableRng;
 
@@ -618,6 +618,30 @@ fn the_value_alone_is_the_whole_sums_bit_for_bit_with_its_errors() {
             .value;
         assert_eq!(value.value.to_bits(), whole.value.to_bits(), "{n} nodes");
         assert_eq!(calls.into_inner(), n, "{n} nodes: every node once");
+    }
+    // `f64::MAX` on composite nodes, whose coarser companions hold every
+    // term in one lane: the value as `product_value` finds it, never a
+    // companion's error.
+    for m in (129..=4097).step_by(2).chain([100_001]) {
+        for (rule, nodes) in [
+            ("trapezoid", trapezoid::unit_nodes(m).expect("nodes")),
+            ("simpson", simpson::unit_nodes(m).expect("nodes")),
+        ] {
+            let par = in_pool(2, || line_value_par(&nodes, |_| Ok(f64::MAX)));
+            let serial = product_value([&nodes], |_: [f64; 1]| Ok(f64::MAX));
+            match (&par, &serial) {
+                (Ok(p), Ok(s)) if m <= PAR_SPAN => assert_eq!(p, s, "{rule}, {m} nodes"),
+                (Ok(p), Ok(_)) => assert!(*p >= f64::MAX * (1.0 - 1e-12), "{rule}, {m}: {p:e}"),
+                (Err(p), Err(s)) => {
+                    assert_eq!(p, s, "{rule}, {m} nodes");
+                    assert!(
+                        matches!(p, QuadError::SumOutOfRange { sum: "value", .. }),
+                        "{rule}, {m} nodes: {p}"
+                    );
+                }
+                _ => panic!("{rule}, {m} nodes: {par:?} against {serial:?}"),
+            }
+        }
     }
     let nodes = unit_nodes(200_000).expect("nodes");
     let first = *nodes.u.iter().find(|&&u| u > 0.7).expect("a node past 0.7");

@@ -335,6 +335,21 @@ fn the_sum_is_taken_again_only_past_a_value_that_is_not_finite() {
         assert!((value.value - 0.5).abs() < 1e-14, "{n}: {value:?}");
         assert_eq!(calls.get(), n, "{n} nodes, infinite errors");
 
+        // `f64::MAX` at every trapezoid node: the lanes' sums stay within
+        // the range and their total, `int_0^1 f64::MAX`, is found with no
+        // second pass (the whole sum's `4h` companion, in one lane, leaves
+        // the range at some counts: not this sum's error).
+        let m = 2 * n + 1;
+        let composite = trapezoid::unit_nodes(m).expect("nodes");
+        calls.set(0);
+        let at_max = product_value([&composite], |_: [f64; 1]| {
+            calls.set(calls.get() + 1);
+            Ok(f64::MAX)
+        });
+        let near_max = |v: &f64| *v >= f64::MAX * (1.0 - 1e-12);
+        assert!(at_max.as_ref().is_ok_and(near_max), "{m} nodes: {at_max:?}");
+        assert_eq!(calls.get(), m, "{m} trapezoid nodes, f64::MAX");
+
         for bad in [0, n / 2, n - 1] {
             calls.set(0);
             let nan_at = |[u]: [f64; 1]| {

@@ -94,7 +94,8 @@ impl FixedOrder {
     }
 
     /// `int_a^b f(x) dx` (negated where `b < a`), `f` called once at each
-    /// node; see [`FixedOrder::try_integrate`] for the errors.
+    /// node but where a value is not finite or a sum leaves the f64 range;
+    /// see [`FixedOrder::try_integrate`].
     #[inline]
     pub fn integrate<V: Value>(
         &self,
@@ -146,9 +147,12 @@ impl FixedOrder {
     /// [`FixedOrder::integrate`] itself. The value is `integrate`'s bit for
     /// bit up to [`PAR_SPAN`] nodes, and above differs from it in rounding
     /// only (both compensated sums: the lanes restart at every span), the
-    /// same whatever the number of threads. The same errors, but that the
-    /// integrand is called a second time at the spans that ran where a
-    /// value is not finite, to name it.
+    /// same whatever the number of threads. The same errors, but for a sum
+    /// within rounding of the f64 range, which can leave it in one and not
+    /// in the other ([`line_sum_par`](crate::quadrature::nodes::line_sum_par)).
+    /// Where a value is not finite, or a sum leaves the range, `f` is
+    /// called a second time at every node the whole sum reaches to name it
+    /// ([`line_value_par`]).
     ///
     /// ```
     /// use lightquad::quadrature::gauss_legendre::FixedOrder;

@@ -132,18 +132,16 @@ pub fn line_sum_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     if V::CHANNELS == 0 || a.len() < LANES_FROM {
         return line_sum(a, f);
     }
-    match par_sum::<V, F, false>(a, &f)? {
-        Some(sums) => in_range(sums.finish(a)),
-        None => serially(a, f),
-    }
+    in_range(whole_par(a, &f)?.finish(a))
 }
 
 /// [`line_sum_par`]'s `value` alone, bit for bit, with its errors but for a
 /// companion's, as [`product_value`] is [`product_sum`]'s: the spans sum
 /// the value's lanes alone (no `sum |w y|`, largest term or companions),
 /// and where a span's sums stop being finite (a value not finite, a sum
-/// past the range) the whole of [`line_sum_par`] is taken again, which
-/// names it (`f` called a second time at the nodes of the spans that ran).
+/// past the range), or their total is not, the whole of [`line_sum_par`]
+/// is taken again, which names it: `f` is called a second time at every
+/// node that sum reaches.
 ///
 /// ```
 /// use lightquad::quadrature::gauss_legendre::unit_nodes;
@@ -173,18 +171,23 @@ pub fn line_value_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
             return Ok(value);
         }
     }
-    value_in_range(line_sum_par(a, f)?)
+    value_in_range(whole_par(a, &f)?.finish(a))
 }
 
-/// [`line_sum`]: where the spans stopped without naming why, which only
-/// [`line_value_par`]'s do (the whole sum's name the value that is not
-/// finite), so never on [`line_sum_par`]'s path.
-#[cold]
-fn serially<V: Value>(
+/// [`par_sum`]'s whole sums, which never stop without an error: a span
+/// of them names the value that is not finite. An error that says so
+/// rather than a panic, should one ever come back stopped.
+fn whole_par<V: Value, F: Fn(f64) -> Result<V, QuadError> + Sync>(
     a: &UnitNodes,
-    f: impl FnMut(f64) -> Result<V, QuadError>,
-) -> Result<ProductSum<V>, QuadError> {
-    line_sum(a, f)
+    f: &F,
+) -> Result<LineSum<V>, QuadError> {
+    par_sum::<V, F, false>(a, f)?.ok_or_else(|| {
+        QuadError::invalid(
+            "line_sum_par",
+            "a span stopped without an error",
+            "a whole span that runs to its end or names its error",
+        )
+    })
 }
 
 /// The sums of [`line_sum_par`] (with `VALUE_ONLY`, of
@@ -343,16 +346,18 @@ pub(super) fn line_sum<V: Value>(
 /// y|`, the largest term, the companions): below [`SHORT_BELOW`] nodes
 /// [`short_value`], from there the lanes of the value alone
 /// ([`LineSum::add_value_span`]). Where those lanes meet a value that is
-/// not finite, or leave the f64 range, the whole sum is taken again from
-/// the first node (`f` called a second time at the nodes before), which
-/// names the node or the sum as [`line_sum`] does.
+/// not finite, or leave the f64 range, or their total does, the whole sum
+/// is taken again from the first node and names the node or the sum as
+/// [`line_sum`] does: `f` is called a second time at every node that sum
+/// reaches (to the end of the block holding the first value that is not
+/// finite, or every node).
 ///
 /// Why: at n = 1e6 on `cos(50 x)` the largest term's `maxpd` alone, one
 /// instruction a group of four nodes, cost 0.7% (`examples/gl_race.rs`,
-/// `lightquad / bilby` 1.0132 with it and 1.0059 without, medians of 7 and
-/// 5 processes); without `sum |w y|` too, the rule through
+/// `lightquad / bilby` 1.0132 with it and 1.0059 without); without `sum |w
+/// y|` too, the rule through
 /// [`Rule::integrate`](crate::quadrature::Rule::integrate) went from
-/// 1.0134 to 1.0032 times bilby (benches/README.md, tenth session).
+/// 1.0134 to 1.0055 times bilby (benches/README.md, tenth session).
 #[inline]
 pub(super) fn line_value<V: Value>(
     a: &UnitNodes,
@@ -676,7 +681,7 @@ impl<V: Value, F: FnMut(f64) -> Result<V, QuadError>, const VALUE_ONLY: bool> Ke
                 &mut largest,
             );
             if VALUE_ONLY {
-                if !value.parts()[0].sum().all_finite() {
+                if !value.parts()[0].finite_as_value() {
                     return Ok(false);
                 }
                 continue;

@@ -266,11 +266,10 @@ fn odometer_sum<const D: usize, V: Value, F: FnMut([f64; D]) -> Result<V, QuadEr
 /// the call (`benches/README.md`, `gl_small`), at 1e6 nodes of `cos(50 x)`
 /// one percent. Where a value is not finite, or the sum leaves the f64
 /// range, the whole sum is taken again to name it: from 128 nodes on one
-/// axis `f` is then called a second time at the nodes up to the end of the
-/// block of 256 where the lanes' sums stopped being finite (a value not
-/// finite, or a running sum past `f64::MAX`), or at every node where the
-/// total alone leaves the range (below 128 the values are kept and summed
-/// again).
+/// axis `f` is then called a second time at every node that sum reaches,
+/// to the end of the block of 256 holding the first value that is not
+/// finite, or every node where the sum left the range (below 128 the
+/// values are kept and summed again).
 ///
 /// ```
 /// use lightquad::quadrature::gauss_legendre::unit_nodes;
