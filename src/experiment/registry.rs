@@ -451,6 +451,13 @@ impl Registry {
                 serde_json::json!({ "const": e.name, "description": e.about });
             branch["properties"]["name"]["pattern"] =
                 format!("^[A-Za-z0-9_-]{{1,{}}}$", super::validate::MAX_NAME).into();
+            // The family's own equation IDs, as `check` accepts them; none
+            // where it instantiates no equation of the documents.
+            branch["properties"]["equations"]["items"] = if e.equations.is_empty() {
+                serde_json::json!(false)
+            } else {
+                serde_json::json!({ "enum": e.equations })
+            };
             branches.push(branch);
         }
         for v in defs.values_mut().chain(branches.iter_mut()) {

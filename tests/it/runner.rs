@@ -463,8 +463,9 @@ fn a_schema_named_in_the_file_is_accepted_and_allowed_by_the_schema() {
 /// The experiment schema, read by boon (an independent validator), refuses
 /// what `check` refuses of the lists: an empty or repeated budget, more
 /// than 200 budgets, a range's factor of 1, no target, a repeated one or
-/// one outside [1e-15, 1), no quantity or a repeated one, and no rule;
-/// and both still allow VALID. (A seed past u64 is refused by check and by
+/// one outside [1e-15, 1), an equation ID not of the family (and any for a
+/// family of none), no quantity or a repeated one, and no rule; and both
+/// still allow VALID. (A seed past u64 is refused by check and by
 /// the schema's maximum read exactly; boon reads 2^64 as the f64 of
 /// u64::MAX and allows it.)
 #[test]
@@ -508,6 +509,7 @@ fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
         (targets("[0]"), "targets[0]"),
         (targets("[1e-3, 1]"), "targets[1]"),
         (targets("[1e-3, 1e-16]"), "targets[1]"),
+        (VALID.replace("\"V-E\"]", "\"V-e\"]"), "equations[1]"),
         (VALID.replace("[\"tau\", \"I_E\"]", "[]"), "quantities"),
         (
             VALID.replace("[\"tau\", \"I_E\"]", "[\"tau\", \"tau\"]"),
@@ -527,6 +529,16 @@ fn the_schema_refuses_empty_and_repeated_budgets_and_repeated_targets() {
         assert!(!o.status.success(), "check allowed: {refused}");
         assert!(stderr(&o).contains(&format!("`{field}")), "{}", stderr(&o));
     }
+    // A family of no equations: its own file is allowed, and refused with
+    // any equation ID in it.
+    let calibration = fs::read_to_string(root().join("experiments/calibration-exp.json"))
+        .expect("calibration-exp.json");
+    assert!(valid(&calibration));
+    let with_id = calibration.replacen('{', r#"{"equations": ["V-tau"],"#, 1);
+    assert!(!valid(&with_id), "the schema allowed: {with_id}");
+    fs::write(&file, &with_id).expect("write");
+    let o = bin().arg("check").arg(&file).output().expect("runs");
+    assert!(stderr(&o).contains("`equations[0]`"), "{}", stderr(&o));
     fs::write(&file, VALID).expect("write");
     let o = bin().arg("check").arg(&file).output().expect("runs");
     assert!(o.status.success(), "{}", stderr(&o));
