@@ -11,7 +11,7 @@
 
 use std::sync::Arc;
 
-use super::unit_table::{running_sum, unit_table};
+use super::unit_table::{FIXED_STRAIGHT_UP_TO, running_sum, unit_table};
 use super::{TABLE_MAX_ORDER, check_order, unit_nodes, unit_rule};
 use crate::error::{QuadError, channels, readable_number};
 use crate::quadrature::nodes::{UnitNodes, line_value_par, product_value};
@@ -133,7 +133,7 @@ impl FixedOrder {
         if !h.is_finite() {
             return retabulated(table.len(), &[a, b], f);
         }
-        let value = running_sum(table, |u| f(a + h * u))?.map(|s| s * h);
+        let value = running_sum::<FIXED_STRAIGHT_UP_TO, V>(table, |u| f(a + h * u))?.map(|s| s * h);
         if value.all_finite() {
             return Ok(value);
         }

@@ -89,7 +89,7 @@ pub(super) fn tabulated_value<V: Value>(
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
     evaluations: &mut u64,
 ) -> Result<V, QuadError> {
-    let sum = running_sum(RULES[m], &mut f)?;
+    let sum = running_sum::<RULE_STRAIGHT_UP_TO, V>(RULES[m], &mut f)?;
     *evaluations = m as u64;
     if sum.all_finite() {
         return Ok(sum);
@@ -101,12 +101,13 @@ pub(super) fn tabulated_value<V: Value>(
 /// `sum_i w_i f(u_i)` over `pairs` (`[u_i, w_i]`), one running sum in
 /// their order, unchecked: within `gamma_(k-1) sum |w f|` of the terms'
 /// exact sum where it is finite, `k = pairs.len()` (module doc). Up to
-/// [`STRAIGHT_UP_TO`] pairs, one arm an order ([`straight_sum`]); above,
-/// a loop by index, as the peers' loops run (`benches/README.md`,
-/// `gl_small`, fifth and sixth sessions). Both add the same terms in the
-/// same order, so the arms change no bit of a value.
+/// `UPTO` pairs (at most [`STRAIGHT_UP_TO`]), one arm an order
+/// ([`straight_sum`]); above, a loop over chunks of [`CHUNK`] pairs
+/// ([`chunked_sum`]; `benches/README.md`, `gl_small`, fifth, sixth and
+/// eleventh sessions). Both add the same terms in the same order, so the
+/// arms change no bit of a value.
 #[inline(always)]
-pub(super) fn running_sum<V: Value>(
+pub(super) fn running_sum<const UPTO: usize, V: Value>(
     pairs: &[[f64; 2]],
     f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<V, QuadError> {
@@ -119,25 +120,36 @@ pub(super) fn running_sum<V: Value>(
                 [$($k),*].len() == STRAIGHT_UP_TO && [$($k),*][STRAIGHT_UP_TO - 1] == STRAIGHT_UP_TO,
                 "one arm for each order 1..=STRAIGHT_UP_TO"
             );
+            const { assert!(UPTO <= STRAIGHT_UP_TO) };
             match pairs.len() {
-                $($k => match <&[[f64; 2]; $k]>::try_from(pairs) {
+                $($k if $k <= UPTO => match <&[[f64; 2]; $k]>::try_from(pairs) {
                     Ok(order) => straight_sum(order, f),
-                    Err(_) => looped_sum(pairs, f),
+                    Err(_) => chunked_sum(pairs, f),
                 },)*
-                _ => looped_sum(pairs, f),
+                _ => chunked_sum(pairs, f),
             }
         }};
     }
-    by_order!(1 2 3 4 5 6 7 8)
+    by_order!(1 2 3 4 5 6 7 8 9 10)
 }
 
-/// Orders summed by [`straight_sum`]. Each order's arm is compiled with
-/// the integrand inlined at each of its calls where the compiler inlines
-/// it (a large integrand may be called instead): 36 copies per integrand
-/// and call site, on `FixedOrder` and on the rule's tabulated line alike,
-/// and nested integrals multiply them. Only the order in use runs. The
-/// command-line binary grew by 1.8% (`benches/README.md`, sixth session).
-const STRAIGHT_UP_TO: usize = 8;
+/// Most orders [`running_sum`] sums by [`straight_sum`]. Each order's arm
+/// is compiled with the integrand inlined at each of its calls where the
+/// compiler inlines it (a large integrand may be called instead):
+/// `k (k + 1) / 2` copies per integrand and call site for arms up to `k`,
+/// and nested integrals multiply them. Only the order in use runs.
+const STRAIGHT_UP_TO: usize = FIXED_STRAIGHT_UP_TO;
+
+/// [`running_sum`]'s arms on `FixedOrder`: 55 copies of the integrand,
+/// where 8 arms left n = 10 about 1% slower than bilby (`benches/README.md`,
+/// eleventh session).
+pub(super) const FIXED_STRAIGHT_UP_TO: usize = 10;
+
+/// [`running_sum`]'s arms on the rule's tabulated line: 36 copies (the
+/// command-line binary grew by 1.8%, `benches/README.md`, sixth session).
+/// Arms to 10 there made the rule 5 to 10% slower at n = 5, 10 and 20
+/// (eleventh session): the compiler inlined less of its caller.
+const RULE_STRAIGHT_UP_TO: usize = 8;
 
 /// [`running_sum`] over an order known when compiled: a loop of `K`
 /// steps, which an optimized build unrolls into `K` calls in a row.
@@ -153,16 +165,28 @@ fn straight_sum<const K: usize, V: Value>(
     Ok(sum)
 }
 
-/// [`running_sum`] above [`STRAIGHT_UP_TO`] pairs.
+/// Pairs [`chunked_sum`] takes at a time. Against a loop by index over the
+/// pairs, the rule at n = 20 and 50 went from 1.0094 and 0.9836 times
+/// bilby to 0.9828 and 0.9739, `FixedOrder` at n = 20 from 1.0033 to
+/// 0.9963 (`benches/README.md`, eleventh session).
+const CHUNK: usize = 4;
+
+/// [`running_sum`] above its straight arms, [`CHUNK`] terms at a time,
+/// each chunk's calls one after another (as in [`straight_sum`]), then the
+/// remaining terms in their order.
 #[inline(always)]
-fn looped_sum<V: Value>(
+fn chunked_sum<V: Value>(
     pairs: &[[f64; 2]],
     mut f: impl FnMut(f64) -> Result<V, QuadError>,
 ) -> Result<V, QuadError> {
     let mut sum = V::zero();
-    #[allow(clippy::needless_range_loop)]
-    for i in 0..pairs.len() {
-        let [u, w] = pairs[i];
+    let (chunks, rest) = pairs.as_chunks::<CHUNK>();
+    for chunk in chunks {
+        for &[u, w] in chunk {
+            sum = sum.zip(f(u)?, |s, y| s + y * w);
+        }
+    }
+    for &[u, w] in rest {
         sum = sum.zip(f(u)?, |s, y| s + y * w);
     }
     Ok(sum)
