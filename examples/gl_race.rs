@@ -321,6 +321,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("lightquad", "bilby"),
         ("lightquad", "gauss-quad"),
         ("lightquad", "plain loop"),
+        ("plain loop", "bilby"),
+        ("lightquad fixed", "plain loop"),
         ("lightquad fixed par", "gauss-quad par"),
         ("lightquad fixed par", "lightquad par"),
         ("lightquad par", "gauss-quad par"),
