@@ -18,9 +18,9 @@ fn rule(n: usize) -> FixedOrder {
 #[test]
 fn polynomials_up_to_degree_2n_minus_1_are_exact() {
     let (a, b, c): (f64, f64, f64) = (-0.5, 2.0, 0.75);
-    let straight_and_looped = 1..=12;
+    let straight_and_chunked = 1..=12;
     let larger = [37, 64, 99, 100, 101, 128, 300];
-    for n in straight_and_looped.chain(larger) {
+    for n in straight_and_chunked.chain(larger) {
         let fixed = rule(n);
         assert_eq!(fixed.order(), n);
         for k in [0, n, 2 * n - 1] {

@@ -136,8 +136,9 @@ pub(super) fn running_sum<const UPTO: usize, V: Value>(
 /// Most orders [`running_sum`] sums by [`straight_sum`]. Each order's arm
 /// is compiled with the integrand inlined at each of its calls where the
 /// compiler inlines it (a large integrand may be called instead):
-/// `k (k + 1) / 2` copies per integrand and call site for arms up to `k`,
-/// and nested integrals multiply them. Only the order in use runs.
+/// `k (k + 1) / 2` copies per integrand and call site for arms up to `k`
+/// (and [`chunked_sum`]'s own beside them), and nested integrals multiply
+/// them. Only the order in use runs.
 const STRAIGHT_UP_TO: usize = FIXED_STRAIGHT_UP_TO;
 
 /// [`running_sum`]'s arms on `FixedOrder`: 55 copies of the integrand,
